@@ -1,0 +1,161 @@
+//! One 8×8×8 brick as the GPU reads it: a 512-bit occupancy mask and one material word.
+//!
+//! Bit order: voxel (x, y, z), each in 0..8, has linear index `i = x + 8·y + 64·z`; it is bit
+//! `i % 32` of `mask[i / 32]`. Material bytes of a non-uniform brick are stored in that order
+//! for solid voxels only, so a voxel's slot is the number of set bits before it (its rank).
+
+use bytemuck::{Pod, Zeroable};
+
+/// Voxels along one brick edge.
+pub const BRICK_EDGE: i32 = 8;
+/// Voxels in one brick.
+pub const BRICK_VOXELS: usize = 512;
+/// Set in [`Brick::material`] when every solid voxel of the brick uses one material; the low
+/// 8 bits are then that material index and the brick owns no material bytes.
+pub const UNIFORM_FLAG: u32 = 1 << 31;
+
+/// Linear index of a voxel inside its brick (coordinates in 0..8).
+#[inline]
+pub fn voxel_bit(x: i32, y: i32, z: i32) -> usize {
+    debug_assert!((0..8).contains(&x) && (0..8).contains(&y) && (0..8).contains(&z));
+    (x + 8 * y + 64 * z) as usize
+}
+
+/// The 512-bit occupancy mask of a brick. Keep in sync with `Brick.mask` in the shaders.
+#[repr(transparent)]
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Pod, Zeroable, Default)]
+pub struct Mask(pub [u32; 16]);
+
+impl std::fmt::Debug for Mask {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Mask({} set)", self.count())
+    }
+}
+
+impl Mask {
+    /// No voxel set.
+    pub const EMPTY: Mask = Mask([0; 16]);
+    /// Every voxel set.
+    pub const FULL: Mask = Mask([u32::MAX; 16]);
+
+    /// Whether voxel `i` is set.
+    #[inline]
+    pub fn get(&self, i: usize) -> bool {
+        self.0[i >> 5] >> (i & 31) & 1 != 0
+    }
+    /// Sets voxel `i`.
+    #[inline]
+    pub fn set(&mut self, i: usize) {
+        self.0[i >> 5] |= 1 << (i & 31);
+    }
+    /// Clears voxel `i`.
+    #[inline]
+    pub fn clear(&mut self, i: usize) {
+        self.0[i >> 5] &= !(1 << (i & 31));
+    }
+    /// Number of set voxels.
+    #[inline]
+    pub fn count(&self) -> u32 {
+        self.0.iter().map(|w| w.count_ones()).sum()
+    }
+    /// Number of set voxels before voxel `i`: the slot of voxel `i` in popcount order.
+    #[inline]
+    pub fn rank(&self, i: usize) -> usize {
+        let word = i >> 5;
+        let below: u32 = self.0[..word].iter().map(|w| w.count_ones()).sum();
+        let partial = self.0[word] & ((1u32 << (i & 31)) - 1);
+        (below + partial.count_ones()) as usize
+    }
+    /// No voxel set.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.0.iter().all(|&w| w == 0)
+    }
+    /// All voxels set.
+    #[inline]
+    pub fn is_full(&self) -> bool {
+        self.0.iter().all(|&w| w == u32::MAX)
+    }
+    /// Bitwise and.
+    #[inline]
+    pub fn and(&self, o: &Mask) -> Mask {
+        Mask(std::array::from_fn(|i| self.0[i] & o.0[i]))
+    }
+    /// Bitwise or.
+    #[inline]
+    pub fn or(&self, o: &Mask) -> Mask {
+        Mask(std::array::from_fn(|i| self.0[i] | o.0[i]))
+    }
+    /// `self & !o`.
+    #[inline]
+    pub fn and_not(&self, o: &Mask) -> Mask {
+        Mask(std::array::from_fn(|i| self.0[i] & !o.0[i]))
+    }
+    /// Indices of the set voxels, ascending (popcount order).
+    pub fn ones(&self) -> impl Iterator<Item = usize> + '_ {
+        self.0.iter().enumerate().flat_map(|(w, &bits)| {
+            let mut b = bits;
+            std::iter::from_fn(move || {
+                if b == 0 {
+                    return None;
+                }
+                let t = b.trailing_zeros() as usize;
+                b &= b - 1;
+                Some(w * 32 + t)
+            })
+        })
+    }
+}
+
+/// A brick as stored in the GPU brick buffer (68 bytes). Keep in sync with `struct Brick` in
+/// `shaders/brickmap.glsl`.
+#[repr(C)]
+#[derive(Clone, Copy, PartialEq, Eq, Pod, Zeroable, Default, Debug)]
+pub struct Brick {
+    /// Occupancy, bit order as in the module docs.
+    pub mask: Mask,
+    /// [`UNIFORM_FLAG`] set: low 8 bits are the material index of every solid voxel.
+    /// Clear: global byte offset of this brick's first material byte in the material buffer.
+    pub material: u32,
+}
+const _: () = assert!(std::mem::size_of::<Brick>() == 68);
+
+impl Brick {
+    /// Whether every solid voxel shares one material stored in the word itself.
+    #[inline]
+    pub fn is_uniform(&self) -> bool {
+        self.material & UNIFORM_FLAG != 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rank_counts_bits_before() {
+        let mut m = Mask::EMPTY;
+        for i in [0, 5, 31, 32, 33, 200, 511] {
+            m.set(i);
+        }
+        assert_eq!(m.rank(0), 0);
+        assert_eq!(m.rank(5), 1);
+        assert_eq!(m.rank(32), 3);
+        assert_eq!(m.rank(511), 6);
+        assert_eq!(m.count(), 7);
+        assert_eq!(
+            m.ones().collect::<Vec<_>>(),
+            vec![0, 5, 31, 32, 33, 200, 511]
+        );
+        m.clear(33);
+        assert!(!m.get(33) && m.get(32));
+    }
+
+    #[test]
+    fn bit_order_is_x_fastest() {
+        assert_eq!(voxel_bit(1, 0, 0), 1);
+        assert_eq!(voxel_bit(0, 1, 0), 8);
+        assert_eq!(voxel_bit(0, 0, 1), 64);
+        assert_eq!(voxel_bit(7, 7, 7), 511);
+    }
+}

@@ -1,0 +1,126 @@
+//! Edit operations, as submitted to the world, and their inverses.
+//!
+//! An inverse holds, per touched brick, the prior occupancy of exactly the touched voxels and
+//! the prior materials of those that were solid (sparse, in popcount order): applying it
+//! restores the prior content, and applying it returns the inverse of that in turn (redo).
+
+use crate::brick::Mask;
+use crate::shape::Shape;
+use glam::{IVec3, UVec3};
+
+/// What a shape edit does to the voxels inside the shape.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Mode {
+    /// Make every voxel solid with this material (existing voxels take it too).
+    Add(u8),
+    /// Make every voxel empty.
+    Remove,
+    /// Give every solid voxel this material; empty voxels stay empty.
+    Paint(u8),
+}
+
+/// One single-voxel write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum VoxelOp {
+    /// Solid with a material.
+    Set(u8),
+    /// Empty.
+    Clear,
+    /// New material if solid.
+    Paint(u8),
+}
+
+/// A single-voxel write at a position.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct VoxelEdit {
+    /// Voxel coordinate (must lie in the grid).
+    pub pos: IVec3,
+    /// What to do there.
+    pub op: VoxelOp,
+}
+
+/// An edit the world applies atomically (every brick or none, on success or error).
+#[derive(Clone, Debug, PartialEq)]
+pub enum EditOp {
+    /// A shape with a mode; voxels outside the grid are clipped away.
+    Shape {
+        /// The region.
+        shape: Shape,
+        /// What happens inside it.
+        mode: Mode,
+    },
+    /// A batch of single-voxel writes, applied in list order (a later write to the same
+    /// voxel wins). Every position must lie in the grid.
+    Voxels(Vec<VoxelEdit>),
+    /// Puts back what an earlier edit changed (undo), or re-applies it (redo).
+    Restore(EditInverse),
+}
+
+/// Prior materials of the touched solid voxels of one brick.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PriorMaterials {
+    /// The brick was uniform: every prior solid voxel had this material.
+    Uniform(u8),
+    /// One byte per voxel of `touched ∩ prior_mask`, in popcount order.
+    PerVoxel(Vec<u8>),
+}
+
+/// The prior state of the touched voxels of one brick.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BrickUndo {
+    /// Brick coordinate.
+    pub brick: UVec3,
+    /// Occupancy before the edit (only bits inside `touched` matter).
+    pub prior_mask: Mask,
+    /// Voxels the edit may have changed.
+    pub touched: Mask,
+    /// Their prior materials.
+    pub prior: PriorMaterials,
+}
+
+impl BrickUndo {
+    /// The prior material of the `k`-th voxel of `touched ∩ prior_mask`.
+    #[inline]
+    pub fn prior_material(&self, k: usize) -> u8 {
+        match &self.prior {
+            PriorMaterials::Uniform(m) => *m,
+            PriorMaterials::PerVoxel(v) => v[k],
+        }
+    }
+}
+
+/// Everything needed to undo an edit, sorted by brick cell (deterministic whatever the
+/// worker count).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct EditInverse {
+    /// One entry per touched brick.
+    pub bricks: Vec<BrickUndo>,
+}
+
+impl EditInverse {
+    /// Whether the edit changed nothing.
+    pub fn is_empty(&self) -> bool {
+        self.bricks.is_empty()
+    }
+    /// Heap bytes held (what an undo history pays for this step).
+    pub fn heap_bytes(&self) -> usize {
+        self.bricks.capacity() * std::mem::size_of::<BrickUndo>()
+            + self
+                .bricks
+                .iter()
+                .map(|b| match &b.prior {
+                    PriorMaterials::Uniform(_) => 0,
+                    PriorMaterials::PerVoxel(v) => v.capacity(),
+                })
+                .sum::<usize>()
+    }
+}
+
+/// What an applied edit reports.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct EditOutcome {
+    /// The inverse edit.
+    pub inverse: EditInverse,
+    /// Voxels whose occupancy or material changed.
+    pub changed_voxels: u64,
+}

@@ -1,0 +1,688 @@
+//! The world: the grid split into x-slabs, one worker thread per slab, fed by
+//! crossbeam-channel queues. Any thread may submit an edit; it is validated first (bad input
+//! never reaches a worker), split into per-slab parts, and queued to the workers it touches
+//! in one global order, so every slab sees edits in the same order whatever the thread that
+//! submitted them. A [`Ticket`] waits for the parts; if any part fails, the others are rolled
+//! back, so an edit applies entirely or not at all. A worker panic is caught and reported.
+
+use crate::brick::Brick;
+use crate::dirty::DirtyRanges;
+use crate::edit::{EditInverse, EditOp, EditOutcome, Mode, PriorMaterials, VoxelEdit};
+use crate::error::{BrickmapError, Result};
+use crate::grid::{EMPTY_BRICK, GridDims, SlabBounds};
+use crate::material::{Material, MaterialKind, MaterialTable, MaterialTablesGpu};
+use crate::shape::Shape;
+use crate::slab::{Slab, WorkItem};
+use crate::storage::{BRICK_CHUNK, BucketSizes, ChunkCounters, MATERIAL_CHUNK};
+use crossbeam_channel::{Receiver, Sender};
+use glam::{IVec3, UVec3};
+use std::ops::Range;
+use std::sync::{Arc, Mutex, RwLock, RwLockReadGuard};
+use std::thread::JoinHandle;
+
+/// How a world is built.
+#[derive(Clone, Debug)]
+pub struct WorldConfig {
+    /// Worker threads (0: one per available core). Capped by the grid's coarse columns.
+    pub workers: usize,
+    /// Bucket sizes for per-voxel material bytes.
+    pub bucket_sizes: BucketSizes,
+}
+
+impl Default for WorldConfig {
+    fn default() -> Self {
+        Self {
+            workers: 0,
+            bucket_sizes: BucketSizes::default(),
+        }
+    }
+}
+
+/// The buffers the GPU mirrors.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum GpuBuffer {
+    /// One u32 per brick cell: global brick index or [`EMPTY_BRICK`].
+    BrickIndex,
+    /// [`Brick`]s (68 bytes each).
+    Bricks,
+    /// Coarse occupancy bits (see [`GridDims::coarse_bit`]).
+    Coarse,
+    /// Per-voxel material bytes.
+    MaterialBytes,
+    /// [`MaterialTablesGpu`].
+    MaterialTables,
+}
+
+impl GpuBuffer {
+    /// Every buffer.
+    pub const ALL: [GpuBuffer; 5] = [
+        GpuBuffer::BrickIndex,
+        GpuBuffer::Bricks,
+        GpuBuffer::Coarse,
+        GpuBuffer::MaterialBytes,
+        GpuBuffer::MaterialTables,
+    ];
+}
+
+/// Changed byte ranges of every GPU buffer since the last drain, sorted and merged.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct DirtySet {
+    /// Per buffer, in [`GpuBuffer::ALL`] order.
+    pub ranges: [Vec<Range<u64>>; 5],
+}
+
+impl DirtySet {
+    /// The ranges of one buffer.
+    pub fn of(&self, b: GpuBuffer) -> &[Range<u64>] {
+        &self.ranges[b as usize]
+    }
+    /// Total bytes covered.
+    pub fn bytes(&self) -> u64 {
+        self.ranges.iter().flatten().map(|r| r.end - r.start).sum()
+    }
+}
+
+/// Bytes by buffer.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct MemoryStats {
+    /// Brick-index grid (dense).
+    pub brick_index: u64,
+    /// Bricks in use × 68.
+    pub bricks_used: u64,
+    /// Brick chunks claimed × 68.
+    pub bricks_reserved: u64,
+    /// Coarse occupancy grid.
+    pub coarse: u64,
+    /// Material pages dedicated to a bucket size.
+    pub material_used: u64,
+    /// Material chunks claimed.
+    pub material_reserved: u64,
+    /// Material, colour and parameter tables.
+    pub tables: u64,
+    /// CPU-only bookkeeping (slot metadata, free-list links).
+    pub cpu_only: u64,
+}
+
+impl MemoryStats {
+    /// Everything the GPU must hold to render the world as it is.
+    pub fn gpu_used(&self) -> u64 {
+        self.brick_index + self.bricks_used + self.coarse + self.material_used + self.tables
+    }
+    /// Everything the GPU buffers occupy with whole chunks.
+    pub fn gpu_reserved(&self) -> u64 {
+        self.brick_index + self.bricks_reserved + self.coarse + self.material_reserved + self.tables
+    }
+}
+
+enum Job {
+    Work {
+        item: WorkItem,
+        reply: Sender<PartResult>,
+    },
+    Stop,
+}
+
+type PartResult = (usize, Result<(Vec<crate::edit::BrickUndo>, u64)>);
+
+/// The voxel world.
+pub struct World {
+    dims: GridDims,
+    slabs: Vec<Arc<RwLock<Slab>>>,
+    slab_of_x: Vec<u16>,
+    senders: Vec<Sender<Job>>,
+    threads: Vec<JoinHandle<()>>,
+    submit_order: Mutex<()>,
+    materials: RwLock<MaterialTable>,
+    counters: Arc<ChunkCounters>,
+}
+
+impl std::fmt::Debug for World {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("World")
+            .field("dims", &self.dims)
+            .field("workers", &self.slabs.len())
+            .finish()
+    }
+}
+
+impl World {
+    /// An empty world with the default material table.
+    pub fn new(dims: GridDims, config: WorldConfig) -> Result<Self> {
+        let workers = if config.workers == 0 {
+            std::thread::available_parallelism().map_or(1, |n| n.get())
+        } else {
+            config.workers
+        };
+        if workers > 1024 {
+            return Err(BrickmapError::Config(format!(
+                "{workers} workers is too many"
+            )));
+        }
+        let counters = Arc::new(ChunkCounters::default());
+        let bounds = SlabBounds::split(&dims, workers);
+        let mut slab_of_x = vec![0u16; dims.bricks().x as usize];
+        let mut slabs = Vec::new();
+        let mut senders = Vec::new();
+        let mut threads = Vec::new();
+        for (w, b) in bounds.into_iter().enumerate() {
+            slab_of_x[b.bricks_x.start as usize..b.bricks_x.end as usize].fill(w as u16);
+            let slab = Arc::new(RwLock::new(Slab::new(
+                dims,
+                b,
+                config.bucket_sizes.clone(),
+                counters.clone(),
+            )));
+            let (tx, rx) = crossbeam_channel::unbounded();
+            let mine = slab.clone();
+            let thread = std::thread::Builder::new()
+                .name(format!("brickmap-worker-{w}"))
+                .spawn(move || worker_loop(w, mine, rx))
+                .map_err(|e| BrickmapError::Config(format!("cannot start worker: {e}")))?;
+            slabs.push(slab);
+            senders.push(tx);
+            threads.push(thread);
+        }
+        Ok(Self {
+            dims,
+            slabs,
+            slab_of_x,
+            senders,
+            threads,
+            submit_order: Mutex::new(()),
+            materials: RwLock::new(MaterialTable::default()),
+            counters,
+        })
+    }
+
+    /// Grid size.
+    pub fn dims(&self) -> GridDims {
+        self.dims
+    }
+    /// Worker threads running.
+    pub fn workers(&self) -> usize {
+        self.slabs.len()
+    }
+
+    /// Validates and queues an edit; the ticket waits for it.
+    pub fn submit(&self, op: EditOp) -> Result<Ticket<'_>> {
+        self.validate(&op)?;
+        let parts = self.split(op);
+        let (reply, rx) = crossbeam_channel::unbounded();
+        let expected = parts.len();
+        {
+            let _order = self.submit_order.lock().unwrap_or_else(|p| p.into_inner());
+            for (w, item) in parts {
+                self.senders[w]
+                    .send(Job::Work {
+                        item,
+                        reply: reply.clone(),
+                    })
+                    .map_err(|_| BrickmapError::WorkerGone(w))?;
+            }
+        }
+        Ok(Ticket {
+            world: self,
+            rx,
+            expected,
+        })
+    }
+
+    /// Submits an edit and waits for it.
+    pub fn apply(&self, op: EditOp) -> Result<EditOutcome> {
+        self.submit(op)?.wait()
+    }
+
+    fn validate(&self, op: &EditOp) -> Result<()> {
+        let table = self.materials();
+        match op {
+            EditOp::Shape { shape, mode } => {
+                shape.validate()?;
+                if let Shape::Voxel(v) = shape
+                    && !self.dims.contains_voxel(*v)
+                {
+                    return Err(BrickmapError::OutOfRange(*v, self.dims.voxels()));
+                }
+                if let Mode::Add(m) | Mode::Paint(m) = mode {
+                    table.check(*m as u32)?;
+                }
+            }
+            EditOp::Voxels(list) => {
+                for e in list {
+                    if !self.dims.contains_voxel(e.pos) {
+                        return Err(BrickmapError::OutOfRange(e.pos, self.dims.voxels()));
+                    }
+                    if let crate::edit::VoxelOp::Set(m) | crate::edit::VoxelOp::Paint(m) = e.op {
+                        table.check(m as u32)?;
+                    }
+                }
+            }
+            EditOp::Restore(inv) => {
+                for u in &inv.bricks {
+                    if u.brick.cmpge(self.dims.bricks()).any() {
+                        return Err(BrickmapError::BadInverse("brick outside the grid"));
+                    }
+                    match &u.prior {
+                        PriorMaterials::Uniform(m) => table.check(*m as u32)?,
+                        PriorMaterials::PerVoxel(v) => {
+                            if v.len() != u.prior_mask.and(&u.touched).count() as usize {
+                                return Err(BrickmapError::BadInverse("material count mismatch"));
+                            }
+                            for m in v {
+                                table.check(*m as u32)?;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn split(&self, op: EditOp) -> Vec<(usize, WorkItem)> {
+        match op {
+            EditOp::Shape { shape, mode } => {
+                let (lo, hi) = shape.voxel_bounds();
+                let max = self.dims.voxels() - 1;
+                if hi.cmplt(IVec3::ZERO).any() || lo.cmpgt(max).any() {
+                    return Vec::new();
+                }
+                let x0 = self.slab_of_x[(lo.x.clamp(0, max.x) / 8) as usize] as usize;
+                let x1 = self.slab_of_x[(hi.x.clamp(0, max.x) / 8) as usize] as usize;
+                let job = Arc::new((shape, mode));
+                (x0..=x1)
+                    .map(|w| (w, WorkItem::Shape(job.clone())))
+                    .collect()
+            }
+            EditOp::Voxels(list) => {
+                let mut per: Vec<Vec<VoxelEdit>> = vec![Vec::new(); self.slabs.len()];
+                for e in list {
+                    per[self.slab_of_x[(e.pos.x / 8) as usize] as usize].push(e);
+                }
+                per.into_iter()
+                    .enumerate()
+                    .filter(|(_, v)| !v.is_empty())
+                    .map(|(w, v)| (w, WorkItem::Voxels(v)))
+                    .collect()
+            }
+            EditOp::Restore(inv) => {
+                let mut per = vec![Vec::new(); self.slabs.len()];
+                for u in inv.bricks {
+                    per[self.slab_of_x[u.brick.x as usize] as usize].push(u);
+                }
+                per.into_iter()
+                    .enumerate()
+                    .filter(|(_, v)| !v.is_empty())
+                    .map(|(w, v)| (w, WorkItem::Restore(v)))
+                    .collect()
+            }
+        }
+    }
+
+    /// Waits until every edit queued so far has been applied: each worker answers an
+    /// empty job, which it reaches only after every job queued before it.
+    pub fn flush(&self) -> Result<()> {
+        let (reply, rx) = crossbeam_channel::unbounded();
+        {
+            let _order = self.submit_order.lock().unwrap_or_else(|p| p.into_inner());
+            for (w, s) in self.senders.iter().enumerate() {
+                s.send(Job::Work {
+                    item: WorkItem::Restore(Vec::new()),
+                    reply: reply.clone(),
+                })
+                .map_err(|_| BrickmapError::WorkerGone(w))?;
+            }
+        }
+        for _ in 0..self.senders.len() {
+            rx.recv()
+                .map_err(|_| BrickmapError::WorkerGone(usize::MAX))?
+                .1?;
+        }
+        Ok(())
+    }
+
+    // ---- materials -------------------------------------------------------------------
+
+    /// The material table (read-locked).
+    pub fn materials(&self) -> RwLockReadGuard<'_, MaterialTable> {
+        self.materials.read().unwrap_or_else(|p| p.into_inner())
+    }
+    fn materials_mut(&self) -> std::sync::RwLockWriteGuard<'_, MaterialTable> {
+        self.materials.write().unwrap_or_else(|p| p.into_inner())
+    }
+    /// Appends a material, returning its index.
+    pub fn push_material(&self, m: Material) -> Result<u8> {
+        self.materials_mut().push(m)
+    }
+    /// Replaces a material, returning the previous one.
+    pub fn set_material(&self, index: u8, m: Material) -> Result<Material> {
+        self.materials_mut().set(index, m)
+    }
+    /// Replaces a colour, returning the previous one.
+    pub fn set_colour(&self, index: u8, rgb: [u8; 3]) -> [u8; 3] {
+        self.materials_mut().set_colour(index, rgb)
+    }
+    /// Sets a material parameter, returning the previous value.
+    pub fn set_param(&self, kind: MaterialKind, index: u8, value: f32) -> Result<f32> {
+        self.materials_mut().set_param(kind, index, value)
+    }
+
+    // ---- reads -----------------------------------------------------------------------
+
+    /// Read access to the whole world. Waits for the jobs workers are running now; edits
+    /// queued later wait for the view to be dropped.
+    pub fn read(&self) -> WorldView<'_> {
+        let slabs = self
+            .slabs
+            .iter()
+            .map(|s| s.read().unwrap_or_else(|p| p.into_inner()))
+            .collect();
+        WorldView {
+            world: self,
+            slabs,
+            materials: self.materials(),
+        }
+    }
+
+    /// Takes the byte ranges changed since the last call, per GPU buffer.
+    pub fn take_dirty(&self) -> DirtySet {
+        let mut merged: [DirtyRanges; 4] = Default::default();
+        for s in &self.slabs {
+            let mut s = s.write().unwrap_or_else(|p| p.into_inner());
+            let d = &mut s.dirty;
+            for (m, part) in
+                merged
+                    .iter_mut()
+                    .zip([&mut d.index, &mut d.bricks, &mut d.coarse, &mut d.material])
+            {
+                for r in part.take() {
+                    m.record(r);
+                }
+            }
+        }
+        let [index, bricks, coarse, material] = merged.map(|mut m| m.take());
+        DirtySet {
+            ranges: [
+                index,
+                bricks,
+                coarse,
+                material,
+                self.materials_mut().take_dirty(),
+            ],
+        }
+    }
+
+    /// Size in bytes a GPU buffer must have now.
+    pub fn gpu_buffer_size(&self, b: GpuBuffer) -> u64 {
+        match b {
+            GpuBuffer::BrickIndex => self.dims.brick_cells() as u64 * 4,
+            GpuBuffer::Bricks => {
+                self.counters.brick_chunks() as u64
+                    * BRICK_CHUNK as u64
+                    * std::mem::size_of::<Brick>() as u64
+            }
+            GpuBuffer::Coarse => self.dims.coarse_words() as u64 * 4,
+            GpuBuffer::MaterialBytes => {
+                self.counters.material_chunks() as u64 * MATERIAL_CHUNK as u64
+            }
+            GpuBuffer::MaterialTables => std::mem::size_of::<MaterialTablesGpu>() as u64,
+        }
+    }
+}
+
+impl Drop for World {
+    fn drop(&mut self) {
+        for s in &self.senders {
+            let _ = s.send(Job::Stop);
+        }
+        for t in self.threads.drain(..) {
+            let _ = t.join();
+        }
+    }
+}
+
+fn worker_loop(worker: usize, slab: Arc<RwLock<Slab>>, rx: Receiver<Job>) {
+    for job in rx {
+        let Job::Work { item, reply } = job else {
+            break;
+        };
+        let result =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match slab.write() {
+                Ok(mut s) => s.run(item),
+                Err(_) => Err(BrickmapError::WorkerPanicked {
+                    worker,
+                    message: "an earlier edit panicked; the slab may be inconsistent".into(),
+                }),
+            }));
+        let result = result.unwrap_or_else(|payload| {
+            let message = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            Err(BrickmapError::WorkerPanicked { worker, message })
+        });
+        let _ = reply.send((worker, result));
+    }
+}
+
+/// Waits for an edit's parts.
+#[must_use = "an edit's result is only known once waited for"]
+pub struct Ticket<'w> {
+    world: &'w World,
+    rx: Receiver<PartResult>,
+    expected: usize,
+}
+
+impl Ticket<'_> {
+    /// Waits for every part; on failure of any part rolls back the others and returns the
+    /// first error, leaving the world as before the edit.
+    pub fn wait(self) -> Result<EditOutcome> {
+        let mut parts = Vec::with_capacity(self.expected);
+        let mut first_error = None;
+        for _ in 0..self.expected {
+            match self.rx.recv() {
+                Ok((w, Ok(part))) => parts.push((w, part)),
+                Ok((_, Err(e))) => {
+                    first_error.get_or_insert(e);
+                }
+                Err(_) => {
+                    first_error.get_or_insert(BrickmapError::WorkerGone(usize::MAX));
+                }
+            }
+        }
+        parts.sort_by_key(|(w, _)| *w);
+        let mut inverse = EditInverse::default();
+        let mut changed_voxels = 0;
+        for (_, (undo, changed)) in parts {
+            inverse.bricks.extend(undo);
+            changed_voxels += changed;
+        }
+        if let Some(e) = first_error {
+            if !inverse.is_empty() {
+                self.world.apply(EditOp::Restore(inverse))?;
+            }
+            return Err(e);
+        }
+        Ok(EditOutcome {
+            inverse,
+            changed_voxels,
+        })
+    }
+}
+
+/// Read access to every slab and the material table at once.
+pub struct WorldView<'w> {
+    world: &'w World,
+    slabs: Vec<RwLockReadGuard<'w, Slab>>,
+    materials: RwLockReadGuard<'w, MaterialTable>,
+}
+
+/// A voxel lookup resolved to its brick.
+pub(crate) struct BrickRef<'a> {
+    pub slab: &'a Slab,
+    pub slot: u32,
+}
+
+impl WorldView<'_> {
+    /// Grid size.
+    pub fn dims(&self) -> GridDims {
+        self.world.dims
+    }
+    /// The material table.
+    pub fn materials(&self) -> &MaterialTable {
+        &self.materials
+    }
+
+    #[inline]
+    pub(crate) fn slab_for_brick_x(&self, bx: u32) -> &Slab {
+        &self.slabs[self.world.slab_of_x[bx as usize] as usize]
+    }
+
+    /// The brick at a brick coordinate inside the grid.
+    #[inline]
+    pub(crate) fn brick_at(&self, b: UVec3) -> Option<BrickRef<'_>> {
+        let slab = self.slab_for_brick_x(b.x);
+        slab.slot(self.world.dims.cell_index(b))
+            .map(|slot| BrickRef { slab, slot })
+    }
+
+    /// The material of a voxel, `None` when empty; an error outside the grid.
+    pub fn voxel(&self, v: IVec3) -> Result<Option<u8>> {
+        if !self.world.dims.contains_voxel(v) {
+            return Err(BrickmapError::OutOfRange(v, self.world.dims.voxels()));
+        }
+        let b = (v / 8).as_uvec3();
+        let l = v - (v / 8) * 8;
+        let bit = crate::brick::voxel_bit(l.x, l.y, l.z);
+        Ok(self.brick_at(b).and_then(|r| {
+            r.slab
+                .brick(r.slot)
+                .mask
+                .get(bit)
+                .then(|| r.slab.material(r.slot, bit))
+        }))
+    }
+
+    /// Solid voxels in the world.
+    pub fn solid_count(&self) -> u64 {
+        self.slabs.iter().map(|s| s.solid()).sum()
+    }
+
+    /// Bricks in the world.
+    pub fn brick_count(&self) -> u64 {
+        self.slabs.iter().map(|s| s.pool.used() as u64).sum()
+    }
+
+    /// Bytes by buffer.
+    pub fn memory(&self) -> MemoryStats {
+        let brick = std::mem::size_of::<Brick>() as u64;
+        let mut m = MemoryStats {
+            brick_index: self.world.dims.brick_cells() as u64 * 4,
+            coarse: self.world.dims.coarse_words() as u64 * 4,
+            tables: std::mem::size_of::<MaterialTablesGpu>() as u64,
+            ..Default::default()
+        };
+        for s in &self.slabs {
+            m.bricks_used += s.pool.used() as u64 * brick;
+            m.bricks_reserved += s.pool.reserved() as u64 * brick;
+            m.material_used += s.buckets.bytes_in_use();
+            m.material_reserved += s.buckets.bytes_reserved();
+            m.cpu_only += s.pool.reserved() as u64 * 8 + s.buckets.bytes_reserved() / 8;
+        }
+        m
+    }
+
+    /// A hash of the logical content: grid size, every solid voxel with its material, and
+    /// the material tables. Independent of bucket layout, brick slots, uniform-or-not storage
+    /// and worker count.
+    pub fn content_hash(&self) -> u64 {
+        use xxhash_rust::xxh3::{Xxh3, xxh3_64};
+        let mut sum = 0u64;
+        let mut mats = Vec::with_capacity(512);
+        for s in &self.slabs {
+            for (cell, slot) in s.bricks() {
+                let b = s.brick(slot);
+                let coord = self.world.dims.cell_coord(cell);
+                let mut h = Xxh3::new();
+                h.update(bytemuck::bytes_of(&coord.to_array()));
+                h.update(bytemuck::bytes_of(&b.mask));
+                mats.clear();
+                if b.is_uniform() {
+                    mats.resize(b.mask.count() as usize, b.material as u8);
+                } else {
+                    mats.extend(b.mask.ones().map(|bit| s.material(slot, bit)));
+                }
+                h.update(&mats);
+                // A commutative combination: the order slabs are visited in does not matter.
+                sum = sum.wrapping_add(h.digest());
+            }
+        }
+        let mut all = Vec::new();
+        all.extend_from_slice(bytemuck::bytes_of(&self.world.dims.bricks().to_array()));
+        all.extend_from_slice(&sum.to_le_bytes());
+        all.extend_from_slice(&self.materials.logical_bytes());
+        xxh3_64(&all)
+    }
+
+    /// Checks every invariant of every slab (tests use it after each step).
+    pub fn validate(&self) -> std::result::Result<(), String> {
+        for (w, s) in self.slabs.iter().enumerate() {
+            s.validate().map_err(|e| format!("worker {w}: {e}"))?;
+        }
+        Ok(())
+    }
+
+    /// The whole of a GPU buffer, as the renderer's copy of it must be.
+    pub fn gpu_image(&self, buffer: GpuBuffer) -> Vec<u8> {
+        let size = self.world.gpu_buffer_size(buffer) as usize;
+        let mut out = vec![0u8; size];
+        match buffer {
+            GpuBuffer::BrickIndex => {
+                let mut at = 0;
+                for s in &self.slabs {
+                    for &slot in s.raw_slots() {
+                        let v = if slot == EMPTY_BRICK {
+                            EMPTY_BRICK
+                        } else {
+                            s.pool.global(slot)
+                        };
+                        out[at..at + 4].copy_from_slice(&v.to_le_bytes());
+                        at += 4;
+                    }
+                }
+            }
+            GpuBuffer::Coarse => {
+                let mut at = 0;
+                for s in &self.slabs {
+                    let bytes: &[u8] = bytemuck::cast_slice(s.coarse_words());
+                    out[at..at + bytes.len()].copy_from_slice(bytes);
+                    at += bytes.len();
+                }
+            }
+            GpuBuffer::Bricks => {
+                let chunk = BRICK_CHUNK as usize * std::mem::size_of::<Brick>();
+                for s in &self.slabs {
+                    let bytes: &[u8] = bytemuck::cast_slice(s.pool.bricks());
+                    for (k, &id) in s.pool.chunk_ids().iter().enumerate() {
+                        let dst = id as usize * chunk;
+                        out[dst..dst + chunk].copy_from_slice(&bytes[k * chunk..(k + 1) * chunk]);
+                    }
+                }
+            }
+            GpuBuffer::MaterialBytes => {
+                let chunk = MATERIAL_CHUNK as usize;
+                for s in &self.slabs {
+                    let bytes = s.buckets.bytes();
+                    for (k, &id) in s.buckets.chunk_ids().iter().enumerate() {
+                        let dst = id as usize * chunk;
+                        out[dst..dst + chunk].copy_from_slice(&bytes[k * chunk..(k + 1) * chunk]);
+                    }
+                }
+            }
+            GpuBuffer::MaterialTables => {
+                out.copy_from_slice(bytemuck::bytes_of(self.materials.gpu()))
+            }
+        }
+        out
+    }
+}
