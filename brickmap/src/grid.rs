@@ -18,6 +18,10 @@ pub const MAX_BRICKS_Z: u32 = 512;
 pub const COARSE_BRICKS: u32 = 4;
 /// Marks an empty cell of the brick-index grid.
 pub const EMPTY_BRICK: u32 = u32::MAX;
+/// Brick-index values `FULL_BRICK_BASE | m` (m in 0..256) mark a cell whose 512 voxels are
+/// all solid with material m. No brick is stored for it: interior bricks of solid terrain
+/// cost 4 bytes instead of 72, and a ray entering one hits without reading a mask.
+pub const FULL_BRICK_BASE: u32 = 0xFFFF_FE00;
 
 /// Grid size in bricks, validated against the supported maximum.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

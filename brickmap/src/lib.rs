@@ -24,6 +24,7 @@ pub mod raycast;
 pub mod shape;
 mod slab;
 pub mod storage;
+pub mod terrain;
 pub mod world;
 
 pub use brick::{Brick, Mask};

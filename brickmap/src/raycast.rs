@@ -328,17 +328,10 @@ impl Occupancy for crate::world::WorldView<'_> {
             .coarse_occupied(c)
     }
     fn brick_occupied(&self, b: UVec3) -> bool {
-        self.brick_at(b).is_some()
+        crate::world::WorldView::brick_occupied(self, b)
     }
     fn solid(&self, v: IVec3) -> bool {
-        let b = (v / 8).as_uvec3();
-        let l = v - (v / 8) * 8;
-        self.brick_at(b).is_some_and(|r| {
-            r.slab
-                .brick(r.slot)
-                .mask
-                .get(crate::brick::voxel_bit(l.x, l.y, l.z))
-        })
+        self.solid_at(v)
     }
 }
 

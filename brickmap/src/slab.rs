@@ -8,11 +8,10 @@ use crate::brick::{Brick, Mask, UNIFORM_FLAG};
 use crate::dirty::DirtyRanges;
 use crate::edit::{BrickUndo, Mode, PriorMaterials, VoxelEdit, VoxelOp};
 use crate::error::Result;
-use crate::grid::{COARSE_BRICKS, EMPTY_BRICK, GridDims, SlabBounds};
+use crate::grid::{COARSE_BRICKS, EMPTY_BRICK, FULL_BRICK_BASE, GridDims, SlabBounds};
 use crate::shape::{Coverage, Shape};
 use crate::storage::{BrickPool, BucketSizes, ChunkCounters, MaterialBuckets};
 use glam::{IVec3, UVec3};
-use std::collections::HashMap;
 use std::sync::Arc;
 
 const NO_BUCKET: u32 = u32::MAX;
@@ -38,6 +37,17 @@ pub struct SlabDirty {
     pub material: DirtyRanges,
 }
 
+/// What one grid cell holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum CellState {
+    /// Nothing.
+    Empty,
+    /// Every voxel solid with one material; no brick stored.
+    Full(u8),
+    /// A stored brick in this local slot.
+    Brick(u32),
+}
+
 /// A brick's materials, copied out so the brick can be rewritten.
 #[derive(Clone)]
 pub(crate) enum Mats {
@@ -46,7 +56,7 @@ pub(crate) enum Mats {
 }
 
 impl Mats {
-    fn at(&self, k: usize) -> u8 {
+    pub(crate) fn at(&self, k: usize) -> u8 {
         match self {
             Mats::Uniform(m) => *m,
             Mats::Bytes { buf, .. } => buf[k],
@@ -65,6 +75,8 @@ pub(crate) enum WorkItem {
     Shape(Arc<(Shape, Mode)>),
     Voxels(Vec<VoxelEdit>),
     Restore(Vec<BrickUndo>),
+    /// Panics (see `World::inject_worker_panic`).
+    Panic,
 }
 
 /// One worker's share of the world.
@@ -114,11 +126,45 @@ impl Slab {
 
     // ---- reads -------------------------------------------------------------------------
 
-    /// Local brick slot of a grid cell, if the cell holds a brick.
+    /// What a grid cell holds.
     #[inline]
-    pub(crate) fn slot(&self, cell: usize) -> Option<u32> {
-        let s = self.slots[cell - self.cell_base];
-        (s != EMPTY_BRICK).then_some(s)
+    pub(crate) fn cell(&self, cell: usize) -> CellState {
+        match self.slots[cell - self.cell_base] {
+            EMPTY_BRICK => CellState::Empty,
+            v if v >= FULL_BRICK_BASE => CellState::Full(v as u8),
+            slot => CellState::Brick(slot),
+        }
+    }
+    /// Occupancy and materials of a cell, copied out.
+    pub(crate) fn read(&self, cell: usize) -> (Mask, Mats) {
+        match self.cell(cell) {
+            CellState::Empty => (Mask::EMPTY, Mats::Uniform(0)),
+            CellState::Full(m) => (Mask::FULL, Mats::Uniform(m)),
+            CellState::Brick(s) => (self.pool.get(s).mask, self.mats(s)),
+        }
+    }
+    /// Material of voxel `bit` of a cell, `None` when empty.
+    #[inline]
+    pub(crate) fn voxel(&self, cell: usize, bit: usize) -> Option<u8> {
+        match self.cell(cell) {
+            CellState::Empty => None,
+            CellState::Full(m) => Some(m),
+            CellState::Brick(s) => self
+                .pool
+                .get(s)
+                .mask
+                .get(bit)
+                .then(|| self.material(s, bit)),
+        }
+    }
+    /// Whether voxel `bit` of a cell is solid.
+    #[inline]
+    pub(crate) fn solid_at(&self, cell: usize, bit: usize) -> bool {
+        match self.cell(cell) {
+            CellState::Empty => false,
+            CellState::Full(_) => true,
+            CellState::Brick(s) => self.pool.get(s).mask.get(bit),
+        }
     }
     /// The brick in a slot.
     #[inline]
@@ -156,17 +202,21 @@ impl Slab {
     pub(crate) fn solid(&self) -> u64 {
         self.solid
     }
-    /// Cells of this slab with their slots: (global cell, slot).
-    pub(crate) fn bricks(&self) -> impl Iterator<Item = (usize, u32)> + '_ {
-        self.slots
-            .iter()
-            .enumerate()
-            .filter(|(_, s)| **s != EMPTY_BRICK)
-            .map(|(i, s)| (i + self.cell_base, *s))
+    /// Non-empty cells of this slab: (global cell, state).
+    pub(crate) fn cells(&self) -> impl Iterator<Item = (usize, CellState)> + '_ {
+        (0..self.slots.len())
+            .filter(|&i| self.slots[i] != EMPTY_BRICK)
+            .map(|i| (i + self.cell_base, self.cell(i + self.cell_base)))
     }
-    /// Slots of the cells, in cell order (for the GPU image: translated to global indices).
-    pub(crate) fn raw_slots(&self) -> &[u32] {
-        &self.slots
+    /// The brick-index words of this slab's cells as the GPU reads them.
+    pub(crate) fn gpu_index_words(&self) -> impl Iterator<Item = u32> + '_ {
+        self.slots.iter().map(|&v| {
+            if v >= FULL_BRICK_BASE {
+                v
+            } else {
+                self.pool.global(v)
+            }
+        })
     }
     /// Coarse words of this slab.
     pub(crate) fn coarse_words(&self) -> &[u32] {
@@ -212,31 +262,62 @@ impl Slab {
             .record(4 * cell as u64..4 * cell as u64 + 4);
     }
 
-    fn release(&mut self, cell: usize, slot: u32) {
-        let meta = self.meta[slot as usize];
-        if meta.bucket != NO_BUCKET {
-            self.buckets.free(meta.bucket, meta.class);
+    /// Empties a cell, returning its brick slot and bucket.
+    fn clear_cell(&mut self, cell: usize) {
+        let (count, slot) = match self.cell(cell) {
+            CellState::Empty => return,
+            CellState::Full(_) => (512, None),
+            CellState::Brick(s) => (self.pool.get(s).mask.count(), Some(s)),
+        };
+        if let Some(slot) = slot {
+            self.free_brick(slot);
         }
-        self.solid -= self.pool.get(slot).mask.count() as u64;
-        self.pool.free(slot);
+        self.solid -= count as u64;
         self.slots[cell - self.cell_base] = EMPTY_BRICK;
         self.record_index(cell);
         self.coarse_adjust(cell, false);
     }
 
-    /// Makes the brick at `cell` hold `mask` with `new` materials. Allocates before it frees:
-    /// on error the brick is exactly as before.
+    fn free_brick(&mut self, slot: u32) {
+        let meta = self.meta[slot as usize];
+        if meta.bucket != NO_BUCKET {
+            self.buckets.free(meta.bucket, meta.class);
+        }
+        self.pool.free(slot);
+    }
+
+    /// Makes the cell hold `mask` with `new` materials: nothing, a full cell, or a stored
+    /// brick. Allocates before it frees: on error the cell is exactly as before.
     pub(crate) fn store(&mut self, cell: usize, mask: Mask, new: NewMats<'_>) -> Result<()> {
-        let old_slot = self.slot(cell);
+        let old = self.cell(cell);
         if mask.is_empty() {
-            if let Some(slot) = old_slot {
-                self.release(cell, slot);
-            }
+            self.clear_cell(cell);
             return Ok(());
         }
         let new = match new {
             NewMats::Bytes(b) if b.iter().all(|&m| m == b[0]) => NewMats::Uniform(b[0]),
             other => other,
+        };
+        let old_count = match old {
+            CellState::Empty => 0,
+            CellState::Full(_) => 512,
+            CellState::Brick(s) => self.pool.get(s).mask.count(),
+        };
+        if let (true, NewMats::Uniform(m)) = (mask.is_full(), &new) {
+            if let CellState::Brick(s) = old {
+                self.free_brick(s);
+            }
+            self.slots[cell - self.cell_base] = FULL_BRICK_BASE | *m as u32;
+            self.record_index(cell);
+            if old == CellState::Empty {
+                self.coarse_adjust(cell, true);
+            }
+            self.solid = self.solid + 512 - old_count as u64;
+            return Ok(());
+        }
+        let old_slot = match old {
+            CellState::Brick(s) => Some(s),
+            _ => None,
         };
         let slot = match old_slot {
             Some(s) => s,
@@ -296,11 +377,6 @@ impl Slab {
                 self.buckets.global(off)
             }
         };
-        let old_count = if old_slot.is_some() {
-            self.pool.get(slot).mask.count()
-        } else {
-            0
-        };
         *self.pool.get_mut(slot) = Brick {
             mask,
             material: word,
@@ -310,7 +386,9 @@ impl Slab {
         if old_slot.is_none() {
             self.slots[cell - self.cell_base] = slot;
             self.record_index(cell);
-            self.coarse_adjust(cell, true);
+            if old == CellState::Empty {
+                self.coarse_adjust(cell, true);
+            }
         }
         Ok(())
     }
@@ -325,6 +403,7 @@ impl Slab {
             WorkItem::Shape(job) => self.run_shape(&job.0, job.1, &mut undo),
             WorkItem::Voxels(list) => self.run_voxels(&list, &mut undo),
             WorkItem::Restore(list) => self.run_restore(&list, &mut undo),
+            WorkItem::Panic => panic!("injected worker panic"),
         };
         match result {
             Ok(changed) => Ok((undo, changed)),
@@ -376,9 +455,7 @@ impl Slab {
         undo: &mut Vec<BrickUndo>,
     ) -> Result<u64> {
         let cell = self.dims.cell_index(b);
-        let slot = self.slot(cell);
-        let old_mask = slot.map_or(Mask::EMPTY, |s| self.pool.get(s).mask);
-        let old = slot.map_or(Mats::Uniform(0), |s| self.mats(s));
+        let (old_mask, old) = self.read(cell);
         let touched = match mode {
             Mode::Add(_) => *region,
             Mode::Remove | Mode::Paint(_) => region.and(&old_mask),
@@ -461,9 +538,7 @@ impl Slab {
     /// Puts back the touched voxels of one brick, recording what they were.
     fn restore_brick(&mut self, u: &BrickUndo, undo: &mut Vec<BrickUndo>) -> Result<u64> {
         let cell = self.dims.cell_index(u.brick);
-        let slot = self.slot(cell);
-        let old_mask = slot.map_or(Mask::EMPTY, |s| self.pool.get(s).mask);
-        let old = slot.map_or(Mats::Uniform(0), |s| self.mats(s));
+        let (old_mask, old) = self.read(cell);
         let back = u.prior_mask.and(&u.touched);
         let new_mask = old_mask.and_not(&u.touched).or(&back);
         let mut dense = [0u8; 512];
@@ -496,87 +571,95 @@ impl Slab {
         Ok(changed)
     }
 
-    /// Single-voxel writes, each O(1) plus a move of at most one brick's bytes.
+    /// Single-voxel writes, each O(1) plus a move of at most one brick's bytes. The list is
+    /// first grouped by brick (a stable radix sort on the cell, so a later write to a voxel
+    /// still wins), so each brick is visited once and memory is walked in order: in arrival
+    /// order, scattered writes spend most of their time waiting on cache misses.
     fn run_voxels(&mut self, list: &[VoxelEdit], undo: &mut Vec<BrickUndo>) -> Result<u64> {
-        // First touch of a brick records its whole prior state; trimmed to the touched
-        // voxels at the end.
-        let mut seen: HashMap<usize, usize> = HashMap::new();
+        let packed: Vec<u64> = list
+            .iter()
+            .map(|e| {
+                let local = self.dims.cell_index((e.pos / 8).as_uvec3()) - self.cell_base;
+                let l = e.pos - (e.pos / 8) * 8;
+                (local as u64) << 32
+                    | pack_voxel(crate::brick::voxel_bit(l.x, l.y, l.z), e.op) as u64
+            })
+            .collect();
+        let sorted = radix_sort_high(packed);
         let mut changed = 0;
-        let mut failure = None;
-        for e in list {
-            let b = (e.pos / 8).as_uvec3();
-            let local = e.pos - (e.pos / 8) * 8;
-            let bit = crate::brick::voxel_bit(local.x, local.y, local.z);
-            let cell = self.dims.cell_index(b);
-            let at = *seen.entry(cell).or_insert_with(|| {
-                let slot = self.slots[cell - self.cell_base];
-                let (mask, prior) = if slot == EMPTY_BRICK {
-                    (Mask::EMPTY, PriorMaterials::PerVoxel(Vec::new()))
-                } else {
-                    let mask = self.pool.get(slot).mask;
-                    (mask, prior_of(&mask, &self.mats(slot), &mask))
-                };
+        let mut i = 0;
+        while i < sorted.len() {
+            let local = sorted[i] >> 32;
+            let cell = local as usize + self.cell_base;
+            let (prior_mask, prior) = self.read(cell);
+            let mut touched = Mask::EMPTY;
+            let mut failure = None;
+            while i < sorted.len() && sorted[i] >> 32 == local {
+                let (bit, op) = unpack_voxel(sorted[i] as u32);
+                i += 1;
+                match self.voxel_op(cell, bit, op) {
+                    Ok(true) => touched.set(bit),
+                    Ok(false) => {}
+                    Err(err) => {
+                        failure = Some(err);
+                        break;
+                    }
+                }
+            }
+            if !touched.is_empty() {
+                // Net change: a voxel written twice (set, then cleared) may end as it began.
+                let (now, now_mats) = self.read(cell);
+                for (k, bit) in prior_mask.ones().enumerate() {
+                    if touched.get(bit) {
+                        let same = now.get(bit) && now_mats.at(now.rank(bit)) == prior.at(k);
+                        changed += !same as u64;
+                    }
+                }
+                changed += touched.and_not(&prior_mask).and(&now).count() as u64;
                 undo.push(BrickUndo {
-                    brick: b,
-                    prior_mask: mask,
-                    touched: Mask::EMPTY,
-                    prior,
+                    brick: self.dims.cell_coord(cell),
+                    prior_mask,
+                    touched,
+                    prior: prior_of(&prior_mask, &prior, &touched),
                 });
-                undo.len() - 1
-            });
-            match self.voxel_op(cell, bit, e.op) {
-                Ok(true) => undo[at].touched.set(bit),
-                Ok(false) => {}
-                Err(err) => {
-                    failure = Some(err);
-                    break;
-                }
+            }
+            if let Some(err) = failure {
+                return Err(err);
             }
         }
-        // Net change: a voxel written twice (set, then cleared) may end as it began.
-        for u in undo.iter() {
-            let slot = self.slot(self.dims.cell_index(u.brick));
-            let now = slot.map_or(Mask::EMPTY, |s| self.pool.get(s).mask);
-            for (k, bit) in u.prior_mask.ones().enumerate() {
-                if u.touched.get(bit) {
-                    let same = now.get(bit)
-                        && slot.is_some_and(|s| self.material(s, bit) == prior_at(&u.prior, k));
-                    changed += !same as u64;
-                }
-            }
-            changed += u.touched.and_not(&u.prior_mask).and(&now).count() as u64;
-        }
-        // Trim prior materials to touched ∩ prior, and drop bricks nothing changed in.
-        undo.retain_mut(|u| {
-            if let PriorMaterials::PerVoxel(v) = &mut u.prior {
-                let kept: Vec<u8> = u
-                    .prior_mask
-                    .ones()
-                    .zip(v.iter())
-                    .filter(|(bit, _)| u.touched.get(*bit))
-                    .map(|(_, m)| *m)
-                    .collect();
-                *v = kept;
-            }
-            !u.touched.is_empty()
-        });
-        undo.sort_by_key(|u| self.dims.cell_index(u.brick));
-        match failure {
-            Some(err) => Err(err),
-            None => Ok(changed),
-        }
+        Ok(changed)
     }
 
     /// One voxel write; returns whether anything changed.
     fn voxel_op(&mut self, cell: usize, bit: usize, op: VoxelOp) -> Result<bool> {
-        let Some(slot) = self.slot(cell) else {
-            if let VoxelOp::Set(m) = op {
-                let mut mask = Mask::EMPTY;
-                mask.set(bit);
-                self.store(cell, mask, NewMats::Uniform(m))?;
-                return Ok(true);
+        let slot = match self.cell(cell) {
+            CellState::Brick(slot) => slot,
+            CellState::Empty => {
+                if let VoxelOp::Set(m) = op {
+                    let mut mask = Mask::EMPTY;
+                    mask.set(bit);
+                    self.store(cell, mask, NewMats::Uniform(m))?;
+                    return Ok(true);
+                }
+                return Ok(false);
             }
-            return Ok(false);
+            CellState::Full(a) => {
+                // Leaving the full state stores a brick (rare: once per cell and edit).
+                return match op {
+                    VoxelOp::Set(m) | VoxelOp::Paint(m) if m == a => Ok(false),
+                    VoxelOp::Set(m) | VoxelOp::Paint(m) => {
+                        let mut bytes = [a; 512];
+                        bytes[bit] = m;
+                        self.store(cell, Mask::FULL, NewMats::Bytes(&bytes))
+                            .map(|_| true)
+                    }
+                    VoxelOp::Clear => {
+                        let mut mask = Mask::FULL;
+                        mask.clear(bit);
+                        self.store(cell, mask, NewMats::Uniform(a)).map(|_| true)
+                    }
+                };
+            }
         };
         let brick = *self.pool.get(slot);
         let solid = brick.mask.get(bit);
@@ -640,7 +723,7 @@ impl Slab {
                 let mut mask = brick.mask;
                 mask.clear(bit);
                 if n == 1 {
-                    self.release(cell, slot);
+                    self.clear_cell(cell);
                     return Ok(true);
                 }
                 if brick.is_uniform() {
@@ -692,7 +775,16 @@ impl Slab {
         let mut held = Vec::new();
         let mut solid = 0u64;
         let mut counts = vec![0u8; self.coarse_counts.len()];
-        for (cell, slot) in self.bricks() {
+        for (cell, state) in self.cells() {
+            counts[self.coarse_count_index(cell).0] += 1;
+            let slot = match state {
+                CellState::Empty => return Err(format!("cell {cell} listed but empty")),
+                CellState::Full(_) => {
+                    solid += 512;
+                    continue;
+                }
+                CellState::Brick(slot) => slot,
+            };
             if std::mem::replace(&mut used[slot as usize], true) {
                 return Err(format!("slot {slot} used twice or both used and free"));
             }
@@ -721,7 +813,11 @@ impl Slab {
                 }
                 held.push((m.bucket, m.class));
             }
-            counts[self.coarse_count_index(cell).0] += 1;
+            if b.is_uniform() && b.mask.is_full() {
+                return Err(format!(
+                    "cell {cell}: a full uniform brick should be a full cell"
+                ));
+            }
         }
         if used.iter().any(|u| !u) {
             return Err("a brick slot is neither used nor free".into());
@@ -751,12 +847,53 @@ impl Slab {
     }
 }
 
-/// Prior material of the `k`-th prior solid voxel, before trimming to the touched ones.
-fn prior_at(prior: &PriorMaterials, k: usize) -> u8 {
-    match prior {
-        PriorMaterials::Uniform(m) => *m,
-        PriorMaterials::PerVoxel(v) => v[k],
+/// A voxel write in 32 bits: bit index (9 bits), op kind (2 bits), material (8 bits).
+fn pack_voxel(bit: usize, op: VoxelOp) -> u32 {
+    let (kind, m) = match op {
+        VoxelOp::Set(m) => (0, m),
+        VoxelOp::Clear => (1, 0),
+        VoxelOp::Paint(m) => (2, m),
+    };
+    bit as u32 | kind << 9 | (m as u32) << 11
+}
+
+fn unpack_voxel(v: u32) -> (usize, VoxelOp) {
+    let m = (v >> 11) as u8;
+    let op = match v >> 9 & 3 {
+        0 => VoxelOp::Set(m),
+        1 => VoxelOp::Clear,
+        _ => VoxelOp::Paint(m),
+    };
+    ((v & 511) as usize, op)
+}
+
+/// Sorts by the high 32 bits, stably (equal keys keep their order): LSD radix, 11 bits a
+/// pass, only as many passes as the largest key needs.
+fn radix_sort_high(mut items: Vec<u64>) -> Vec<u64> {
+    if items.len() < 64 {
+        items.sort_by_key(|v| v >> 32);
+        return items;
     }
+    let max = items.iter().map(|v| v >> 32).max().unwrap_or(0);
+    let mut scratch = vec![0u64; items.len()];
+    let mut shift = 32;
+    while shift < 64 && (max >> (shift - 32)) > 0 {
+        let mut count = [0usize; 2049];
+        for v in &items {
+            count[(v >> shift & 2047) as usize + 1] += 1;
+        }
+        for d in 1..2049 {
+            count[d] += count[d - 1];
+        }
+        for &v in &items {
+            let d = (v >> shift & 2047) as usize;
+            scratch[count[d]] = v;
+            count[d] += 1;
+        }
+        std::mem::swap(&mut items, &mut scratch);
+        shift += 11;
+    }
+    items
 }
 
 /// Materials in popcount order of `mask`, from a dense 512-entry array.

@@ -29,14 +29,35 @@ const BRICK_CHUNKS_MAX: u32 = u32::MAX / BRICK_CHUNK - 1;
 const NONE: u32 = u32::MAX;
 const FREE_PAGE: u8 = u8::MAX;
 
-/// Next unclaimed chunk of each global buffer, shared by all workers.
-#[derive(Debug, Default)]
+/// Next unclaimed chunk of each global buffer, shared by all workers, and the budgets.
+#[derive(Debug)]
 pub struct ChunkCounters {
     bricks: AtomicU32,
     material: AtomicU32,
+    brick_limit: u32,
+    material_limit: u32,
+}
+
+impl Default for ChunkCounters {
+    fn default() -> Self {
+        Self::with_budget(u64::MAX, u64::MAX)
+    }
 }
 
 impl ChunkCounters {
+    /// Counters that refuse to grow the brick buffer beyond `max_bricks` bricks or the
+    /// material buffer beyond `max_material_bytes` (rounded up to whole chunks; never beyond
+    /// what the 32-bit indices can address).
+    pub fn with_budget(max_bricks: u64, max_material_bytes: u64) -> Self {
+        let chunks = |n: u64, per: u32, cap: u32| n.div_ceil(per as u64).min(cap as u64) as u32;
+        Self {
+            bricks: AtomicU32::new(0),
+            material: AtomicU32::new(0),
+            brick_limit: chunks(max_bricks, BRICK_CHUNK, BRICK_CHUNKS_MAX),
+            material_limit: chunks(max_material_bytes, MATERIAL_CHUNK, MATERIAL_CHUNKS_MAX),
+        }
+    }
+
     fn claim(counter: &AtomicU32, max: u32, what: &'static str) -> Result<u32> {
         let id = counter.fetch_add(1, Ordering::Relaxed);
         if id >= max {
@@ -187,7 +208,8 @@ impl MaterialBuckets {
     }
 
     fn grow(&mut self, counters: &ChunkCounters) -> Result<()> {
-        let id = ChunkCounters::claim(&counters.material, MATERIAL_CHUNKS_MAX, "material byte")?;
+        let id =
+            ChunkCounters::claim(&counters.material, counters.material_limit, "material byte")?;
         let first_page = self.pages.len() as u32;
         self.chunk_ids.push(id);
         self.bytes
@@ -366,7 +388,7 @@ impl BrickPool {
     /// Takes a slot (recycled when one is free).
     pub fn alloc(&mut self, counters: &ChunkCounters) -> Result<u32> {
         if self.free.is_empty() {
-            let id = ChunkCounters::claim(&counters.bricks, BRICK_CHUNKS_MAX, "brick")?;
+            let id = ChunkCounters::claim(&counters.bricks, counters.brick_limit, "brick")?;
             let first = self.bricks.len() as u32;
             self.chunk_ids.push(id);
             self.bricks

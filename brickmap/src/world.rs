@@ -9,10 +9,10 @@ use crate::brick::Brick;
 use crate::dirty::DirtyRanges;
 use crate::edit::{EditInverse, EditOp, EditOutcome, Mode, PriorMaterials, VoxelEdit};
 use crate::error::{BrickmapError, Result};
-use crate::grid::{EMPTY_BRICK, GridDims, SlabBounds};
+use crate::grid::{GridDims, SlabBounds};
 use crate::material::{Material, MaterialKind, MaterialTable, MaterialTablesGpu};
 use crate::shape::Shape;
-use crate::slab::{Slab, WorkItem};
+use crate::slab::{CellState, Slab, WorkItem};
 use crate::storage::{BRICK_CHUNK, BucketSizes, ChunkCounters, MATERIAL_CHUNK};
 use crossbeam_channel::{Receiver, Sender};
 use glam::{IVec3, UVec3};
@@ -27,6 +27,10 @@ pub struct WorldConfig {
     pub workers: usize,
     /// Bucket sizes for per-voxel material bytes.
     pub bucket_sizes: BucketSizes,
+    /// Budget for the brick buffer, in bricks (an edit that needs more fails cleanly).
+    pub max_bricks: u64,
+    /// Budget for the material-byte buffer, in bytes.
+    pub max_material_bytes: u64,
 }
 
 impl Default for WorldConfig {
@@ -34,6 +38,8 @@ impl Default for WorldConfig {
         Self {
             workers: 0,
             bucket_sizes: BucketSizes::default(),
+            max_bricks: u64::MAX,
+            max_material_bytes: u64::MAX,
         }
     }
 }
@@ -97,6 +103,12 @@ pub struct MemoryStats {
     pub material_used: u64,
     /// Material chunks claimed.
     pub material_reserved: u64,
+    /// Material bytes the bricks actually hold (the rest of `material_used` is bucket slack).
+    pub material_payload: u64,
+    /// Stored bricks whose solid voxels share one material (no material bytes).
+    pub uniform_bricks: u64,
+    /// Full uniform cells, stored in the brick index alone.
+    pub full_cells: u64,
     /// Material, colour and parameter tables.
     pub tables: u64,
     /// CPU-only bookkeeping (slot metadata, free-list links).
@@ -158,7 +170,10 @@ impl World {
                 "{workers} workers is too many"
             )));
         }
-        let counters = Arc::new(ChunkCounters::default());
+        let counters = Arc::new(ChunkCounters::with_budget(
+            config.max_bricks,
+            config.max_material_bytes,
+        ));
         let bounds = SlabBounds::split(&dims, workers);
         let mut slab_of_x = vec![0u16; dims.bricks().x as usize];
         let mut slabs = Vec::new();
@@ -316,6 +331,26 @@ impl World {
                     .collect()
             }
         }
+    }
+
+    /// Makes worker `w` panic inside its next job (for testing that a panic surfaces as an
+    /// error); its slab is marked poisoned and every later edit touching it fails.
+    #[doc(hidden)]
+    pub fn inject_worker_panic(&self, w: usize) -> Result<Ticket<'_>> {
+        let (reply, rx) = crossbeam_channel::unbounded();
+        self.senders
+            .get(w)
+            .ok_or(BrickmapError::WorkerGone(w))?
+            .send(Job::Work {
+                item: WorkItem::Panic,
+                reply,
+            })
+            .map_err(|_| BrickmapError::WorkerGone(w))?;
+        Ok(Ticket {
+            world: self,
+            rx,
+            expected: 1,
+        })
     }
 
     /// Waits until every edit queued so far has been applied: each worker answers an
@@ -510,17 +545,19 @@ impl Ticket<'_> {
     }
 }
 
+/// Brick coordinate and bit of a voxel inside the grid.
+#[inline]
+fn split_voxel(v: IVec3) -> (UVec3, usize) {
+    let b = v / 8;
+    let l = v - b * 8;
+    (b.as_uvec3(), crate::brick::voxel_bit(l.x, l.y, l.z))
+}
+
 /// Read access to every slab and the material table at once.
 pub struct WorldView<'w> {
     world: &'w World,
     slabs: Vec<RwLockReadGuard<'w, Slab>>,
     materials: RwLockReadGuard<'w, MaterialTable>,
-}
-
-/// A voxel lookup resolved to its brick.
-pub(crate) struct BrickRef<'a> {
-    pub slab: &'a Slab,
-    pub slot: u32,
 }
 
 impl WorldView<'_> {
@@ -538,12 +575,20 @@ impl WorldView<'_> {
         &self.slabs[self.world.slab_of_x[bx as usize] as usize]
     }
 
-    /// The brick at a brick coordinate inside the grid.
+    /// Whether the brick cell at `b` (inside the grid) holds anything.
     #[inline]
-    pub(crate) fn brick_at(&self, b: UVec3) -> Option<BrickRef<'_>> {
-        let slab = self.slab_for_brick_x(b.x);
-        slab.slot(self.world.dims.cell_index(b))
-            .map(|slot| BrickRef { slab, slot })
+    pub(crate) fn brick_occupied(&self, b: UVec3) -> bool {
+        self.slab_for_brick_x(b.x)
+            .cell(self.world.dims.cell_index(b))
+            != CellState::Empty
+    }
+
+    /// Whether voxel `v` (inside the grid) is solid.
+    #[inline]
+    pub(crate) fn solid_at(&self, v: IVec3) -> bool {
+        let (b, bit) = split_voxel(v);
+        self.slab_for_brick_x(b.x)
+            .solid_at(self.world.dims.cell_index(b), bit)
     }
 
     /// The material of a voxel, `None` when empty; an error outside the grid.
@@ -551,16 +596,10 @@ impl WorldView<'_> {
         if !self.world.dims.contains_voxel(v) {
             return Err(BrickmapError::OutOfRange(v, self.world.dims.voxels()));
         }
-        let b = (v / 8).as_uvec3();
-        let l = v - (v / 8) * 8;
-        let bit = crate::brick::voxel_bit(l.x, l.y, l.z);
-        Ok(self.brick_at(b).and_then(|r| {
-            r.slab
-                .brick(r.slot)
-                .mask
-                .get(bit)
-                .then(|| r.slab.material(r.slot, bit))
-        }))
+        let (b, bit) = split_voxel(v);
+        Ok(self
+            .slab_for_brick_x(b.x)
+            .voxel(self.world.dims.cell_index(b), bit))
     }
 
     /// Solid voxels in the world.
@@ -587,6 +626,18 @@ impl WorldView<'_> {
             m.bricks_reserved += s.pool.reserved() as u64 * brick;
             m.material_used += s.buckets.bytes_in_use();
             m.material_reserved += s.buckets.bytes_reserved();
+            for (_, state) in s.cells() {
+                let CellState::Brick(slot) = state else {
+                    m.full_cells += 1;
+                    continue;
+                };
+                let b = s.brick(slot);
+                if b.is_uniform() {
+                    m.uniform_bricks += 1;
+                } else {
+                    m.material_payload += b.mask.count() as u64;
+                }
+            }
             m.cpu_only += s.pool.reserved() as u64 * 8 + s.buckets.bytes_reserved() / 8;
         }
         m
@@ -600,18 +651,14 @@ impl WorldView<'_> {
         let mut sum = 0u64;
         let mut mats = Vec::with_capacity(512);
         for s in &self.slabs {
-            for (cell, slot) in s.bricks() {
-                let b = s.brick(slot);
+            for (cell, _) in s.cells() {
+                let (mask, materials) = s.read(cell);
                 let coord = self.world.dims.cell_coord(cell);
                 let mut h = Xxh3::new();
                 h.update(bytemuck::bytes_of(&coord.to_array()));
-                h.update(bytemuck::bytes_of(&b.mask));
+                h.update(bytemuck::bytes_of(&mask));
                 mats.clear();
-                if b.is_uniform() {
-                    mats.resize(b.mask.count() as usize, b.material as u8);
-                } else {
-                    mats.extend(b.mask.ones().map(|bit| s.material(slot, bit)));
-                }
+                mats.extend((0..mask.count() as usize).map(|k| materials.at(k)));
                 h.update(&mats);
                 // A commutative combination: the order slabs are visited in does not matter.
                 sum = sum.wrapping_add(h.digest());
@@ -640,12 +687,7 @@ impl WorldView<'_> {
             GpuBuffer::BrickIndex => {
                 let mut at = 0;
                 for s in &self.slabs {
-                    for &slot in s.raw_slots() {
-                        let v = if slot == EMPTY_BRICK {
-                            EMPTY_BRICK
-                        } else {
-                            s.pool.global(slot)
-                        };
+                    for v in s.gpu_index_words() {
                         out[at..at + 4].copy_from_slice(&v.to_le_bytes());
                         at += 4;
                     }

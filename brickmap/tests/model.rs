@@ -301,10 +301,10 @@ fn run_sequence(steps: &[Step]) -> Result<(), TestCaseError> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
     #[test]
-    fn edits_match_dense_reference(steps in prop::collection::vec(step(), 1..14)) {
+    fn edits_match_dense_reference(steps in prop::collection::vec(step(), 1..20)) {
         run_sequence(&steps)?;
     }
 }
