@@ -465,3 +465,53 @@ fn edits_from_many_threads_agree_with_sequential_order() {
     w.read().validate().unwrap();
     assert_eq!(w.read().content_hash(), seq.read().content_hash());
 }
+
+#[test]
+fn voxel_writes_into_full_cells() {
+    // Whole bricks filled by a box are stored as full cells; single-voxel writes must turn
+    // them back into stored bricks correctly (with every model check after each step).
+    let inside = |i: i32, op: VoxelOp| VoxelEdit {
+        pos: IVec3::new(8 + i % 16, 8 + i / 16 % 8, 8 + i / 128),
+        op,
+    };
+    let steps = vec![
+        Step::Edit(EditOp::Shape {
+            shape: Shape::Box {
+                min: IVec3::ZERO,
+                max: IVec3::new(31, 23, 31),
+            },
+            mode: Mode::Add(2),
+        }),
+        Step::Edit(EditOp::Voxels(
+            (0..40).map(|i| inside(i * 7, VoxelOp::Set(3))).collect(),
+        )),
+        Step::Edit(EditOp::Voxels(
+            (0..40).map(|i| inside(i * 5 + 1, VoxelOp::Clear)).collect(),
+        )),
+        Step::Edit(EditOp::Voxels(vec![
+            inside(300, VoxelOp::Paint(4)),
+            inside(301, VoxelOp::Set(2)),
+        ])),
+        Step::Edit(EditOp::Shape {
+            shape: Shape::Box {
+                min: IVec3::new(16, 0, 0),
+                max: IVec3::new(23, 23, 31),
+            },
+            mode: Mode::Paint(5),
+        }),
+        Step::Edit(EditOp::Voxels(vec![
+            inside(9, VoxelOp::Set(2)),
+            inside(200, VoxelOp::Clear),
+        ])),
+        Step::UndoLast,
+        Step::Edit(EditOp::Shape {
+            shape: Shape::Box {
+                min: IVec3::ZERO,
+                max: IVec3::new(31, 23, 31),
+            },
+            mode: Mode::Add(1),
+        }),
+        Step::Edit(EditOp::Voxels(vec![inside(0, VoxelOp::Clear)])),
+    ];
+    run_sequence(&steps).unwrap();
+}
