@@ -11,6 +11,9 @@
 //! same event rule at their boundaries. Steps are bounded by the grid size, so it never loops
 //! forever; every returned t is finite.
 
+// The DDA walks three axes over several parallel per-axis arrays; index loops say that best.
+#![allow(clippy::needless_range_loop)]
+
 use crate::error::{BrickmapError, Result};
 use crate::grid::GridDims;
 use glam::{DVec3, IVec3, UVec3};
