@@ -21,15 +21,12 @@ fn thesis_dims() -> GridDims {
     GridDims::new(64, 32, 64).unwrap() // 512 × 256 × 512 voxels
 }
 
+fn empty_world() -> World {
+    World::new(thesis_dims(), WorldConfig::with_workers(workers())).unwrap()
+}
+
 fn terrain_world() -> World {
-    let world = World::new(
-        thesis_dims(),
-        WorldConfig {
-            workers: workers(),
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let world = empty_world();
     for c in [2, 3, 4] {
         world
             .push_material(brickmap::Material::lambertian(c))
@@ -93,29 +90,18 @@ fn sphere_brush(bencher: Bencher, radius: f64) {
 /// Fills the whole 512 × 256 × 512 grid (67 M voxels) with one box edit.
 #[divan::bench(sample_count = 10, sample_size = 1)]
 fn box_fill_512x256x512(bencher: Bencher) {
-    bencher
-        .with_inputs(|| {
-            World::new(
-                thesis_dims(),
-                WorldConfig {
-                    workers: workers(),
-                    ..Default::default()
+    bencher.with_inputs(empty_world).bench_local_refs(|world| {
+        let max = world.dims().voxels() - 1;
+        world
+            .apply(EditOp::Shape {
+                shape: Shape::Box {
+                    min: IVec3::ZERO,
+                    max,
                 },
-            )
+                mode: Mode::Add(0),
+            })
             .unwrap()
-        })
-        .bench_local_refs(|world| {
-            let max = world.dims().voxels() - 1;
-            world
-                .apply(EditOp::Shape {
-                    shape: Shape::Box {
-                        min: IVec3::ZERO,
-                        max,
-                    },
-                    mode: Mode::Add(0),
-                })
-                .unwrap()
-        });
+    });
 }
 
 /// One million single-voxel sets at random positions of the whole 512 × 256 × 512 grid
@@ -146,14 +132,7 @@ fn random_inserts_1m(bencher: Bencher, extent: i32) {
         .collect();
     bencher
         .with_inputs(|| {
-            let w = World::new(
-                thesis_dims(),
-                WorldConfig {
-                    workers: workers(),
-                    ..Default::default()
-                },
-            )
-            .unwrap();
+            let w = empty_world();
             w.push_material(brickmap::Material::lambertian(5)).unwrap();
             (w, edits.clone())
         })
@@ -165,25 +144,14 @@ fn random_inserts_1m(bencher: Bencher, extent: i32) {
 /// Builds the 512 × 256 × 512 test terrain (heights, bricks and the bulk write).
 #[divan::bench(sample_count = 5, sample_size = 1)]
 fn terrain_build(bencher: Bencher) {
-    bencher
-        .with_inputs(|| {
-            World::new(
-                thesis_dims(),
-                WorldConfig {
-                    workers: workers(),
-                    ..Default::default()
-                },
-            )
-            .unwrap()
-        })
-        .bench_local_refs(|world| {
-            for c in [2, 3, 4] {
-                world
-                    .push_material(brickmap::Material::lambertian(c))
-                    .unwrap();
-            }
-            world.apply(terrain::rolling_hills(thesis_dims())).unwrap()
-        });
+    bencher.with_inputs(empty_world).bench_local_refs(|world| {
+        for c in [2, 3, 4] {
+            world
+                .push_material(brickmap::Material::lambertian(c))
+                .unwrap();
+        }
+        world.apply(terrain::rolling_hills(thesis_dims())).unwrap()
+    });
 }
 
 /// 1024 × 576 primary rays from a camera above the terrain looking across it, split over the

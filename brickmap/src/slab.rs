@@ -212,13 +212,18 @@ impl Slab {
     }
     /// The brick-index words of this slab's cells as the GPU reads them.
     pub(crate) fn gpu_index_words(&self) -> impl Iterator<Item = u32> + '_ {
-        self.slots.iter().map(|&v| {
-            if v >= FULL_BRICK_BASE {
-                v
-            } else {
-                self.pool.global(v)
-            }
-        })
+        (0..self.slots.len()).map(|i| self.gpu_index_word(i + self.cell_base))
+    }
+    /// The brick-index word of a global cell of this slab, as the GPU reads it.
+    pub(crate) fn gpu_index_word(&self, cell: usize) -> u32 {
+        match self.slots[cell - self.cell_base] {
+            v if v >= FULL_BRICK_BASE => v,
+            slot => self.pool.global(slot),
+        }
+    }
+    /// A coarse-grid word of this slab, by global word index.
+    pub(crate) fn coarse_word(&self, word: usize) -> u32 {
+        self.coarse[word - self.coarse_base]
     }
     /// Coarse words of this slab.
     pub(crate) fn coarse_words(&self) -> &[u32] {

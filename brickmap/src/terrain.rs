@@ -156,14 +156,7 @@ mod tests {
         let dims = GridDims::new(4, 3, 2).unwrap();
         let size = dims.voxels();
         let heights: Vec<i32> = (0..size.x * size.z).map(|i| (i * 7) % 25).collect();
-        let world = World::new(
-            dims,
-            WorldConfig {
-                workers: 2,
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let world = World::new(dims, WorldConfig::with_workers(2)).unwrap();
         for _ in 0..3 {
             world.push_material(crate::Material::lambertian(3)).unwrap();
         }

@@ -33,6 +33,16 @@ pub struct WorldConfig {
     pub max_material_bytes: u64,
 }
 
+impl WorldConfig {
+    /// The default configuration with `workers` worker threads (0: one per core).
+    pub fn with_workers(workers: usize) -> Self {
+        Self {
+            workers,
+            ..Self::default()
+        }
+    }
+}
+
 impl Default for WorldConfig {
     fn default() -> Self {
         Self {
@@ -545,6 +555,17 @@ impl Ticket<'_> {
     }
 }
 
+/// Copies the part of `src` (which starts at buffer offset `at`) that falls inside `range`
+/// into `dst` (which holds `range`).
+fn copy_overlap(src: &[u8], at: u64, range: &Range<u64>, dst: &mut [u8]) {
+    let lo = at.max(range.start);
+    let hi = (at + src.len() as u64).min(range.end);
+    if lo < hi {
+        dst[(lo - range.start) as usize..(hi - range.start) as usize]
+            .copy_from_slice(&src[(lo - at) as usize..(hi - at) as usize]);
+    }
+}
+
 /// Brick coordinate and bit of a voxel inside the grid.
 #[inline]
 fn split_voxel(v: IVec3) -> (UVec3, usize) {
@@ -677,6 +698,59 @@ impl WorldView<'_> {
             s.validate().map_err(|e| format!("worker {w}: {e}"))?;
         }
         Ok(())
+    }
+
+    /// The bytes `range` of a GPU buffer, appended to `out`, built from only the cells,
+    /// bricks, words and chunks the range covers: what an upload of drained dirty ranges
+    /// copies, at a cost proportional to the range. Bytes beyond the buffer's size read 0.
+    pub fn copy_gpu_range(&self, buffer: GpuBuffer, range: Range<u64>, out: &mut Vec<u8>) {
+        let start = out.len();
+        let len = (range.end.saturating_sub(range.start)) as usize;
+        out.resize(start + len, 0);
+        let dst = &mut out[start..];
+        let dims = self.world.dims;
+        match buffer {
+            GpuBuffer::BrickIndex | GpuBuffer::Coarse => {
+                let words = (range.start / 4)..range.end.div_ceil(4);
+                let per_x = (dims.bricks().y * dims.bricks().z) as u64;
+                let per_cx = dims.coarse_words_per_column() as u64;
+                let total = self.world.gpu_buffer_size(buffer) / 4;
+                for w in words.start..words.end.min(total) {
+                    let word = if buffer == GpuBuffer::BrickIndex {
+                        let slab = self.slab_for_brick_x((w / per_x) as u32);
+                        slab.gpu_index_word(w as usize)
+                    } else {
+                        let cx = (w / per_cx) as u32;
+                        let slab = self.slab_for_brick_x(cx * crate::grid::COARSE_BRICKS);
+                        slab.coarse_word(w as usize)
+                    };
+                    copy_overlap(&word.to_le_bytes(), w * 4, &range, dst);
+                }
+            }
+            GpuBuffer::Bricks | GpuBuffer::MaterialBytes => {
+                let chunk = if buffer == GpuBuffer::Bricks {
+                    (BRICK_CHUNK as usize * std::mem::size_of::<Brick>()) as u64
+                } else {
+                    MATERIAL_CHUNK as u64
+                };
+                for id in range.start / chunk..range.end.div_ceil(chunk) {
+                    for s in &self.slabs {
+                        let (ids, bytes): (&[u32], &[u8]) = if buffer == GpuBuffer::Bricks {
+                            (s.pool.chunk_ids(), bytemuck::cast_slice(s.pool.bricks()))
+                        } else {
+                            (s.buckets.chunk_ids(), s.buckets.bytes())
+                        };
+                        if let Some(k) = ids.iter().position(|&c| c as u64 == id) {
+                            let local = &bytes[k * chunk as usize..(k + 1) * chunk as usize];
+                            copy_overlap(local, id * chunk, &range, dst);
+                        }
+                    }
+                }
+            }
+            GpuBuffer::MaterialTables => {
+                copy_overlap(bytemuck::bytes_of(self.materials.gpu()), 0, &range, dst)
+            }
+        }
     }
 
     /// The whole of a GPU buffer, as the renderer's copy of it must be.

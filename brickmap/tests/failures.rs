@@ -114,10 +114,7 @@ fn exhausted_brick_budget_rolls_back() {
 fn worker_panic_is_an_error_not_a_hang() {
     let world = World::new(
         GridDims::new(8, 2, 8).unwrap(),
-        WorldConfig {
-            workers: 2,
-            ..Default::default()
-        },
+        WorldConfig::with_workers(2),
     )
     .unwrap();
     let err = world.inject_worker_panic(1).unwrap().wait().unwrap_err();

@@ -515,3 +515,60 @@ fn voxel_writes_into_full_cells() {
     ];
     run_sequence(&steps).unwrap();
 }
+
+#[test]
+fn gpu_ranges_match_whole_images_and_flush_waits() {
+    let w = new_world(3);
+    // Queue several edits without waiting; flush returns once all are applied.
+    let tickets: Vec<_> = (0..6)
+        .map(|k| {
+            let centre = DVec3::new(6.0 + 12.0 * k as f64, 12.0, 20.0);
+            w.submit(EditOp::Shape {
+                shape: Shape::Sphere {
+                    centre,
+                    radius: 7.0,
+                },
+                mode: Mode::Add(k as u8 % MATERIALS),
+            })
+            .unwrap()
+        })
+        .collect();
+    w.flush().unwrap();
+    let solid_after_flush = w.read().solid_count();
+    let changed: u64 = tickets
+        .into_iter()
+        .map(|t| t.wait().unwrap().changed_voxels)
+        .sum();
+    assert_eq!(solid_after_flush, w.read().solid_count());
+    assert!(changed >= solid_after_flush && solid_after_flush > 5000);
+    w.apply(EditOp::Voxels(
+        (0..500)
+            .map(|i| VoxelEdit {
+                pos: IVec3::new(i % 72, i % 24, i % 40),
+                op: VoxelOp::Set((i % 5) as u8),
+            })
+            .collect(),
+    ))
+    .unwrap();
+    let view = w.read();
+    let mut seed = 7u64;
+    for b in GpuBuffer::ALL {
+        let whole = view.gpu_image(b);
+        assert!(!whole.is_empty());
+        for _ in 0..200 {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let a = (seed >> 33) % whole.len() as u64;
+            let len = (seed >> 13) % 300;
+            let range = a..(a + len).min(whole.len() as u64);
+            let mut got = vec![0xAB];
+            view.copy_gpu_range(b, range.clone(), &mut got);
+            assert_eq!(
+                &got[1..],
+                &whole[range.start as usize..range.end as usize],
+                "{b:?} {range:?}"
+            );
+        }
+    }
+}

@@ -134,14 +134,7 @@ fn check(view: &brickmap::WorldView, dims: &GridDims, solids: &[IVec3], ray: &Ra
 /// A 96×32×96 world (3×1×3 coarse cells) with clusters and scattered voxels.
 fn scene(seed: u64) -> (World, Vec<IVec3>) {
     let dims = GridDims::new(12, 4, 12).unwrap();
-    let world = World::new(
-        dims,
-        WorldConfig {
-            workers: 2,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let world = World::new(dims, WorldConfig::with_workers(2)).unwrap();
     let mut rng = Rng(seed);
     world
         .apply(EditOp::Shape {
@@ -356,14 +349,7 @@ fn exact_diagonals_and_axes_through_lattice_points() {
 #[test]
 fn largest_grid_far_corner() {
     let dims = GridDims::new(512, 128, 512).unwrap();
-    let world = World::new(
-        dims,
-        WorldConfig {
-            workers: 2,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let world = World::new(dims, WorldConfig::with_workers(2)).unwrap();
     let far = IVec3::new(4095, 1023, 4095);
     let solids = vec![
         far,
