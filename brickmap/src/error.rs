@@ -85,6 +85,15 @@ pub enum BrickmapError {
     /// A worker thread is gone (it panicked earlier or the world is shutting down).
     #[error("worker {0} is no longer running")]
     WorkerGone(usize),
+    /// An edit failed and putting back its other parts failed too: the world holds part of
+    /// the edit. Both errors are kept.
+    #[error("{cause}; rolling the edit back failed too ({rollback}): the world holds part of it")]
+    RollbackFailed {
+        /// Why the edit failed.
+        cause: Box<BrickmapError>,
+        /// Why the rollback failed.
+        rollback: Box<BrickmapError>,
+    },
     /// An inverse edit does not fit this world (wrong grid or stale state).
     #[error("inverse edit does not fit this world: {0}")]
     BadInverse(&'static str),

@@ -414,7 +414,8 @@ impl World {
     // ---- reads -----------------------------------------------------------------------
 
     /// Read access to the whole world. Waits for the jobs workers are running now; edits
-    /// queued later wait for the view to be dropped.
+    /// queued later wait for the view to be dropped, so do not wait on an edit (`apply`,
+    /// `Ticket::wait`, `flush`) while this thread holds a view: that waits forever.
     pub fn read(&self) -> WorldView<'_> {
         let slabs = self
             .slabs
@@ -543,8 +544,13 @@ impl Ticket<'_> {
             changed_voxels += changed;
         }
         if let Some(e) = first_error {
-            if !inverse.is_empty() {
-                self.world.apply(EditOp::Restore(inverse))?;
+            if !inverse.is_empty()
+                && let Err(rollback) = self.world.apply(EditOp::Restore(inverse))
+            {
+                return Err(BrickmapError::RollbackFailed {
+                    cause: Box::new(e),
+                    rollback: Box::new(rollback),
+                });
             }
             return Err(e);
         }
