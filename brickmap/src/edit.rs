@@ -7,6 +7,34 @@
 use crate::brick::Mask;
 use crate::shape::Shape;
 use glam::{IVec3, UVec3};
+use std::sync::Arc;
+
+/// Produces whole brick columns: a terrain generator, a procedural scene. It must be a pure
+/// function of its inputs (the world stays deterministic whatever the worker count); workers
+/// call it in parallel, each for the columns of its own slab.
+pub trait ColumnSource: Send + Sync {
+    /// Calls `emit(by, mask, materials)` for every non-empty brick of column (bx, bz), with
+    /// materials per set bit in popcount order (or one for all).
+    fn column(&self, bx: u32, bz: u32, emit: &mut dyn FnMut(u32, Mask, PriorMaterials));
+    /// Every material index it may emit (checked against the table before any worker runs).
+    fn materials(&self) -> Vec<u8>;
+}
+
+/// A shared [`ColumnSource`]; equal when it is the same source.
+#[derive(Clone)]
+pub struct Generator(pub Arc<dyn ColumnSource>);
+
+impl std::fmt::Debug for Generator {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Generator(..)")
+    }
+}
+
+impl PartialEq for Generator {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
 
 /// What a shape edit does to the voxels inside the shape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -52,8 +80,12 @@ pub enum EditOp {
     /// A batch of single-voxel writes, applied in list order (a later write to the same
     /// voxel wins). Every position must lie in the grid.
     Voxels(Vec<VoxelEdit>),
-    /// Puts back what an earlier edit changed (undo), or re-applies it (redo).
+    /// Puts back what an earlier edit changed (undo), or re-applies it (redo). With every
+    /// voxel touched it is also the bulk write of whole bricks (`terrain::set_bricks`).
     Restore(EditInverse),
+    /// Replaces every cell of the grid by what the generator emits (cells it leaves out
+    /// become empty), generated on the workers.
+    Generate(Generator),
 }
 
 /// Prior materials of the touched solid voxels of one brick.

@@ -6,7 +6,7 @@
 
 use crate::brick::{Brick, Mask, UNIFORM_FLAG};
 use crate::dirty::DirtyRanges;
-use crate::edit::{BrickUndo, Mode, PriorMaterials, VoxelEdit, VoxelOp};
+use crate::edit::{BrickUndo, ColumnSource, Mode, PriorMaterials, VoxelEdit, VoxelOp};
 use crate::error::Result;
 use crate::grid::{COARSE_BRICKS, EMPTY_BRICK, FULL_BRICK_BASE, GridDims, SlabBounds};
 use crate::shape::{Coverage, Shape};
@@ -77,6 +77,8 @@ pub(crate) enum WorkItem {
     Shape(Arc<(Shape, Mode)>),
     Voxels(Vec<VoxelEdit>),
     Restore(Vec<BrickUndo>),
+    /// Generated columns (every column of the slab).
+    Generate(Arc<dyn ColumnSource>),
     /// Panics (see `World::inject_worker_panic`).
     Panic,
 }
@@ -410,6 +412,7 @@ impl Slab {
             WorkItem::Shape(job) => self.run_shape(&job.0, job.1, &mut undo),
             WorkItem::Voxels(list) => self.run_voxels(&list, &mut undo),
             WorkItem::Restore(list) => self.run_restore(&list, &mut undo),
+            WorkItem::Generate(source) => self.run_generate(source.as_ref(), &mut undo),
             WorkItem::Panic => panic!("injected worker panic"),
         };
         match result {
@@ -542,10 +545,71 @@ impl Slab {
         Ok(changed)
     }
 
+    /// Every column of the slab from the generator; cells it leaves out become empty.
+    fn run_generate(
+        &mut self,
+        source: &dyn ColumnSource,
+        undo: &mut Vec<BrickUndo>,
+    ) -> Result<u64> {
+        let height = self.dims.bricks().y;
+        let mut column: Vec<(u32, Mask, PriorMaterials)> = Vec::new();
+        let mut changed = 0;
+        for bx in self.bounds.bricks_x.clone() {
+            for bz in 0..self.dims.bricks().z {
+                column.clear();
+                source.column(bx, bz, &mut |by, mask, mats| column.push((by, mask, mats)));
+                column.sort_by_key(|c| c.0);
+                let mut next = column.drain(..).peekable();
+                for by in 0..height {
+                    let brick = UVec3::new(bx, by, bz);
+                    let (mask, prior) = match next.next_if(|c| c.0 == by) {
+                        Some((_, mask, PriorMaterials::PerVoxel(v)))
+                            if v.len() != mask.count() as usize =>
+                        {
+                            return Err(crate::BrickmapError::BadInverse(
+                                "generator emitted a brick whose materials do not match its mask",
+                            ));
+                        }
+                        Some((_, mask, mats)) => (mask, mats),
+                        None => {
+                            if self.cell(self.dims.cell_index(brick)) == CellState::Empty {
+                                continue;
+                            }
+                            (Mask::EMPTY, PriorMaterials::PerVoxel(Vec::new()))
+                        }
+                    };
+                    let set = BrickUndo {
+                        brick,
+                        prior_mask: mask,
+                        touched: Mask::FULL,
+                        prior,
+                    };
+                    changed += self.restore_brick(&set, undo)?;
+                }
+            }
+        }
+        Ok(changed)
+    }
+
     /// Puts back the touched voxels of one brick, recording what they were.
     fn restore_brick(&mut self, u: &BrickUndo, undo: &mut Vec<BrickUndo>) -> Result<u64> {
         let cell = self.dims.cell_index(u.brick);
         let (old_mask, old) = self.read(cell);
+        if u.touched.is_full() && old_mask.is_empty() {
+            // A whole-brick write into an empty cell (loading, generating): no merging.
+            let new = match &u.prior {
+                PriorMaterials::Uniform(m) => NewMats::Uniform(*m),
+                PriorMaterials::PerVoxel(v) => NewMats::Bytes(v),
+            };
+            self.store(cell, u.prior_mask, new)?;
+            undo.push(BrickUndo {
+                brick: u.brick,
+                prior_mask: Mask::EMPTY,
+                touched: Mask::FULL,
+                prior: PriorMaterials::PerVoxel(Vec::new()),
+            });
+            return Ok(u.prior_mask.count() as u64);
+        }
         let back = u.prior_mask.and(&u.touched);
         let new_mask = old_mask.and_not(&u.touched).or(&back);
         let mut dense = [0u8; 512];

@@ -281,6 +281,11 @@ impl World {
                     }
                 }
             }
+            EditOp::Generate(g) => {
+                for m in g.0.materials() {
+                    table.check(m as u32)?;
+                }
+            }
             EditOp::Restore(inv) => {
                 for u in &inv.bricks {
                     if u.brick.cmpge(self.dims.bricks()).any() {
@@ -329,6 +334,9 @@ impl World {
                     .map(|(w, v)| (w, WorkItem::Voxels(v)))
                     .collect()
             }
+            EditOp::Generate(g) => (0..self.slabs.len())
+                .map(|w| (w, WorkItem::Generate(g.0.clone())))
+                .collect(),
             EditOp::Restore(inv) => {
                 let mut per = vec![Vec::new(); self.slabs.len()];
                 for u in inv.bricks {

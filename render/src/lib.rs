@@ -1,2 +1,6 @@
-//! The renderer: Vulkan compute path tracer over the brickmap and the CPU reference
-//! renderer. Empty until its issue lands; the crate exists so the workspace shape is fixed.
+//! The renderer: Vulkan compute path tracer over the brickmap and the CPU reference renderer
+//! (their issue), and the scene parameters both consume.
+
+pub mod params;
+
+pub use params::{Camera, ParamError, RenderSettings, SceneParams, Sky, Sun};

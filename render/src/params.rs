@@ -1,0 +1,313 @@
+//! What the renderer needs besides the voxel world: camera, sun, sky and render settings.
+//! Plain data with serde, so scene files carry them as readable RON; `validate` says what is
+//! out of range instead of letting a bad file reach the GPU.
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// A value outside its valid range.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{what} = {value} is outside {range}")]
+pub struct ParamError {
+    /// Which parameter.
+    pub what: &'static str,
+    /// Its value, printed.
+    pub value: String,
+    /// The valid range, in words.
+    pub range: &'static str,
+}
+
+fn check(
+    ok: bool,
+    what: &'static str,
+    value: impl std::fmt::Debug,
+    range: &'static str,
+) -> Result<(), ParamError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(ParamError {
+            what,
+            value: format!("{value:?}"),
+            range,
+        })
+    }
+}
+
+fn finite3(v: DVec3) -> bool {
+    v.is_finite()
+}
+
+fn colour_ok(c: [f32; 3]) -> bool {
+    c.iter().all(|v| v.is_finite() && *v >= 0.0)
+}
+
+/// A pinhole camera: position, orientation as yaw and pitch, vertical field of view.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Camera {
+    /// Eye position, in voxel units.
+    pub position: DVec3,
+    /// Rotation about +y in degrees; 0 looks along −z, 90 along −x.
+    pub yaw_deg: f64,
+    /// Elevation in degrees, −89..=89; positive looks up.
+    pub pitch_deg: f64,
+    /// Vertical field of view in degrees, in (0, 180).
+    pub fov_y_deg: f64,
+}
+
+impl Camera {
+    /// Unit view direction.
+    pub fn forward(&self) -> DVec3 {
+        let (yaw, pitch) = (self.yaw_deg.to_radians(), self.pitch_deg.to_radians());
+        DVec3::new(
+            -yaw.sin() * pitch.cos(),
+            pitch.sin(),
+            -yaw.cos() * pitch.cos(),
+        )
+    }
+    /// A camera at `position` looking at `target`.
+    pub fn looking_at(position: DVec3, target: DVec3, fov_y_deg: f64) -> Self {
+        let d = (target - position).normalize_or(DVec3::NEG_Z);
+        let pitch = d.y.clamp(-1.0, 1.0).asin().to_degrees().clamp(-89.0, 89.0);
+        let yaw = (-d.x).atan2(-d.z).to_degrees();
+        Self {
+            position,
+            yaw_deg: yaw,
+            pitch_deg: pitch,
+            fov_y_deg,
+        }
+    }
+    /// Checks every field.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        check(
+            finite3(self.position),
+            "camera position",
+            self.position,
+            "finite numbers",
+        )?;
+        check(
+            self.yaw_deg.is_finite(),
+            "camera yaw",
+            self.yaw_deg,
+            "finite degrees",
+        )?;
+        check(
+            (-89.0..=89.0).contains(&self.pitch_deg),
+            "camera pitch",
+            self.pitch_deg,
+            "[-89, 89] degrees",
+        )?;
+        check(
+            self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0,
+            "camera fov",
+            self.fov_y_deg,
+            "(0, 180) degrees",
+        )
+    }
+}
+
+/// The sun: a one-sided disc facing the grid centre.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Sun {
+    /// Whether it lights the scene.
+    pub enabled: bool,
+    /// Disc centre, in voxel units.
+    pub position: DVec3,
+    /// Disc radius, > 0.
+    pub radius: f64,
+    /// Linear RGB colour.
+    pub colour: [f32; 3],
+    /// Radiance scale, ≥ 0.
+    pub intensity: f32,
+    /// Whether the sun circles the scene.
+    pub animate: bool,
+    /// Animation speed in degrees per second.
+    pub speed_deg_per_s: f64,
+}
+
+impl Sun {
+    /// Checks every field.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        check(
+            finite3(self.position),
+            "sun position",
+            self.position,
+            "finite numbers",
+        )?;
+        check(
+            self.radius > 0.0 && self.radius.is_finite(),
+            "sun radius",
+            self.radius,
+            "(0, ∞)",
+        )?;
+        check(
+            colour_ok(self.colour),
+            "sun colour",
+            self.colour,
+            "finite, ≥ 0",
+        )?;
+        check(
+            self.intensity.is_finite() && self.intensity >= 0.0,
+            "sun intensity",
+            self.intensity,
+            "[0, ∞)",
+        )?;
+        check(
+            self.speed_deg_per_s.is_finite(),
+            "sun speed",
+            self.speed_deg_per_s,
+            "finite",
+        )
+    }
+}
+
+/// Radiance arriving from directions that hit nothing.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Sky {
+    /// The same radiance from every direction.
+    Uniform {
+        /// Linear RGB radiance.
+        colour: [f32; 3],
+    },
+    /// L(d) = (1 − t)·horizon + t·zenith with t = clamp(d.y, 0, 1).
+    Gradient {
+        /// Radiance at and below the horizon.
+        horizon: [f32; 3],
+        /// Radiance straight up.
+        zenith: [f32; 3],
+    },
+}
+
+impl Sky {
+    /// Checks every colour.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        match self {
+            Sky::Uniform { colour } => {
+                check(colour_ok(*colour), "sky colour", colour, "finite, ≥ 0")
+            }
+            Sky::Gradient { horizon, zenith } => {
+                check(colour_ok(*horizon), "sky horizon", horizon, "finite, ≥ 0")?;
+                check(colour_ok(*zenith), "sky zenith", zenith, "finite, ≥ 0")
+            }
+        }
+    }
+}
+
+/// How the image is computed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RenderSettings {
+    /// Samples per pixel per frame, 1..=1024.
+    pub samples_per_pixel: u32,
+    /// Scattering vertices per path, 1..=64 (DESIGN.md's B).
+    pub max_bounces: u32,
+    /// Internal resolution (width, height), each 1..=16384.
+    pub internal_resolution: (u32, u32),
+    /// Exposure in stops.
+    pub exposure: f32,
+}
+
+impl RenderSettings {
+    /// Checks every field.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        check(
+            (1..=1024).contains(&self.samples_per_pixel),
+            "samples per pixel",
+            self.samples_per_pixel,
+            "1..=1024",
+        )?;
+        check(
+            (1..=64).contains(&self.max_bounces),
+            "max bounces",
+            self.max_bounces,
+            "1..=64",
+        )?;
+        let (w, h) = self.internal_resolution;
+        check(
+            (1..=16384).contains(&w) && (1..=16384).contains(&h),
+            "internal resolution",
+            (w, h),
+            "1..=16384 each",
+        )?;
+        check(
+            self.exposure.is_finite() && self.exposure.abs() <= 32.0,
+            "exposure",
+            self.exposure,
+            "[-32, 32] stops",
+        )
+    }
+}
+
+/// Everything but the voxels: what a scene file carries besides the world.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SceneParams {
+    /// The camera.
+    pub camera: Camera,
+    /// The sun.
+    pub sun: Sun,
+    /// The sky.
+    pub sky: Sky,
+    /// Render settings.
+    pub settings: RenderSettings,
+}
+
+impl SceneParams {
+    /// Defaults framing a grid of `size` voxels: camera above a corner looking at the
+    /// centre, sun high over the opposite side, a blue gradient sky.
+    pub fn framing(size: DVec3) -> Self {
+        let centre = size * 0.5;
+        let eye = DVec3::new(-0.15 * size.x, size.y * 0.9 + 0.2 * size.x, -0.15 * size.z);
+        Self {
+            camera: Camera::looking_at(eye, centre, 50.0),
+            sun: Sun {
+                enabled: true,
+                position: centre + DVec3::new(0.6, 1.0, 0.3).normalize() * size.max_element() * 2.0,
+                radius: size.max_element() * 0.05,
+                colour: [1.0, 0.95, 0.85],
+                intensity: 40.0,
+                animate: false,
+                speed_deg_per_s: 10.0,
+            },
+            sky: Sky::Gradient {
+                horizon: [0.85, 0.9, 1.0],
+                zenith: [0.25, 0.45, 0.9],
+            },
+            settings: RenderSettings {
+                samples_per_pixel: 1,
+                max_bounces: 3,
+                internal_resolution: (1024, 576),
+                exposure: 0.0,
+            },
+        }
+    }
+    /// Checks every part.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        self.camera.validate()?;
+        self.sun.validate()?;
+        self.sky.validate()?;
+        self.settings.validate()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn looking_at_points_at_the_target() {
+        let c = Camera::looking_at(DVec3::new(1.0, 5.0, 2.0), DVec3::new(10.0, 0.0, -7.0), 45.0);
+        let want = (DVec3::new(10.0, 0.0, -7.0) - DVec3::new(1.0, 5.0, 2.0)).normalize();
+        assert!((c.forward() - want).length() < 1e-12);
+        c.validate().unwrap();
+    }
+
+    #[test]
+    fn validation_names_the_field() {
+        let mut p = SceneParams::framing(DVec3::splat(64.0));
+        p.validate().unwrap();
+        p.settings.max_bounces = 0;
+        assert_eq!(p.validate().unwrap_err().what, "max bounces");
+        p.settings.max_bounces = 3;
+        p.sun.radius = f64::NAN;
+        assert_eq!(p.validate().unwrap_err().what, "sun radius");
+    }
+}
