@@ -1,14 +1,17 @@
-//! `voxbrick`: the voxel scene editor's command line. For now it builds the built-in scene
-//! and reports on it; the editor, file formats and renderer arrive with their issues.
+//! `voxbrick`: the voxel scene editor's command line. Subcommands build, convert and inspect
+//! scenes; the editor and the renderer arrive with their issues.
 
-mod scene;
-
-use anyhow::Result;
-use brickmap::{Ray, World};
-use clap::{Parser, Subcommand};
-use glam::DVec3;
-use scene::SceneSize;
-use std::time::Instant;
+use anyhow::{Context, Result, bail};
+use app::Scene;
+use app::formats::{self, Format};
+use app::scene::{SceneSize, default_scene, terrain_materials, thesis_scene, thesis_terrain};
+use brickmap::terrain::{NoiseKind, NoiseTerrain};
+use brickmap::{GridDims, Ray, World};
+use clap::{Parser, Subcommand, ValueEnum};
+use glam::{DVec3, IVec3};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 #[derive(Parser)]
 #[command(
@@ -17,6 +20,9 @@ use std::time::Instant;
     about = "Voxel scene editor with a path-traced viewport"
 )]
 struct Cli {
+    /// Worker threads for the voxel world (0: one per core).
+    #[arg(long, global = true, default_value_t = 0)]
+    workers: usize,
     #[command(subcommand)]
     command: Command,
 }
@@ -28,10 +34,92 @@ enum Command {
         /// Scene size.
         #[arg(long, value_enum, default_value = "full")]
         size: SceneSize,
-        /// Worker threads (0: one per core).
-        #[arg(long, default_value_t = 0)]
-        workers: usize,
     },
+    /// Convert between project (.ron) and MagicaVoxel (.vox) files.
+    Convert {
+        /// Input file (.ron or .vox).
+        input: PathBuf,
+        /// Output file (.ron or .vox); replaced atomically.
+        output: PathBuf,
+        /// Offset added to imported .vox voxels, as X,Y,Z.
+        #[arg(long, value_parser = parse_ivec3, default_value = "0,0,0")]
+        offset: IVec3,
+        /// Import nodes on hidden layers too.
+        #[arg(long)]
+        include_hidden: bool,
+    },
+    /// Create a new scene file.
+    New {
+        /// A noise terrain with water (the parameters below).
+        #[arg(long, conflicts_with = "thesis")]
+        terrain: bool,
+        /// The thesis benchmark scene: 512×256×512 terrain, water and a metal statue.
+        #[arg(long)]
+        thesis: bool,
+        /// Grid size in voxels, as WxHxD (multiples of 8 are used as they are).
+        #[arg(long, value_parser = parse_size, default_value = "512x256x512")]
+        size: IVec3,
+        /// Noise seed.
+        #[arg(long, default_value_t = 2022)]
+        seed: u32,
+        /// Noise function.
+        #[arg(long, value_enum, default_value = "perlin")]
+        noise: Noise,
+        /// Wavelength of the first octave, in voxels.
+        #[arg(long)]
+        scale: Option<f64>,
+        /// Octaves of fractal noise (1..=12).
+        #[arg(long, default_value_t = 5)]
+        octaves: u32,
+        /// Lowest surface height in voxels.
+        #[arg(long)]
+        height_min: Option<u32>,
+        /// Highest surface height in voxels.
+        #[arg(long)]
+        height_max: Option<u32>,
+        /// Water level in voxels (0: none).
+        #[arg(long)]
+        water_level: Option<u32>,
+        /// Output file (.ron or .vox).
+        output: PathBuf,
+    },
+    /// Print a scene file's dimensions, voxel count, materials and memory.
+    Info {
+        /// A .ron or .vox file.
+        file: PathBuf,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Noise {
+    Perlin,
+    OpenSimplex,
+    SuperSimplex,
+    Value,
+}
+
+fn parse_ivec3(s: &str) -> Result<IVec3, String> {
+    let v: Vec<i32> = s
+        .split(',')
+        .map(|p| p.trim().parse::<i32>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("{s:?}: {e}"))?;
+    match v[..] {
+        [x, y, z] => Ok(IVec3::new(x, y, z)),
+        _ => Err(format!("{s:?}: expected three integers X,Y,Z")),
+    }
+}
+
+fn parse_size(s: &str) -> Result<IVec3, String> {
+    let v: Vec<i32> = s
+        .split('x')
+        .map(|p| p.trim().parse::<i32>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("{s:?}: {e}"))?;
+    match v[..] {
+        [x, y, z] if x > 0 && y > 0 && z > 0 => Ok(IVec3::new(x, y, z)),
+        _ => Err(format!("{s:?}: expected three positive integers WxHxD")),
+    }
 }
 
 fn main() -> std::process::ExitCode {
@@ -44,66 +132,218 @@ fn main() -> std::process::ExitCode {
     }
 }
 
+/// A spinner on stderr while `work` runs (hidden when stderr is not a terminal).
+fn with_progress<T>(message: String, work: impl FnOnce() -> Result<T>) -> Result<T> {
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {msg} {elapsed}").expect("valid template"),
+    );
+    bar.set_message(message);
+    bar.enable_steady_tick(Duration::from_millis(100));
+    let out = work();
+    bar.finish_and_clear();
+    out
+}
+
 fn run(cli: Cli) -> Result<()> {
+    let workers = cli.workers;
     match cli.command {
-        Command::Stats { size, workers } => stats(size, workers),
+        Command::Stats { size } => {
+            let started = Instant::now();
+            let scene = with_progress("building the default scene".into(), || {
+                default_scene(size, workers)
+            })?;
+            print_stats(&scene.world, started.elapsed().as_secs_f64())
+        }
+        Command::Convert {
+            input,
+            output,
+            offset,
+            include_hidden,
+        } => {
+            let started = Instant::now();
+            let scene = with_progress(
+                format!("reading {}", input.display()),
+                || match Format::of(&input)? {
+                    Format::Project => Ok(formats::project::load(&input, workers)?),
+                    Format::Vox => {
+                        let options = formats::vox::ImportOptions {
+                            offset,
+                            include_hidden,
+                        };
+                        let (scene, report) = formats::vox::import_file(&input, &options, workers)?;
+                        eprintln!(
+                            "imported {} voxels from {} instances of {} models, {} materials",
+                            report.voxels, report.instances, report.models, report.materials
+                        );
+                        for line in &report.dropped {
+                            eprintln!("  dropped: {line}");
+                        }
+                        Ok(scene)
+                    }
+                },
+            )?;
+            with_progress(format!("writing {}", output.display()), || {
+                Ok(scene.save(&output)?)
+            })?;
+            eprintln!(
+                "wrote {} in {:.2} s",
+                output.display(),
+                started.elapsed().as_secs_f64()
+            );
+            Ok(())
+        }
+        Command::New {
+            terrain,
+            thesis,
+            size,
+            seed,
+            noise,
+            scale,
+            octaves,
+            height_min,
+            height_max,
+            water_level,
+            output,
+        } => {
+            if !terrain && !thesis {
+                bail!("say what to create: --terrain (with its parameters) or --thesis");
+            }
+            Format::of(&output)?;
+            let started = Instant::now();
+            let scene = with_progress("generating".into(), || {
+                if thesis {
+                    return thesis_scene(workers);
+                }
+                let dims = GridDims::from_voxels(size.as_uvec3()).context("grid size")?;
+                let scene = Scene::empty(dims, workers)?;
+                let h = dims.voxels().y as u32;
+                let mut params = thesis_terrain(terrain_materials(&scene.world)?, h);
+                params.seed = seed;
+                params.noise = match noise {
+                    Noise::Perlin => NoiseKind::Perlin,
+                    Noise::OpenSimplex => NoiseKind::OpenSimplex,
+                    Noise::SuperSimplex => NoiseKind::SuperSimplex,
+                    Noise::Value => NoiseKind::Value,
+                };
+                params.octaves = octaves;
+                params.scale = scale.unwrap_or(params.scale);
+                params.height_range = (
+                    height_min.unwrap_or(params.height_range.0),
+                    height_max.unwrap_or(params.height_range.1),
+                );
+                params.water_level = water_level.unwrap_or(params.water_level);
+                scene.world.apply(NoiseTerrain::new(params, dims)?.edit())?;
+                scene.world.take_dirty();
+                Ok(scene)
+            })?;
+            let generated = started.elapsed().as_secs_f64();
+            with_progress(format!("writing {}", output.display()), || {
+                Ok(scene.save(&output)?)
+            })?;
+            eprintln!(
+                "generated in {generated:.2} s, wrote {} in {:.2} s total",
+                output.display(),
+                started.elapsed().as_secs_f64()
+            );
+            Ok(())
+        }
+        Command::Info { file } => {
+            let started = Instant::now();
+            let scene = with_progress(format!("reading {}", file.display()), || {
+                Ok(Scene::load(&file, workers)?)
+            })?;
+            let p = &scene.params;
+            let mut text = format!("file         {}\n", file.display());
+            text += &stats_text(&scene.world, started.elapsed().as_secs_f64());
+            text += &format!(
+                "camera       at {} yaw {:.1} pitch {:.1} fov {:.1}\nrender       {} spp, {} bounces, {}x{}\n",
+                p.camera.position,
+                p.camera.yaw_deg,
+                p.camera.pitch_deg,
+                p.camera.fov_y_deg,
+                p.settings.samples_per_pixel,
+                p.settings.max_bounces,
+                p.settings.internal_resolution.0,
+                p.settings.internal_resolution.1
+            );
+            emit(&text)?;
+            Ok(())
+        }
     }
 }
 
-fn stats(size: SceneSize, workers: usize) -> Result<()> {
-    let started = Instant::now();
-    let world = scene::default_scene(size, workers)?;
-    let built = started.elapsed();
-    print_stats(&world, built.as_secs_f64());
-    Ok(())
+/// Writes to stdout; a reader that went away (`voxbrick info f | head`) ends output quietly.
+fn emit(text: &str) -> Result<()> {
+    use std::io::Write;
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
 }
 
-fn print_stats(world: &World, build_seconds: f64) {
+fn print_stats(world: &World, seconds: f64) -> Result<()> {
+    emit(&stats_text(world, seconds))
+}
+
+fn stats_text(world: &World, seconds: f64) -> String {
     let view = world.read();
     let dims = world.dims();
     let m = view.memory();
     let solid = view.solid_count();
     let v = dims.voxels();
-    println!(
-        "scene        {} x {} x {} voxels ({} x {} x {} bricks)",
-        v.x,
-        v.y,
-        v.z,
-        dims.bricks().x,
-        dims.bricks().y,
-        dims.bricks().z
-    );
-    println!(
-        "built in     {:.1} ms on {} workers",
-        build_seconds * 1e3,
-        world.workers()
-    );
-    println!("solid        {solid} voxels");
-    println!(
-        "cells        {} stored bricks ({} uniform), {} full cells",
-        view.brick_count(),
-        m.uniform_bricks,
-        m.full_cells
-    );
-    println!("materials    {} in the table", view.materials().len());
-    println!(
-        "gpu memory   {} bytes used, {} reserved",
-        m.gpu_used(),
-        m.gpu_reserved()
-    );
-    println!("  brick index  {}", m.brick_index);
-    println!("  bricks       {}", m.bricks_used);
-    println!("  coarse grid  {}", m.coarse);
-    println!(
-        "  material     {} ({} payload)",
-        m.material_used, m.material_payload
-    );
-    println!("  tables       {}", m.tables);
+    let b = dims.bricks();
+    let table = view.materials();
+    let mut kinds = [0usize; 4];
+    for i in 0..table.len() {
+        if let Ok(mat) = table.get(i as u8) {
+            kinds[mat.kind as usize] += 1;
+        }
+    }
+    let mut lines = vec![
+        format!(
+            "scene        {} x {} x {} voxels ({} x {} x {} bricks)",
+            v.x, v.y, v.z, b.x, b.y, b.z
+        ),
+        format!(
+            "built in     {:.1} ms on {} workers",
+            seconds * 1e3,
+            world.workers()
+        ),
+        format!("solid        {solid} voxels"),
+        format!(
+            "cells        {} stored bricks ({} uniform), {} full cells",
+            view.brick_count(),
+            m.uniform_bricks,
+            m.full_cells
+        ),
+        format!(
+            "materials    {} in the table ({} lambertian, {} metal, {} dielectric, {} emissive)",
+            table.len(),
+            kinds[0],
+            kinds[1],
+            kinds[2],
+            kinds[3]
+        ),
+        format!(
+            "gpu memory   {} bytes used, {} reserved",
+            m.gpu_used(),
+            m.gpu_reserved()
+        ),
+        format!("  brick index  {}", m.brick_index),
+        format!("  bricks       {}", m.bricks_used),
+        format!("  coarse grid  {}", m.coarse),
+        format!(
+            "  material     {} ({} payload)",
+            m.material_used, m.material_payload
+        ),
+        format!("  tables       {}", m.tables),
+    ];
     if solid > 0 {
-        println!(
+        lines.push(format!(
             "per voxel    {:.4} bytes per solid voxel",
             m.gpu_used() as f64 / solid as f64
-        );
+        ));
     }
     // A pick ray straight down through the middle, as a brush would cast it.
     let centre = v.as_dvec3() * 0.5;
@@ -111,15 +351,16 @@ fn print_stats(world: &World, build_seconds: f64) {
         origin: DVec3::new(centre.x + 0.5, v.y as f64 + 10.0, centre.z + 0.5),
         dir: -DVec3::Y,
     };
-    match view.ray_cast(&ray, f64::INFINITY) {
+    lines.push(match view.ray_cast(&ray, f64::INFINITY) {
         Ok(Some((hit, material))) => {
-            println!(
+            format!(
                 "pick         voxel {} material {material} normal {} at t = {:.3}",
                 hit.voxel, hit.normal, hit.t
             )
         }
-        Ok(None) => println!("pick         nothing below the centre"),
-        Err(e) => println!("pick         failed: {e}"),
-    }
-    println!("content hash {:016x}", view.content_hash());
+        Ok(None) => "pick         nothing below the centre".to_string(),
+        Err(e) => format!("pick         failed: {e}"),
+    });
+    lines.push(format!("content hash {:016x}", view.content_hash()));
+    lines.join("\n") + "\n"
 }

@@ -1,11 +1,53 @@
-//! The built-in default scene: rolling terrain with grass, dirt, rock and sand, plus a metal
-//! sphere, a glass block and an emissive lamp, so every material type is present.
+//! The scene document: the voxel world (with its material and colour tables) and the
+//! camera, sun, sky and render settings; plus the built-in scenes.
 
+use crate::formats::{self, Format, FormatError};
 use anyhow::{Context, Result};
 use brickmap::{
     EditOp, GridDims, Material, MaterialKind, Mode, Shape, World, WorldConfig, terrain,
 };
 use glam::{DVec3, IVec3};
+use render::SceneParams;
+use std::path::Path;
+
+/// A scene: everything a file carries.
+#[derive(Debug)]
+pub struct Scene {
+    /// Voxels, materials, colours.
+    pub world: World,
+    /// Camera, sun, sky, render settings.
+    pub params: SceneParams,
+}
+
+impl Scene {
+    /// An empty scene of a grid size, framed by the default camera.
+    pub fn empty(dims: GridDims, workers: usize) -> brickmap::Result<Self> {
+        let world = World::new(dims, WorldConfig::with_workers(workers))?;
+        Ok(Self {
+            params: SceneParams::framing(dims.voxels().as_dvec3()),
+            world,
+        })
+    }
+
+    /// Loads a `.ron` project or imports a `.vox` file (which gets the default sun and sky).
+    pub fn load(path: &Path, workers: usize) -> Result<Self, FormatError> {
+        match Format::of(path)? {
+            Format::Project => formats::project::load(path, workers),
+            Format::Vox => {
+                formats::vox::import_file(path, &formats::vox::ImportOptions::default(), workers)
+                    .map(|(s, _)| s)
+            }
+        }
+    }
+
+    /// Saves as a `.ron` project or exports `.vox`, atomically.
+    pub fn save(&self, path: &Path) -> Result<(), FormatError> {
+        match Format::of(path)? {
+            Format::Project => formats::project::save(self, path),
+            Format::Vox => formats::vox::export_file(self, path).map(|_| ()),
+        }
+    }
+}
 
 /// Size presets for the default scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -16,19 +58,15 @@ pub enum SceneSize {
     Small,
 }
 
-/// Builds the default scene.
-pub fn default_scene(size: SceneSize, workers: usize) -> Result<World> {
+/// The built-in default scene: rolling terrain with grass, dirt, rock and sand, plus a metal
+/// sphere, a glass block and an emissive lamp, so every material type is present.
+pub fn default_scene(size: SceneSize, workers: usize) -> Result<Scene> {
     let dims = match size {
         SceneSize::Full => GridDims::new(64, 32, 64),
         SceneSize::Small => GridDims::new(16, 8, 16),
     }?;
-    let world = World::new(
-        dims,
-        WorldConfig {
-            workers,
-            ..Default::default()
-        },
-    )?;
+    let scene = Scene::empty(dims, workers)?;
+    let world = &scene.world;
     // Colours 200.. of the table are the scene's own. Terrain materials must be 0..=3 (grass,
     // dirt, rock, sand: the indices terrain::rolling_hills uses); then metal, glass, lamp.
     let colours = [
@@ -96,5 +134,122 @@ pub fn default_scene(size: SceneSize, workers: usize) -> Result<World> {
         shape: pole,
         mode: Mode::Add(lamp),
     })?;
-    Ok(world)
+    Ok(scene)
+}
+
+/// The statue placed in metal in the thesis scene: "Mini Mike's Metro Minis" by Mike Judge,
+/// CC BY 4.0 (assets/vox/SOURCES.md).
+pub const STATUE_VOX: &[u8] = include_bytes!("../../assets/vox/mmmm_obj_statue3.vox");
+
+/// Terrain parameters of the thesis benchmark scene for a grid height.
+pub fn thesis_terrain(materials: terrain::TerrainMaterials, height: u32) -> terrain::TerrainParams {
+    let h = height as f64;
+    terrain::TerrainParams {
+        seed: 2022,
+        noise: terrain::NoiseKind::Perlin,
+        scale: 180.0 * h / 256.0,
+        octaves: 5,
+        height_range: ((h * 0.16) as u32, (h * 0.78) as u32),
+        water_level: (h * 0.375) as u32,
+        rock_line: 0.62,
+        snow_line: 0.86,
+        soil_depth: 3,
+        materials,
+    }
+}
+
+/// Adds the terrain palette to a world: grass, dirt, rock with colour variants, sand, snow,
+/// and water (a blue-tinted dielectric, IOR 1.333).
+pub fn terrain_materials(world: &World) -> Result<terrain::TerrainMaterials> {
+    // Colours are taken from the top of the table down; a fresh table's placeholder
+    // material 0 is replaced by the first terrain material.
+    let fresh = world.read().solid_count() == 0 && world.materials().len() == 1;
+    let mut next_colour = 255u8;
+    let mut first = fresh;
+    let mut add = |rgb: [u8; 3], kind: MaterialKind, param: u8| -> Result<u8> {
+        let colour = next_colour;
+        next_colour -= 1;
+        world.set_colour(colour, rgb);
+        let m = Material {
+            kind,
+            param,
+            colour,
+        };
+        if std::mem::take(&mut first) {
+            world.set_material(0, m)?;
+            return Ok(0);
+        }
+        Ok(world.push_material(m)?)
+    };
+    let l = MaterialKind::Lambertian;
+    let grass = vec![
+        add([88, 150, 60], l, 0)?,
+        add([98, 162, 66], l, 0)?,
+        add([78, 138, 54], l, 0)?,
+    ];
+    let dirt = vec![add([120, 86, 58], l, 0)?, add([108, 78, 52], l, 0)?];
+    let rock = vec![add([126, 126, 122], l, 0)?, add([112, 112, 110], l, 0)?];
+    let sand = vec![add([218, 202, 150], l, 0)?];
+    let snow = vec![add([240, 244, 250], l, 0)?];
+    // Dielectric parameter 1 of the default table is water's IOR, 1.333.
+    let water = add([190, 220, 240], MaterialKind::Dielectric, 1)?;
+    Ok(terrain::TerrainMaterials {
+        grass,
+        dirt,
+        rock,
+        sand,
+        snow,
+        water,
+    })
+}
+
+/// The thesis benchmark scene: 512 × 256 × 512 noise terrain with water, and a statue in
+/// polished gold standing on the ground at the centre.
+pub fn thesis_scene(workers: usize) -> Result<Scene> {
+    let dims = GridDims::new(64, 32, 64)?;
+    let scene = Scene::empty(dims, workers)?;
+    let world = &scene.world;
+    let materials = terrain_materials(world)?;
+    let params = thesis_terrain(materials, dims.voxels().y as u32);
+    world
+        .apply(terrain::NoiseTerrain::new(params, dims)?.edit())
+        .context("generating the terrain")?;
+    place_statue(world)?;
+    world.take_dirty();
+    Ok(scene)
+}
+
+/// Places the CC-BY statue in gold on the ground (or water) at the centre of the grid.
+fn place_statue(world: &World) -> Result<()> {
+    world.set_colour(64, [232, 196, 110]);
+    let gold = world.push_material(Material {
+        kind: MaterialKind::Metal,
+        param: 6,
+        colour: 64,
+    })?;
+    let size = formats::vox::extent(STATUE_VOX).map_err(anyhow::Error::msg)?;
+    let v = world.dims().voxels();
+    let centre = DVec3::new(
+        v.x as f64 / 2.0 + 0.5,
+        v.y as f64 + 1.0,
+        v.z as f64 / 2.0 + 0.5,
+    );
+    let ground = world
+        .read()
+        .ray_cast(
+            &brickmap::Ray {
+                origin: centre,
+                dir: DVec3::NEG_Y,
+            },
+            f64::INFINITY,
+        )?
+        .map_or(0, |(hit, _)| hit.voxel.y + 1);
+    let offset = IVec3::new(v.x / 2 - size.x / 2, ground, v.z / 2 - size.z / 2);
+    let options = formats::vox::ImportOptions {
+        offset,
+        ..Default::default()
+    };
+    formats::vox::import_into(world, STATUE_VOX, &options, Some(gold))
+        .map_err(anyhow::Error::msg)?;
+    Ok(())
 }

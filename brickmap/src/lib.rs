@@ -37,4 +37,4 @@ pub use material::{Material, MaterialKind, MaterialTable};
 pub use raycast::{Occupancy, Ray, RayHit};
 pub use shape::Shape;
 pub use storage::BucketSizes;
-pub use world::{DirtySet, GpuBuffer, MemoryStats, World, WorldConfig, WorldView};
+pub use world::{BrickMaterials, DirtySet, GpuBuffer, MemoryStats, World, WorldConfig, WorldView};

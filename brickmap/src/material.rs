@@ -239,6 +239,11 @@ impl MaterialTable {
     pub fn gpu(&self) -> &MaterialTablesGpu {
         &self.gpu
     }
+    /// Marks the whole table changed (after it replaced another).
+    pub fn mark_all_dirty(&mut self) {
+        self.dirty
+            .record(0..std::mem::size_of::<MaterialTablesGpu>() as u64);
+    }
     /// Byte ranges of [`MaterialTablesGpu`] changed since the last drain.
     pub fn take_dirty(&mut self) -> Vec<std::ops::Range<u64>> {
         self.dirty.take()

@@ -212,6 +212,28 @@ impl Slab {
             .filter(|&i| self.slots[i] != EMPTY_BRICK)
             .map(|i| (i + self.cell_base, self.cell(i + self.cell_base)))
     }
+    /// Calls `f(cell, mask, materials)` for every non-empty cell, in cell order.
+    pub(crate) fn visit(&self, f: &mut dyn FnMut(usize, &Mask, crate::world::BrickMaterials<'_>)) {
+        use crate::world::BrickMaterials;
+        for (cell, state) in self.cells() {
+            match state {
+                CellState::Empty => {}
+                CellState::Full(m) => f(cell, &Mask::FULL, BrickMaterials::Uniform(m)),
+                CellState::Brick(slot) => {
+                    let b = self.pool.get(slot);
+                    let mats = if b.is_uniform() {
+                        BrickMaterials::Uniform(b.material as u8)
+                    } else {
+                        let n = b.mask.count() as usize;
+                        BrickMaterials::PerVoxel(
+                            self.buckets.slice(self.meta[slot as usize].bucket, n),
+                        )
+                    };
+                    f(cell, &b.mask, mats);
+                }
+            }
+        }
+    }
     /// The brick-index words of this slab's cells as the GPU reads them.
     pub(crate) fn gpu_index_words(&self) -> impl Iterator<Item = u32> + '_ {
         (0..self.slots.len()).map(|i| self.gpu_index_word(i + self.cell_base))
@@ -748,6 +770,10 @@ impl Slab {
                     if a == m {
                         if solid {
                             return Ok(false);
+                        }
+                        if mask.is_full() {
+                            // A uniform brick that fills up becomes a full cell.
+                            return self.store(cell, mask, NewMats::Uniform(a)).map(|_| true);
                         }
                         self.set_mask_in_place(slot, mask, 1);
                         return Ok(true);

@@ -98,6 +98,15 @@ impl DirtySet {
     }
 }
 
+/// The materials of one brick, borrowed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BrickMaterials<'a> {
+    /// Every solid voxel has this material.
+    Uniform(u8),
+    /// One material per solid voxel, in popcount order.
+    PerVoxel(&'a [u8]),
+}
+
 /// Bytes by buffer.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct MemoryStats {
@@ -414,6 +423,30 @@ impl World {
     pub fn set_colour(&self, index: u8, rgb: [u8; 3]) -> [u8; 3] {
         self.materials_mut().set_colour(index, rgb)
     }
+    /// Replaces the whole material table (loading a scene), returning the previous one.
+    /// Refused when a voxel uses a material the new table lacks.
+    pub fn replace_materials(&self, table: MaterialTable) -> Result<MaterialTable> {
+        let mut highest = None::<u8>;
+        self.read().for_each_brick(|_, mask, mats| {
+            let top = match mats {
+                BrickMaterials::Uniform(m) => m,
+                BrickMaterials::PerVoxel(v) => v[..mask.count() as usize]
+                    .iter()
+                    .copied()
+                    .max()
+                    .unwrap_or(0),
+            };
+            highest = highest.max(Some(top));
+        });
+        if let Some(m) = highest {
+            table.check(m as u32)?;
+        }
+        let mut current = self.materials_mut();
+        let mut table = table;
+        table.mark_all_dirty();
+        Ok(std::mem::replace(&mut *current, table))
+    }
+
     /// Sets a material parameter, returning the previous value.
     pub fn set_param(&self, kind: MaterialKind, index: u8, value: f32) -> Result<f32> {
         self.materials_mut().set_param(kind, index, value)
@@ -704,6 +737,14 @@ impl WorldView<'_> {
         all.extend_from_slice(&sum.to_le_bytes());
         all.extend_from_slice(&self.materials.logical_bytes());
         xxh3_64(&all)
+    }
+
+    /// Calls `f(brick, mask, materials)` for every non-empty brick cell in cell order
+    /// (`(bx·Z + bz)·Y + by` ascending), materials borrowed, without copying the world.
+    pub fn for_each_brick(&self, mut f: impl FnMut(UVec3, &crate::Mask, BrickMaterials<'_>)) {
+        for s in &self.slabs {
+            s.visit(&mut |cell, mask, mats| f(self.world.dims.cell_coord(cell), mask, mats));
+        }
     }
 
     /// Checks every invariant of every slab (tests use it after each step).

@@ -135,7 +135,9 @@ impl Reference {
                     }
                 }
             }
-            EditOp::Restore(_) => unreachable!("the reference keeps snapshots for undo"),
+            EditOp::Restore(_) | EditOp::Generate(_) => {
+                unreachable!("the model never generates; undo uses snapshots")
+            }
         }
     }
 }
@@ -512,6 +514,30 @@ fn voxel_writes_into_full_cells() {
             mode: Mode::Add(1),
         }),
         Step::Edit(EditOp::Voxels(vec![inside(0, VoxelOp::Clear)])),
+        // Filling a whole brick voxel by voxel with one material makes it a full cell again.
+        Step::Edit(EditOp::Shape {
+            shape: Shape::Box {
+                min: IVec3::new(40, 0, 0),
+                max: IVec3::new(47, 7, 7),
+            },
+            mode: Mode::Remove,
+        }),
+        Step::Edit(EditOp::Voxels(
+            (0..512)
+                .map(|i| VoxelEdit {
+                    pos: IVec3::new(40 + i % 8, i / 8 % 8, i / 64),
+                    op: VoxelOp::Set(3),
+                })
+                .collect(),
+        )),
+        Step::Edit(EditOp::Voxels(
+            (0..512)
+                .map(|i| VoxelEdit {
+                    pos: IVec3::new(40 + i % 8, i / 8 % 8, i / 64),
+                    op: VoxelOp::Paint(4),
+                })
+                .collect(),
+        )),
     ];
     run_sequence(&steps).unwrap();
 }

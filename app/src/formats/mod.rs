@@ -1,0 +1,98 @@
+//! Scene file formats: RON projects (`project`, with the voxel payload in `payload`) and
+//! MagicaVoxel `.vox` (`vox`).
+
+pub mod payload;
+pub mod project;
+pub mod vox;
+
+use std::path::Path;
+
+/// Why a file could not be read or written. Messages name the file and what is wrong.
+#[derive(Debug, thiserror::Error)]
+pub enum FormatError {
+    /// The file system refused.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The content is not a valid file of this format.
+    #[error("{path}: {message}")]
+    Invalid {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// Valid, but from a newer program.
+    #[error(
+        "{path}: format version {found} is newer than this program understands ({known}); update voxbrick"
+    )]
+    NewerVersion {
+        /// The file.
+        path: String,
+        /// Its version.
+        found: u32,
+        /// The newest version known here.
+        known: u32,
+    },
+    /// The content does not fit the world (grid, materials, budget).
+    #[error("{path}: {source}")]
+    World {
+        /// The file.
+        path: String,
+        /// The cause.
+        source: brickmap::BrickmapError,
+    },
+}
+
+impl FormatError {
+    pub(crate) fn invalid(path: &Path, message: impl Into<String>) -> Self {
+        FormatError::Invalid {
+            path: path.display().to_string(),
+            message: message.into(),
+        }
+    }
+    pub(crate) fn io(path: &Path, source: std::io::Error) -> Self {
+        FormatError::Io {
+            path: path.display().to_string(),
+            source,
+        }
+    }
+    pub(crate) fn world(path: &Path, source: brickmap::BrickmapError) -> Self {
+        FormatError::World {
+            path: path.display().to_string(),
+            source,
+        }
+    }
+}
+
+/// The formats, by file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// voxbrick project (`.ron`).
+    Project,
+    /// MagicaVoxel (`.vox`).
+    Vox,
+}
+
+impl Format {
+    /// The format a path's extension names.
+    pub fn of(path: &Path) -> Result<Format, FormatError> {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase())
+            .as_deref()
+        {
+            Some("ron") => Ok(Format::Project),
+            Some("vox") => Ok(Format::Vox),
+            _ => Err(FormatError::invalid(
+                path,
+                "unknown file type: expected .ron or .vox",
+            )),
+        }
+    }
+}

@@ -1,0 +1,345 @@
+//! voxbrick project files (`.ron`): everything a scene is, as plain RON a person can read,
+//! diff and edit, except the voxels, which are a compact base64 payload (see `payload`).
+//!
+//! ```text
+//! (
+//!     format_version: 1,
+//!     grid_bricks: (64, 32, 64),
+//!     camera: (position: (..), yaw_deg: .., pitch_deg: .., fov_y_deg: ..),
+//!     sun: (enabled: true, position: (..), radius: .., colour: (..), intensity: .., ..),
+//!     sky: Gradient(horizon: (..), zenith: (..)),
+//!     settings: (samples_per_pixel: 1, max_bounces: 3, internal_resolution: (1024, 576), exposure: 0.0),
+//!     materials: [(kind: Lambertian, param: 0, colour: 200), ..],
+//!     colours: ["#56983a", ..],                     // 256 entries
+//!     roughness: [..], ior: [..], strength: [..],   // 64 entries each
+//!     voxels: (encoding: "vxb1-base64", bricks: .., solid_voxels: .., data: "VlhCMQ.."),
+//! )
+//! ```
+//! Loading checks the version first (newer: a clear error; there is no older version yet,
+//! version 1 is the first), then every field, then every brick; nothing is allocated beyond
+//! what the file's length justifies, except the dense grid of the declared (supported) size.
+
+use super::{FormatError, payload};
+use crate::scene::Scene;
+use base64::Engine;
+use brickmap::{GridDims, Material, MaterialKind, MaterialTable, World, WorldConfig, terrain};
+use render::{Camera, RenderSettings, SceneParams, Sky, Sun};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The version this program writes and the newest it reads.
+pub const FORMAT_VERSION: u32 = 1;
+const ENCODING: &str = "vxb1-base64";
+
+#[derive(Deserialize)]
+struct Probe {
+    format_version: u32,
+}
+
+#[derive(Serialize, Deserialize)]
+struct ProjectFile {
+    format_version: u32,
+    grid_bricks: (u32, u32, u32),
+    camera: Camera,
+    sun: Sun,
+    sky: Sky,
+    settings: RenderSettings,
+    materials: Vec<MaterialRecord>,
+    colours: Vec<String>,
+    roughness: Vec<f32>,
+    ior: Vec<f32>,
+    strength: Vec<f32>,
+    voxels: VoxelRecord,
+}
+
+#[derive(Serialize, Deserialize)]
+struct MaterialRecord {
+    kind: Kind,
+    param: u8,
+    colour: u8,
+}
+
+#[derive(Serialize, Deserialize, Clone, Copy)]
+enum Kind {
+    Lambertian,
+    Metal,
+    Dielectric,
+    Emissive,
+}
+
+#[derive(Serialize, Deserialize)]
+struct VoxelRecord {
+    encoding: String,
+    bricks: u64,
+    solid_voxels: u64,
+    data: String,
+}
+
+impl From<MaterialKind> for Kind {
+    fn from(k: MaterialKind) -> Self {
+        match k {
+            MaterialKind::Lambertian => Kind::Lambertian,
+            MaterialKind::Metal => Kind::Metal,
+            MaterialKind::Dielectric => Kind::Dielectric,
+            MaterialKind::Emissive => Kind::Emissive,
+        }
+    }
+}
+
+impl From<Kind> for MaterialKind {
+    fn from(k: Kind) -> Self {
+        match k {
+            Kind::Lambertian => MaterialKind::Lambertian,
+            Kind::Metal => MaterialKind::Metal,
+            Kind::Dielectric => MaterialKind::Dielectric,
+            Kind::Emissive => MaterialKind::Emissive,
+        }
+    }
+}
+
+/// The project text of a scene.
+pub fn to_string(scene: &Scene) -> String {
+    let view = scene.world.read();
+    let table = view.materials();
+    let dims = scene.world.dims();
+    let b = dims.bricks();
+    let data = payload::encode(&view);
+    let bricks = view.brick_count() + view.memory().full_cells;
+    let file = ProjectFile {
+        format_version: FORMAT_VERSION,
+        grid_bricks: (b.x, b.y, b.z),
+        camera: scene.params.camera.clone(),
+        sun: scene.params.sun.clone(),
+        sky: scene.params.sky.clone(),
+        settings: scene.params.settings.clone(),
+        materials: (0..table.len())
+            .map(|i| {
+                let m = table.get(i as u8).expect("index within the table");
+                MaterialRecord {
+                    kind: m.kind.into(),
+                    param: m.param,
+                    colour: m.colour,
+                }
+            })
+            .collect(),
+        colours: (0..=255u8)
+            .map(|i| {
+                let [r, g, b] = table.colour(i);
+                format!("#{r:02x}{g:02x}{b:02x}")
+            })
+            .collect(),
+        roughness: table.gpu().roughness.to_vec(),
+        ior: table.gpu().ior.to_vec(),
+        strength: table.gpu().strength.to_vec(),
+        voxels: VoxelRecord {
+            encoding: ENCODING.into(),
+            bricks,
+            solid_voxels: view.solid_count(),
+            data: base64::engine::general_purpose::STANDARD.encode(data),
+        },
+    };
+    layout(&file)
+}
+
+/// Lays the file out for people and diffs: one line per field, per material, per eight
+/// colours; every value in ron's compact form (so the result is plain RON).
+fn layout(file: &ProjectFile) -> String {
+    fn ron<T: Serialize>(v: &T) -> String {
+        let compact = ron::ser::PrettyConfig::new()
+            .compact_structs(true)
+            .compact_arrays(true);
+        ron::ser::to_string_pretty(v, compact).expect("project data always serializes")
+    }
+    fn list<T: Serialize>(items: &[T], per_line: usize) -> String {
+        let lines: Vec<String> = items
+            .chunks(per_line)
+            .map(|c| {
+                format!(
+                    "        {},",
+                    c.iter().map(ron).collect::<Vec<_>>().join(", ")
+                )
+            })
+            .collect();
+        format!("[\n{}\n    ]", lines.join("\n"))
+    }
+    let fields = [
+        ("format_version", ron(&file.format_version)),
+        ("grid_bricks", ron(&file.grid_bricks)),
+        ("camera", ron(&file.camera)),
+        ("sun", ron(&file.sun)),
+        ("sky", ron(&file.sky)),
+        ("settings", ron(&file.settings)),
+        ("materials", list(&file.materials, 1)),
+        ("colours", list(&file.colours, 8)),
+        ("roughness", list(&file.roughness, 16)),
+        ("ior", list(&file.ior, 16)),
+        ("strength", list(&file.strength, 16)),
+        ("voxels", ron(&file.voxels)),
+    ];
+    let body: Vec<String> = fields
+        .iter()
+        .map(|(k, v)| format!("    {k}: {v},"))
+        .collect();
+    format!("(\n{}\n)\n", body.join("\n"))
+}
+
+/// Saves a scene atomically.
+pub fn save(scene: &Scene, path: &Path) -> Result<(), FormatError> {
+    let text = to_string(scene);
+    crate::atomic::write_atomic(path, |w| w.write_all(text.as_bytes()))
+        .map_err(|e| FormatError::io(path, e))
+}
+
+/// Loads a project file.
+pub fn load(path: &Path, workers: usize) -> Result<Scene, FormatError> {
+    let text = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
+    from_bytes(&text, path, workers)
+}
+
+/// Parses project text (`path` only names it in errors).
+pub fn from_bytes(text: &[u8], path: &Path, workers: usize) -> Result<Scene, FormatError> {
+    let invalid = |m: String| FormatError::invalid(path, m);
+    let text = std::str::from_utf8(text).map_err(|e| invalid(format!("not UTF-8 text: {e}")))?;
+    let probe: Probe =
+        ron::from_str(text).map_err(|e| invalid(format!("not a voxbrick project: {e}")))?;
+    match probe.format_version {
+        v if v > FORMAT_VERSION => {
+            return Err(FormatError::NewerVersion {
+                path: path.display().to_string(),
+                found: v,
+                known: FORMAT_VERSION,
+            });
+        }
+        FORMAT_VERSION => {}
+        v => {
+            return Err(invalid(format!(
+                "format version {v} never existed (versions start at 1)"
+            )));
+        }
+    }
+    let file: ProjectFile = ron::from_str(text).map_err(|e| invalid(format!("{e}")))?;
+    let params = SceneParams {
+        camera: file.camera,
+        sun: file.sun,
+        sky: file.sky,
+        settings: file.settings,
+    };
+    params.validate().map_err(|e| invalid(e.to_string()))?;
+    let (x, y, z) = file.grid_bricks;
+    let dims = GridDims::new(x, y, z).map_err(|e| FormatError::world(path, e))?;
+    let table = material_table(
+        &file.materials,
+        &file.colours,
+        &file.roughness,
+        &file.ior,
+        &file.strength,
+    )
+    .map_err(invalid)?;
+    if file.voxels.encoding != ENCODING {
+        return Err(invalid(format!(
+            "unknown voxel encoding {:?} (expected {ENCODING:?})",
+            file.voxels.encoding
+        )));
+    }
+    let data = base64::engine::general_purpose::STANDARD
+        .decode(file.voxels.data.as_bytes())
+        .map_err(|e| invalid(format!("voxel payload is not base64: {e}")))?;
+    let bricks = payload::decode(&data, &dims, table.len()).map_err(invalid)?;
+    if bricks.len() as u64 != file.voxels.bricks {
+        return Err(invalid(format!(
+            "voxel payload holds {} bricks, the header says {}",
+            bricks.len(),
+            file.voxels.bricks
+        )));
+    }
+    let world = World::new(dims, WorldConfig::with_workers(workers))
+        .map_err(|e| FormatError::world(path, e))?;
+    world
+        .replace_materials(table)
+        .map_err(|e| FormatError::world(path, e))?;
+    world
+        .apply(terrain::set_bricks(bricks))
+        .map_err(|e| FormatError::world(path, e))?;
+    let solid = world.read().solid_count();
+    if solid != file.voxels.solid_voxels {
+        return Err(invalid(format!(
+            "voxels hold {solid} solid voxels, the header says {}",
+            file.voxels.solid_voxels
+        )));
+    }
+    world.take_dirty();
+    Ok(Scene { world, params })
+}
+
+fn material_table(
+    materials: &[MaterialRecord],
+    colours: &[String],
+    roughness: &[f32],
+    ior: &[f32],
+    strength: &[f32],
+) -> Result<MaterialTable, String> {
+    if materials.is_empty() || materials.len() > 256 {
+        return Err(format!(
+            "{} materials: a scene has 1 to 256",
+            materials.len()
+        ));
+    }
+    if colours.len() != 256 {
+        return Err(format!(
+            "{} colours: the colour table has exactly 256",
+            colours.len()
+        ));
+    }
+    for (name, t) in [
+        ("roughness", roughness),
+        ("ior", ior),
+        ("strength", strength),
+    ] {
+        if t.len() != brickmap::material::PARAMS {
+            return Err(format!(
+                "{} {name} values: the table has exactly 64",
+                t.len()
+            ));
+        }
+    }
+    let mut table = MaterialTable::default();
+    for (i, c) in colours.iter().enumerate() {
+        table.set_colour(
+            i as u8,
+            parse_colour(c).ok_or_else(|| format!("colour {i} {c:?} is not #rrggbb"))?,
+        );
+    }
+    for (kind, values) in [
+        (MaterialKind::Metal, roughness),
+        (MaterialKind::Dielectric, ior),
+        (MaterialKind::Emissive, strength),
+    ] {
+        for (i, v) in values.iter().enumerate() {
+            table
+                .set_param(kind, i as u8, *v)
+                .map_err(|e| format!("{kind:?} parameter {i}: {e}"))?;
+        }
+    }
+    for (i, m) in materials.iter().enumerate() {
+        let m = Material {
+            kind: m.kind.into(),
+            param: m.param,
+            colour: m.colour,
+        };
+        let r = if i == 0 {
+            table.set(0, m).map(|_| 0)
+        } else {
+            table.push(m)
+        };
+        r.map_err(|e| format!("material {i}: {e}"))?;
+    }
+    Ok(table)
+}
+
+fn parse_colour(s: &str) -> Option<[u8; 3]> {
+    let hex = s
+        .strip_prefix('#')
+        .filter(|h| h.len() == 6 && h.is_ascii())?;
+    let c = |i: usize| u8::from_str_radix(&hex[i..i + 2], 16).ok();
+    Some([c(0)?, c(2)?, c(4)?])
+}

@@ -1,0 +1,8 @@
+//! voxbrick's application library: the scene document, file formats and CLI commands that
+//! the `voxbrick` binary (and later the editor) use.
+
+pub mod atomic;
+pub mod formats;
+pub mod scene;
+
+pub use scene::Scene;

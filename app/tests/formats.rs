@@ -1,0 +1,467 @@
+//! File formats end to end: project round trips and hostile files, atomic saves, .vox
+//! import of every sample, import → export → import, scenes beyond 256³, rotations.
+
+use app::Scene;
+use app::formats::{FormatError, project, vox};
+use app::scene::{SceneSize, default_scene};
+use brickmap::{EditOp, GridDims, Material, MaterialKind, Mode, Shape, VoxelEdit, VoxelOp, World};
+use glam::{DVec3, IVec3};
+use std::path::{Path, PathBuf};
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("voxbrick-formats-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn assets() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/vox")
+}
+
+/// Every voxel with its resolved material (kind, parameter value, colour), for comparing
+/// scenes whose tables are numbered differently.
+fn resolved(world: &World) -> Vec<(IVec3, MaterialKind, u32, [u8; 3])> {
+    let view = world.read();
+    let table = view.materials();
+    let mut out = Vec::new();
+    view.for_each_brick(|b, mask, mats| {
+        for (k, bit) in mask.ones().enumerate() {
+            let m = match mats {
+                brickmap::BrickMaterials::Uniform(m) => m,
+                brickmap::BrickMaterials::PerVoxel(v) => v[k],
+            };
+            let mat = table.get(m).unwrap();
+            let p = b.as_ivec3() * 8
+                + IVec3::new((bit % 8) as i32, (bit / 8 % 8) as i32, (bit / 64) as i32);
+            let param = table.param(mat.kind, mat.param).unwrap();
+            out.push((
+                p,
+                mat.kind,
+                (param * 1000.0).round() as u32,
+                table.colour(mat.colour),
+            ));
+        }
+    });
+    out.sort_by_key(|v| (v.0.x, v.0.y, v.0.z));
+    out
+}
+
+#[test]
+fn project_round_trips_everything() {
+    let scene = default_scene(SceneSize::Small, 2).unwrap();
+    let mut params = scene.params.clone();
+    params.camera.yaw_deg = 12.5;
+    params.sky = render::Sky::Uniform {
+        colour: [0.5, 0.25, 2.0],
+    };
+    params.sun.animate = true;
+    params.settings.max_bounces = 7;
+    let scene = Scene { params, ..scene };
+    let d = scratch("roundtrip");
+    let path = d.join("scene.ron");
+    scene.save(&path).unwrap();
+    let loaded = Scene::load(&path, 3).unwrap();
+    assert_eq!(loaded.params, scene.params);
+    assert_eq!(
+        loaded.world.read().content_hash(),
+        scene.world.read().content_hash()
+    );
+    assert_eq!(loaded.world.dims(), scene.world.dims());
+    // Saving the loaded scene gives the same bytes.
+    assert_eq!(
+        project::to_string(&loaded),
+        std::fs::read_to_string(&path).unwrap()
+    );
+    // The non-voxel part is readable RON.
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        text.contains("format_version: 1")
+            && text.contains("kind: Metal")
+            && text.contains("\"#56983a\""),
+        "{}",
+        &text[..600]
+    );
+}
+
+#[test]
+fn versions_and_hostile_files_are_clear_errors() {
+    let scene = default_scene(SceneSize::Small, 2).unwrap();
+    let text = project::to_string(&scene);
+    let p = Path::new("test.ron");
+    let newer = text.replacen("format_version: 1", "format_version: 7", 1);
+    match project::from_bytes(newer.as_bytes(), p, 2) {
+        Err(FormatError::NewerVersion {
+            found: 7, known: 1, ..
+        }) => {}
+        other => panic!("{:?}", other.err()),
+    }
+    let zero = text.replacen("format_version: 1", "format_version: 0", 1);
+    assert!(
+        project::from_bytes(zero.as_bytes(), p, 2)
+            .unwrap_err()
+            .to_string()
+            .contains("never existed")
+    );
+    // Every truncation fails cleanly (sampled; the text is long).
+    for cut in (0..text.trim_end().len()).step_by(97) {
+        assert!(
+            project::from_bytes(&text.as_bytes()[..cut], p, 2).is_err(),
+            "cut at {cut}"
+        );
+    }
+    let cases = [
+        (
+            text.replacen(
+                "grid_bricks: (16, 8, 16)",
+                "grid_bricks: (100000, 8, 16)",
+                1,
+            ),
+            "grid",
+        ),
+        (
+            text.replacen("grid_bricks: (16, 8, 16)", "grid_bricks: (2, 2, 2)", 1),
+            "beyond the",
+        ),
+        (
+            text.replacen("max_bounces: 3", "max_bounces: 0", 1),
+            "max bounces",
+        ),
+        (
+            text.replacen("kind: Metal, param: 8", "kind: Metal, param: 80", 1),
+            "parameter index",
+        ),
+        (
+            text.replacen("\"#56983a\"", "\"#zz983a\"", 1),
+            "not #rrggbb",
+        ),
+        (
+            text.replacen("encoding: \"vxb1-base64\"", "encoding: \"zstd\"", 1),
+            "unknown voxel encoding",
+        ),
+        (
+            text.replacen("solid_voxels: ", "solid_voxels: 1", 1),
+            "header says",
+        ),
+        (text.replacen("data: \"VlhC", "data: \"AAAA", 1), "VXB1"),
+        ("\u{0}\u{1}garbage".to_string(), "not a voxbrick project"),
+    ];
+    for (bad, want) in cases {
+        let err = project::from_bytes(bad.as_bytes(), p, 2)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(want), "expected {want:?} in: {err}");
+        assert!(
+            err.starts_with("test.ron: "),
+            "the error names the file: {err}"
+        );
+    }
+    // Dropping materials the voxels use is refused.
+    let start = text.find("materials: [").unwrap();
+    let end = text[start..].find(']').unwrap() + start;
+    let one = format!(
+        "{}materials: [(kind: Lambertian, param: 0, colour: 1)]{}",
+        &text[..start],
+        &text[end + 1..]
+    );
+    assert!(
+        project::from_bytes(one.as_bytes(), p, 2)
+            .unwrap_err()
+            .to_string()
+            .contains("beyond the table")
+    );
+}
+
+#[test]
+fn failed_save_keeps_the_previous_file() {
+    let scene = default_scene(SceneSize::Small, 2).unwrap();
+    let d = scratch("failsave");
+    let path = d.join("scene.ron");
+    std::fs::write(&path, "previous").unwrap();
+    // A directory in the way of the rename: the write succeeds, the rename fails.
+    let blocked = d.join("blocked.ron");
+    std::fs::create_dir(&blocked).unwrap();
+    std::fs::write(blocked.join("keep"), "x").unwrap();
+    assert!(scene.save(&blocked).is_err());
+    assert!(blocked.join("keep").exists());
+    assert!(scene.save(&d.join("missing/scene.ron")).is_err());
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "previous");
+    let leftovers: Vec<_> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(leftovers.len(), 2, "no temporary files left: {leftovers:?}");
+}
+
+#[test]
+fn every_sample_vox_imports_and_the_invalid_one_is_an_error() {
+    let mut imported = 0;
+    for entry in std::fs::read_dir(assets()).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("vox") {
+            continue;
+        }
+        let result = vox::import_file(&path, &vox::ImportOptions::default(), 2);
+        if path.file_name().unwrap() == "dotvox_not_a.vox" {
+            let err = result
+                .expect_err("the invalid sample is refused")
+                .to_string();
+            assert!(
+                err.contains("dotvox_not_a.vox") && err.contains("not a valid .vox"),
+                "{err}"
+            );
+            continue;
+        }
+        let (scene, report) = result.unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert!(report.voxels > 0, "{}", path.display());
+        assert_eq!(scene.world.read().solid_count(), report.voxels);
+        scene.world.read().validate().unwrap();
+        imported += 1;
+    }
+    assert_eq!(imported, 17);
+}
+
+#[test]
+fn multi_model_scene_graph_places_every_instance() {
+    let path = assets().join("ogt_test_multiple_model_scene.vox");
+    let (_, report) = vox::import_file(&path, &vox::ImportOptions::default(), 2).unwrap();
+    assert_eq!((report.models, report.instances), (41, 104));
+    assert!(
+        report.dropped.iter().any(|d| d.contains("rOBJ")),
+        "{:?}",
+        report.dropped
+    );
+    let with_hidden = vox::import_file(
+        &path,
+        &vox::ImportOptions {
+            include_hidden: true,
+            ..Default::default()
+        },
+        2,
+    )
+    .unwrap()
+    .1;
+    assert!(with_hidden.instances >= report.instances);
+}
+
+#[test]
+fn import_export_import_keeps_voxels_and_materials() {
+    for name in [
+        "mmmm_scene_park.vox",
+        "dotvox_metal-material.vox",
+        "mmmm_veh_tank1.vox",
+    ] {
+        let (first, _) =
+            vox::import_file(&assets().join(name), &vox::ImportOptions::default(), 2).unwrap();
+        let d = scratch(&format!("vox-{name}"));
+        let out = d.join("again.vox");
+        vox::export_file(&first, &out).unwrap();
+        let (second, _) = vox::import_file(&out, &vox::ImportOptions::default(), 2).unwrap();
+        assert_eq!(resolved(&first.world), resolved(&second.world), "{name}");
+    }
+}
+
+#[test]
+fn scene_beyond_256_in_every_axis_survives_vox() {
+    let scene = Scene::empty(GridDims::new(40, 36, 34).unwrap(), 2).unwrap(); // 320 × 288 × 272
+    let w = &scene.world;
+    let metal = w
+        .push_material(Material {
+            kind: MaterialKind::Metal,
+            param: 20,
+            colour: 40,
+        })
+        .unwrap();
+    w.set_param(MaterialKind::Dielectric, 5, 1.7).unwrap();
+    let glass = w
+        .push_material(Material {
+            kind: MaterialKind::Dielectric,
+            param: 5,
+            colour: 41,
+        })
+        .unwrap();
+    w.set_param(MaterialKind::Emissive, 3, 12.0).unwrap();
+    let lamp = w
+        .push_material(Material {
+            kind: MaterialKind::Emissive,
+            param: 3,
+            colour: 42,
+        })
+        .unwrap();
+    let corners: Vec<VoxelEdit> = [
+        IVec3::ZERO,
+        IVec3::new(319, 287, 271),
+        IVec3::new(319, 0, 0),
+        IVec3::new(0, 287, 0),
+        IVec3::new(0, 0, 271),
+        IVec3::new(255, 256, 257),
+    ]
+    .into_iter()
+    .zip([0, metal, glass, lamp, metal, glass])
+    .map(|(pos, m)| VoxelEdit {
+        pos,
+        op: VoxelOp::Set(m),
+    })
+    .collect();
+    w.apply(EditOp::Voxels(corners)).unwrap();
+    w.apply(EditOp::Shape {
+        shape: Shape::Sphere {
+            centre: DVec3::new(256.0, 256.0, 256.0),
+            radius: 12.0,
+        },
+        mode: Mode::Add(lamp),
+    })
+    .unwrap();
+    let d = scratch("big");
+    let out = d.join("big.vox");
+    let report = vox::export_file(&scene, &out).unwrap();
+    assert!(report.models >= 8, "split into ≤256³ models: {report:?}");
+    let (back, _) = vox::import_file(&out, &vox::ImportOptions::default(), 2).unwrap();
+    assert_eq!(back.world.dims(), scene.world.dims());
+    assert_eq!(resolved(&back.world), resolved(&scene.world));
+}
+
+#[test]
+fn rotated_and_translated_instances_land_where_magicavoxel_puts_them() {
+    use dot_vox::*;
+    // One 3×1×1 model (voxels at x = 0, 1, 2 with colours 1, 2, 3) placed twice: as is at
+    // t = (10, 0, 0), and rotated 90° about z (x → y) at t = (0, 10, 0).
+    let model = Model {
+        size: Size { x: 3, y: 1, z: 1 },
+        voxels: (0..3)
+            .map(|x| Voxel {
+                x,
+                y: 0,
+                z: 0,
+                i: x,
+            })
+            .collect(),
+    };
+    let frame = |t: &str, r: Option<&str>| {
+        let mut d = Dict::new();
+        d.insert("_t".into(), t.into());
+        if let Some(r) = r {
+            d.insert("_r".into(), r.into());
+        }
+        Frame::new(d)
+    };
+    // Row 0 = (0, -1, 0): bits 0-1 = 1, sign bit 4 set; row 1 = (1, 0, 0): bits 2-3 = 0.
+    let rot = (1 | (1 << 4)).to_string(); // row 0 → column 1, negative; row 1 → column 0
+    let scenes = vec![
+        SceneNode::Transform {
+            attributes: Dict::new(),
+            frames: vec![frame("0 0 0", None)],
+            child: 1,
+            layer_id: 0,
+        },
+        SceneNode::Group {
+            attributes: Dict::new(),
+            children: vec![2, 4],
+        },
+        SceneNode::Transform {
+            attributes: Dict::new(),
+            frames: vec![frame("10 0 0", None)],
+            child: 3,
+            layer_id: 0,
+        },
+        SceneNode::Shape {
+            attributes: Dict::new(),
+            models: vec![ShapeModel {
+                model_id: 0,
+                attributes: Dict::new(),
+            }],
+        },
+        SceneNode::Transform {
+            attributes: Dict::new(),
+            frames: vec![frame("0 10 0", Some(&rot))],
+            child: 5,
+            layer_id: 0,
+        },
+        SceneNode::Shape {
+            attributes: Dict::new(),
+            models: vec![ShapeModel {
+                model_id: 0,
+                attributes: Dict::new(),
+            }],
+        },
+    ];
+    let data = DotVoxData {
+        version: 150,
+        index_map: DEFAULT_INDEX_MAP.to_vec(),
+        models: vec![model],
+        palette: DEFAULT_PALETTE.to_vec(),
+        materials: vec![],
+        scenes,
+        layers: vec![Layer {
+            attributes: Dict::new(),
+        }],
+    };
+    let mut bytes = Vec::new();
+    data.write_vox(&mut bytes).unwrap();
+    let (scene, report) = vox::import_bytes(
+        &bytes,
+        Path::new("rot.vox"),
+        &vox::ImportOptions::default(),
+        1,
+    )
+    .unwrap();
+    assert_eq!(report.instances, 2);
+    // MagicaVoxel coordinates: unrotated voxel x lands at x − 1 + 10 (pivot ⌊3/2⌋ = 1);
+    // rotated (x → y): voxel x lands at (0, x − 1 + 10, 0)... in doubled form
+    // R·(2v + 1 − s) + 2t = (−0, 2x − 2 + 20, 0)/2 with s = (3,1,1).
+    let expected_vox = [
+        (IVec3::new(9, 0, 0), 0u8),
+        (IVec3::new(10, 0, 0), 1),
+        (IVec3::new(11, 0, 0), 2),
+        (IVec3::new(0, 9, 0), 0),
+        (IVec3::new(0, 10, 0), 1),
+        (IVec3::new(0, 11, 0), 2),
+    ];
+    // To voxbrick axes, then shifted so the minimum is 0 on every axis.
+    let ours: Vec<(IVec3, u8)> = expected_vox
+        .iter()
+        .map(|(v, i)| (IVec3::new(v.x, v.z, -v.y - 1), *i))
+        .collect();
+    let lo = ours.iter().fold(IVec3::MAX, |m, (p, _)| m.min(*p));
+    let view = scene.world.read();
+    let table = view.materials();
+    for (p, i) in ours {
+        let m = view
+            .voxel(p - lo)
+            .unwrap()
+            .unwrap_or_else(|| panic!("no voxel at {}", p - lo));
+        let c = DEFAULT_PALETTE[i as usize];
+        assert_eq!(table.colour(table.get(m).unwrap().colour), [c.r, c.g, c.b]);
+    }
+    assert_eq!(view.solid_count(), 6);
+}
+
+#[test]
+fn import_into_an_existing_world_merges_materials() {
+    let scene = default_scene(SceneSize::Small, 2).unwrap();
+    let before = scene.world.read().solid_count();
+    let materials = scene.world.materials().len();
+    let bytes = std::fs::read(assets().join("mmmm_chr_robot.vox")).unwrap();
+    let at = |x, y, z| vox::ImportOptions {
+        offset: IVec3::new(x, y, z),
+        ..Default::default()
+    };
+    let report = vox::import_into(&scene.world, &bytes, &at(10, 40, 10), None).unwrap();
+    assert!(report.voxels > 0 && report.dropped.is_empty(), "{report:?}");
+    assert!(scene.world.materials().len() > materials);
+    assert!(scene.world.read().solid_count() > before);
+    // Again elsewhere: identical materials and colours are reused, not duplicated.
+    let len = scene.world.materials().len();
+    vox::import_into(&scene.world, &bytes, &at(60, 40, 60), None).unwrap();
+    // Poking out of the top: the outside part is dropped and reported.
+    let clipped = vox::import_into(&scene.world, &bytes, &at(90, 60, 90), None).unwrap();
+    assert!(
+        clipped
+            .dropped
+            .iter()
+            .any(|d| d.contains("outside the grid")),
+        "{:?}",
+        clipped.dropped
+    );
+    assert_eq!(scene.world.materials().len(), len);
+}
