@@ -63,7 +63,7 @@ mod tests {
         let d = scratch("ok");
         let p = d.join("scene.ron");
         fs::write(&p, b"old").unwrap();
-        write_atomic(&p, &mut |w: &mut dyn Write| w.write_all(b"new")).unwrap();
+        write_atomic(&p, |w: &mut dyn Write| w.write_all(b"new")).unwrap();
         assert_eq!(fs::read(&p).unwrap(), b"new");
         assert_eq!(fs::read_dir(&d).unwrap().count(), 1);
     }
@@ -73,7 +73,7 @@ mod tests {
         let d = scratch("fail");
         let p = d.join("scene.ron");
         fs::write(&p, b"precious").unwrap();
-        let err = write_atomic(&p, &mut |w: &mut dyn Write| {
+        let err = write_atomic(&p, |w: &mut dyn Write| {
             w.write_all(&[7; 100_000])?;
             Err(io::Error::other("disk full (simulated)"))
         })
@@ -91,7 +91,7 @@ mod tests {
     fn missing_folder_is_an_error() {
         let d = scratch("missing");
         let p = d.join("no/such/folder/scene.ron");
-        assert!(write_atomic(&p, &mut |w: &mut dyn Write| w.write_all(b"x")).is_err());
+        assert!(write_atomic(&p, |w: &mut dyn Write| w.write_all(b"x")).is_err());
     }
 
     #[test]
@@ -99,6 +99,6 @@ mod tests {
         // /dev/full answers every write with ENOSPC, but it is not a folder we can put a
         // temporary file in; what matters is the error, not a panic.
         let p = Path::new("/dev/full/scene.ron");
-        assert!(write_atomic(p, &mut |w: &mut dyn Write| w.write_all(b"x")).is_err());
+        assert!(write_atomic(p, |w: &mut dyn Write| w.write_all(b"x")).is_err());
     }
 }
