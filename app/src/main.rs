@@ -123,7 +123,21 @@ fn parse_size(s: &str) -> Result<IVec3, String> {
 }
 
 fn main() -> std::process::ExitCode {
-    match run(Cli::parse()) {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // Help and version go to stdout as clap prints them.
+        Err(e) if !e.use_stderr() => e.exit(),
+        Err(e) => {
+            let text = e.to_string();
+            let first = text.lines().next().unwrap_or("invalid arguments");
+            eprintln!(
+                "voxbrick: {} (see voxbrick --help)",
+                first.trim_start_matches("error: ")
+            );
+            return std::process::ExitCode::from(2);
+        }
+    };
+    match run(cli) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("voxbrick: {e:#}");

@@ -1,5 +1,7 @@
-//! The `voxbrick` binary end to end: the main job's statistics, and clear errors.
+//! The `voxbrick` binary end to end: the main job's statistics, conversions, new terrain,
+//! info, and one-line errors that leave files alone.
 
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn voxbrick(args: &[&str]) -> std::process::Output {
@@ -9,21 +11,44 @@ fn voxbrick(args: &[&str]) -> std::process::Output {
         .expect("voxbrick runs")
 }
 
+fn ok(args: &[&str]) -> String {
+    let out = voxbrick(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+fn fails(args: &[&str]) -> String {
+    let out = voxbrick(args);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    err
+}
+
 fn field<'a>(out: &'a str, name: &str) -> &'a str {
     out.lines()
         .find(|l| l.starts_with(name))
         .unwrap_or_else(|| panic!("no {name} in:\n{out}"))
 }
 
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("voxbrick-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
 #[test]
 fn stats_reports_the_default_scene() {
-    let out = voxbrick(&["stats", "--size", "small", "--workers", "2"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = ok(&["stats", "--size", "small", "--workers", "2"]);
     assert!(field(&text, "scene").contains("128 x 64 x 128 voxels"));
     let solid: u64 = field(&text, "solid")
         .split_whitespace()
@@ -35,26 +60,102 @@ fn stats_reports_the_default_scene() {
         solid > 128 * 128 * 16,
         "terrain is solid underground: {solid}"
     );
-    assert!(field(&text, "materials").contains("7 in the table"));
+    assert!(
+        field(&text, "materials")
+            .contains("7 in the table (4 lambertian, 1 metal, 1 dielectric, 1 emissive)")
+    );
     assert!(field(&text, "pick").contains("normal [0, 1, 0]"), "{text}");
     // The same scene with another worker count has the same content.
-    let other = voxbrick(&["stats", "--size", "small", "--workers", "1"]);
-    let other = String::from_utf8(other.stdout).unwrap();
+    let other = ok(&["stats", "--size", "small", "--workers", "1"]);
     assert_eq!(field(&text, "content hash"), field(&other, "content hash"));
 }
 
 #[test]
-fn bad_arguments_are_one_clear_error() {
-    let out = voxbrick(&["stats", "--size", "huge"]);
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("invalid value 'huge'"), "{err}");
-    let out = voxbrick(&["stats", "--workers", "5000"]);
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.starts_with("voxbrick: ") && err.contains("5000 workers"),
-        "{err}"
+fn new_terrain_is_deterministic_and_converts_both_ways() {
+    let d = scratch("terrain");
+    let (a, b) = (d.join("a.ron"), d.join("b.ron"));
+    let args = |p: &Path| {
+        vec![
+            "new",
+            "--terrain",
+            "--size",
+            "96x48x64",
+            "--seed",
+            "9",
+            "--water-level",
+            "14",
+            "--workers",
+            "2",
+            s(p),
+        ]
+        .into_iter()
+        .map(String::from)
+        .collect::<Vec<_>>()
+    };
+    ok(&args(&a).iter().map(String::as_str).collect::<Vec<_>>());
+    let mut other = args(&b);
+    other[9] = "1".into(); // another worker count
+    ok(&other.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(
+        std::fs::read(&a).unwrap(),
+        std::fs::read(&b).unwrap(),
+        "same parameters, same file, byte for byte"
     );
-    assert_eq!(err.lines().count(), 1, "{err}");
+    let info = ok(&["info", s(&a)]);
+    assert!(field(&info, "scene").contains("96 x 48 x 64 voxels"));
+    assert!(
+        field(&info, "materials").contains("1 dielectric"),
+        "water: {info}"
+    );
+    // ron → vox → ron keeps the voxels (the grid is re-fitted to the content on import).
+    let v = d.join("a.vox");
+    ok(&["convert", s(&a), s(&v)]);
+    let back = d.join("back.ron");
+    ok(&["convert", s(&v), s(&back)]);
+    let again = ok(&["info", s(&back)]);
+    assert_eq!(field(&info, "solid"), field(&again, "solid"));
+}
+
+#[test]
+fn errors_are_one_clear_line_and_touch_nothing() {
+    let d = scratch("errors");
+    let target = d.join("keep.ron");
+    std::fs::write(&target, "precious").unwrap();
+    let err = fails(&["convert", "/no/such/file.vox", s(&target)]);
+    assert!(err.contains("/no/such/file.vox"), "{err}");
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "precious");
+    let bad = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/vox/dotvox_not_a.vox");
+    let err = fails(&["convert", s(&bad), s(&target)]);
+    assert!(err.contains("not a valid .vox"), "{err}");
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "precious");
+    assert!(fails(&["info", s(&d.join("scene.txt"))]).contains("expected .ron or .vox"));
+    assert!(fails(&["new", s(&d.join("x.ron"))]).contains("--terrain"));
+    assert!(fails(&["new", "--terrain", "--size", "8x8", s(&d.join("x.ron"))]).contains("WxHxD"));
+    assert!(
+        fails(&[
+            "new",
+            "--terrain",
+            "--size",
+            "8000x8x8",
+            s(&d.join("x.ron"))
+        ])
+        .contains("grid")
+    );
+    assert!(
+        fails(&[
+            "new",
+            "--terrain",
+            "--size",
+            "64x32x64",
+            "--height-min",
+            "30",
+            "--height-max",
+            "20",
+            s(&d.join("x.ron"))
+        ])
+        .contains("height range")
+    );
+    assert!(fails(&["stats", "--size", "huge"]).contains("invalid value 'huge'"));
+    assert!(fails(&["stats", "--workers", "5000"]).contains("5000 workers"));
+    assert!(!d.join("x.ron").exists());
 }

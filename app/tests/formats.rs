@@ -465,3 +465,79 @@ fn import_into_an_existing_world_merges_materials() {
     );
     assert_eq!(scene.world.materials().len(), len);
 }
+
+#[test]
+fn matl_materials_map_to_voxbrick_materials() {
+    use dot_vox::*;
+    let matl = |id: u32, props: &[(&str, &str)]| Material {
+        id,
+        properties: props
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect(),
+    };
+    let data = DotVoxData {
+        version: 150,
+        index_map: DEFAULT_INDEX_MAP.to_vec(),
+        models: vec![Model {
+            size: Size { x: 7, y: 1, z: 1 },
+            voxels: (0..7)
+                .map(|x| Voxel {
+                    x,
+                    y: 0,
+                    z: 0,
+                    i: x,
+                })
+                .collect(),
+        }],
+        palette: DEFAULT_PALETTE.to_vec(),
+        // MATL ids are the file's palette indices: voxel i uses MATL i + 1.
+        materials: vec![
+            matl(1, &[("_type", "_diffuse")]),
+            matl(
+                2,
+                &[("_type", "_metal"), ("_rough", "0.5"), ("_metal", "1")],
+            ),
+            matl(3, &[("_type", "_glass"), ("_ior", "0.3")]),
+            matl(4, &[("_type", "_glass"), ("_ri", "1.7"), ("_ior", "0.9")]),
+            matl(5, &[("_type", "_emit"), ("_emit", "0.5"), ("_flux", "2")]),
+            matl(6, &[("_type", "_cloud")]),
+        ],
+        scenes: vec![],
+        layers: vec![],
+    };
+    let mut bytes = Vec::new();
+    data.write_vox(&mut bytes).unwrap();
+    let (scene, report) = vox::import_bytes(
+        &bytes,
+        Path::new("matl.vox"),
+        &vox::ImportOptions::default(),
+        1,
+    )
+    .unwrap();
+    let view = scene.world.read();
+    let table = view.materials();
+    let at = |x: i32| {
+        let m = table
+            .get(view.voxel(IVec3::new(x, 0, 0)).unwrap().unwrap())
+            .unwrap();
+        (m.kind, table.param(m.kind, m.param).unwrap())
+    };
+    assert_eq!(at(0).0, MaterialKind::Lambertian);
+    assert_eq!(at(1), (MaterialKind::Metal, 32.0 / 63.0));
+    assert_eq!(at(2).0, MaterialKind::Dielectric);
+    assert!(
+        (at(2).1 - 1.3).abs() < 1e-6,
+        "ior − 1 convention: {}",
+        at(2).1
+    );
+    assert!((at(3).1 - 1.7).abs() < 1e-6, "_ri wins: {}", at(3).1);
+    assert_eq!(at(4), (MaterialKind::Emissive, 2.0));
+    assert_eq!(at(5).0, MaterialKind::Lambertian);
+    assert_eq!(at(6).0, MaterialKind::Lambertian, "no MATL: diffuse");
+    assert!(
+        report.dropped.iter().any(|d| d.contains("_cloud")),
+        "{:?}",
+        report.dropped
+    );
+}

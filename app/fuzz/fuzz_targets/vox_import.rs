@@ -1,0 +1,13 @@
+//! Any bytes given to the .vox importer: an error or a scene, never a panic or a hang.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    let options = app::formats::vox::ImportOptions::default();
+    if let Ok((scene, report)) = app::formats::vox::import_bytes(data, std::path::Path::new("fuzz.vox"), &options, 1) {
+        let view = scene.world.read();
+        view.validate().expect("imported world keeps its invariants");
+        assert_eq!(view.solid_count(), report.voxels);
+    }
+});
