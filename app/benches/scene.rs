@@ -46,7 +46,8 @@ fn save_project(bencher: Bencher) {
 #[divan::bench(sample_count = 20, sample_size = 1)]
 fn load_project(bencher: Bencher) {
     let text = project::to_string(&thesis_scene(0).unwrap());
-    bencher.bench_local(|| project::from_bytes(text.as_bytes(), Path::new("thesis.ron"), 0).unwrap());
+    bencher
+        .bench_local(|| project::from_bytes(text.as_bytes(), Path::new("thesis.ron"), 0).unwrap());
 }
 
 #[divan::bench(sample_count = 10, sample_size = 1)]
@@ -64,6 +65,17 @@ fn export_vox(bencher: Bencher) {
 fn import_vox(bencher: Bencher) {
     let scene = thesis_scene(0).unwrap();
     let mut bytes = Vec::new();
-    vox::export_data(&scene.world).unwrap().write_vox(&mut bytes).unwrap();
-    bencher.bench_local(|| vox::import_bytes(&bytes, Path::new("thesis.vox"), &vox::ImportOptions::default(), 0).unwrap());
+    vox::export_data(&scene.world)
+        .unwrap()
+        .write_vox(&mut bytes)
+        .unwrap();
+    bencher.bench_local(|| {
+        vox::import_bytes(
+            &bytes,
+            Path::new("thesis.vox"),
+            &vox::ImportOptions::default(),
+            0,
+        )
+        .unwrap()
+    });
 }

@@ -34,7 +34,7 @@ pub use edit::{
 pub use error::{BrickmapError, Result};
 pub use grid::GridDims;
 pub use material::{Material, MaterialKind, MaterialTable};
-pub use raycast::{Occupancy, Ray, RayHit};
+pub use raycast::{Occupancy, Ray, RayHit, cast, cast_from_cell};
 pub use shape::Shape;
 pub use storage::BucketSizes;
 pub use world::{BrickMaterials, DirtySet, GpuBuffer, MemoryStats, World, WorldConfig, WorldView};

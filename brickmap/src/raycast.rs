@@ -123,6 +123,24 @@ pub fn cast(grid: &impl Occupancy, ray: &Ray, t_max: f64) -> Result<Option<RayHi
         }))
 }
 
+/// Casts a ray that leaves a surface from a known cell: `cell` is the voxel the ray starts
+/// in (for a reflection, the empty cell in front of the face; for a refraction, the voxel
+/// behind it), `ray.origin` the point on the face. Because the start cell is given, no epsilon
+/// offset is needed at any coordinate. The start cell itself is tested first (a hit there has
+/// t = 0). Origins must lie within the grid's box (surface points do).
+pub fn cast_from_cell(
+    grid: &impl Occupancy,
+    ray: &Ray,
+    cell: IVec3,
+    t_max: f64,
+) -> Result<Option<RayHit>> {
+    ray.validate()?;
+    if t_max.is_nan() {
+        return Err(BrickmapError::InvalidRay("t_max is NaN"));
+    }
+    Ok(Dda::at_cell(ray, &grid.dims(), cell).and_then(|mut dda| dda.run(grid, t_max)))
+}
+
 struct Dda<'r> {
     ray: &'r Ray,
     size: [i64; 3],
@@ -184,6 +202,44 @@ impl<'r> Dda<'r> {
                 0 => continue,
                 1 => ray.plane_time(i, dda.cell[i] as f64),
                 _ => ray.plane_time(i, (dda.cell[i] + 1) as f64),
+            };
+            if e > latest {
+                latest = e;
+                dda.normal_axis = i;
+            }
+        }
+        Some(dda)
+    }
+
+    fn at_cell(ray: &'r Ray, dims: &GridDims, cell: IVec3) -> Option<Self> {
+        let size = dims.voxels().as_i64vec3().to_array();
+        let sign = std::array::from_fn(|i| {
+            let d = ray.dir[i];
+            if d > 0.0 {
+                1
+            } else if d < 0.0 {
+                -1
+            } else {
+                0
+            }
+        });
+        let normal_axis = (0..3).find(|&i| sign[i] != 0)?;
+        let cell = cell.as_i64vec3().to_array();
+        let mut dda = Dda {
+            ray,
+            size,
+            sign,
+            cell,
+            t: 0.0,
+            normal_axis,
+        };
+        // The face behind the origin: the axis whose entry plane was crossed last.
+        let mut latest = f64::NEG_INFINITY;
+        for i in 0..3 {
+            let e = match sign[i] {
+                0 => continue,
+                1 => ray.plane_time(i, cell[i] as f64),
+                _ => ray.plane_time(i, (cell[i] + 1) as f64),
             };
             if e > latest {
                 latest = e;

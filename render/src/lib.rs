@@ -1,6 +1,9 @@
-//! The renderer: Vulkan compute path tracer over the brickmap and the CPU reference renderer
-//! (their issue), and the scene parameters both consume.
+//! The renderer: the scene parameters, the CPU reference path tracer (`cpu`) and images;
+//! the Vulkan compute path tracer arrives with the rest of its issue.
 
+pub mod cpu;
+pub mod image;
 pub mod params;
 
+pub use image::Image;
 pub use params::{Camera, ParamError, RenderSettings, SceneParams, Sky, Sun};
