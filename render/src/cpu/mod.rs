@@ -55,7 +55,10 @@ impl SunDisc {
             return None; // parallel, or seeing the back (one-sided)
         }
         let t = (self.centre - o).dot(self.normal) / denom;
-        if !(t > 0.0) || (o + d * t - self.centre).length_squared() > self.radius * self.radius {
+        if t.is_nan()
+            || t <= 0.0
+            || (o + d * t - self.centre).length_squared() > self.radius * self.radius
+        {
             return None;
         }
         Some((t, -denom))
