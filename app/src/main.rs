@@ -83,6 +83,39 @@ enum Command {
         /// Output file (.ron or .vox).
         output: PathBuf,
     },
+    /// Render a scene offscreen to an image.
+    Render {
+        /// A .ron or .vox file (a .vox gets the default camera, sun and sky).
+        scene: PathBuf,
+        /// Output image (.png).
+        #[arg(long)]
+        out: PathBuf,
+        /// Also write the linear image as PFM (for error measurement).
+        #[arg(long)]
+        hdr: Option<PathBuf>,
+        /// Samples per pixel.
+        #[arg(long, default_value_t = 16)]
+        spp: u32,
+        /// Max bounces (default: the scene's setting).
+        #[arg(long)]
+        bounces: Option<u32>,
+        /// Image width.
+        #[arg(long, default_value_t = 512)]
+        width: u32,
+        /// Image height.
+        #[arg(long, default_value_t = 288)]
+        height: u32,
+        /// Camera as EYE_X,EYE_Y,EZE_Z:TARGET_X,TARGET_Y,TARGET_Z (default: the scene's; for
+        /// .vox, framing the whole scene).
+        #[arg(long)]
+        camera: Option<String>,
+        /// gpu (the Vulkan renderer), cpu (the reference path tracer), or a device name.
+        #[arg(long, default_value = "gpu")]
+        device: String,
+        /// Random seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
     /// Print a scene file's dimensions, voxel count, materials and memory.
     Info {
         /// A .ron or .vox file.
@@ -262,6 +295,30 @@ fn run(cli: Cli) -> Result<()> {
             );
             Ok(())
         }
+        Command::Render {
+            scene,
+            out,
+            hdr,
+            spp,
+            bounces,
+            width,
+            height,
+            camera,
+            device,
+            seed,
+        } => render_command(RenderArgs {
+            scene,
+            out,
+            hdr,
+            spp,
+            bounces,
+            width,
+            height,
+            camera,
+            device,
+            seed,
+            workers,
+        }),
         Command::Info { file } => {
             let started = Instant::now();
             let scene = with_progress(format!("reading {}", file.display()), || {
@@ -377,4 +434,96 @@ fn stats_text(world: &World, seconds: f64) -> String {
     });
     lines.push(format!("content hash {:016x}", view.content_hash()));
     lines.join("\n") + "\n"
+}
+
+struct RenderArgs {
+    scene: PathBuf,
+    out: PathBuf,
+    hdr: Option<PathBuf>,
+    spp: u32,
+    bounces: Option<u32>,
+    width: u32,
+    height: u32,
+    camera: Option<String>,
+    device: String,
+    seed: u64,
+    workers: usize,
+}
+
+fn render_command(a: RenderArgs) -> Result<()> {
+    if a.device != "cpu" {
+        bail!(
+            "device {:?}: the Vulkan renderer is not built yet; the CPU reference renderer runs with --device cpu",
+            a.device
+        );
+    }
+    if a.spp == 0 || a.width == 0 || a.height == 0 || a.width > 16384 || a.height > 16384 {
+        bail!("--spp, --width and --height must be positive (sizes at most 16384)");
+    }
+    let scene = with_progress(format!("reading {}", a.scene.display()), || {
+        Ok(Scene::load(&a.scene, a.workers)?)
+    })?;
+    let mut params = scene.params.clone();
+    if let Some(spec) = &a.camera {
+        let (eye, target) = spec
+            .split_once(':')
+            .context("--camera wants EYE:TARGET, each X,Y,Z")?;
+        let eye = parse_ivec3_f(eye)?;
+        let target = parse_ivec3_f(target)?;
+        params.camera = render::Camera::looking_at(eye, target, params.camera.fov_y_deg);
+        params.camera.validate()?;
+    }
+    if let Some(b) = a.bounces {
+        if !(1..=64).contains(&b) {
+            bail!("--bounces {b} is outside 1..=64");
+        }
+        params.settings.max_bounces = b;
+    }
+    let view = scene.world.read();
+    let cpu = render::cpu::CpuScene::new(&view, &params);
+    let job = render::cpu::RenderJob {
+        width: a.width,
+        height: a.height,
+        spp: a.spp,
+        seed: a.seed,
+    };
+    let started = Instant::now();
+    let image = with_progress(
+        format!(
+            "rendering {}x{} at {} spp on the CPU",
+            a.width, a.height, a.spp
+        ),
+        || Ok(cpu.render(&job)),
+    )?;
+    let seconds = started.elapsed().as_secs_f64();
+    let write = |path: &PathBuf, f: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
+        app::atomic::write_atomic(path, f).with_context(|| format!("writing {}", path.display()))
+    };
+    write(&a.out, &|w| image.write_png(w, params.settings.exposure))?;
+    if let Some(hdr) = &a.hdr {
+        write(hdr, &|w| image.write_pfm(w))?;
+    }
+    let samples = a.width as u64 * a.height as u64 * a.spp as u64;
+    emit(&format!(
+        "rendered     {samples} samples ({}x{} at {} spp, {} bounces) on the CPU in {seconds:.2} s\nrays         {} ({:.2} Mrays/s)\nwrote        {}\n",
+        a.width,
+        a.height,
+        a.spp,
+        params.settings.max_bounces,
+        cpu.rays_traced(),
+        cpu.rays_traced() as f64 / seconds / 1e6,
+        a.out.display()
+    ))
+}
+
+fn parse_ivec3_f(s: &str) -> Result<DVec3> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("{s:?} is not X,Y,Z"))?;
+    match v[..] {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(DVec3::new(x, y, z)),
+        _ => bail!("{s:?} is not three finite numbers X,Y,Z"),
+    }
 }

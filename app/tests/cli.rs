@@ -159,3 +159,50 @@ fn errors_are_one_clear_line_and_touch_nothing() {
     assert!(fails(&["stats", "--workers", "5000"]).contains("5000 workers"));
     assert!(!d.join("x.ron").exists());
 }
+
+#[test]
+fn render_on_the_cpu_writes_png_and_pfm() {
+    let d = scratch("render");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/vox/mmmm_chr_robot.vox");
+    let (png, pfm) = (d.join("robot.png"), d.join("robot.pfm"));
+    let text = ok(&[
+        "render",
+        s(&scene),
+        "--out",
+        s(&png),
+        "--hdr",
+        s(&pfm),
+        "--device",
+        "cpu",
+        "--spp",
+        "2",
+        "--width",
+        "40",
+        "--height",
+        "30",
+    ]);
+    assert!(field(&text, "rendered").contains("2400 samples"), "{text}");
+    assert!(field(&text, "rays").contains("Mrays/s"));
+    let png_bytes = std::fs::read(&png).unwrap();
+    assert!(png_bytes.starts_with(b"\x89PNG"));
+    let pfm_bytes = std::fs::read(&pfm).unwrap();
+    assert!(pfm_bytes.starts_with(b"PF\n40 30\n"));
+    assert_eq!(pfm_bytes.len(), b"PF\n40 30\n-1.0\n".len() + 40 * 30 * 12);
+    // The GPU renderer does not exist yet: a clear error, not a silent fallback.
+    let err = fails(&["render", s(&scene), "--out", s(&d.join("x.png"))]);
+    assert!(err.contains("--device cpu"), "{err}");
+    assert!(!d.join("x.png").exists());
+    assert!(
+        fails(&[
+            "render",
+            s(&scene),
+            "--out",
+            s(&png),
+            "--device",
+            "cpu",
+            "--camera",
+            "1,2:3"
+        ])
+        .contains("X,Y,Z")
+    );
+}

@@ -28,6 +28,19 @@ impl Image {
         Ok(())
     }
 
+    /// Writes an 8-bit sRGB PNG after exposure and tone mapping.
+    pub fn write_png(&self, out: &mut dyn Write, exposure: f32) -> std::io::Result<()> {
+        let mut encoder = png::Encoder::new(out, self.width, self.height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
+        let bytes: Vec<u8> = self.to_srgb8(exposure).into_iter().flatten().collect();
+        writer
+            .write_image_data(&bytes)
+            .map_err(std::io::Error::other)?;
+        writer.finish().map_err(std::io::Error::other)
+    }
+
     /// Mean of every channel of every pixel.
     pub fn mean(&self) -> [f64; 3] {
         let n = self.pixels.len().max(1) as f64;
@@ -102,6 +115,25 @@ mod tests {
         }
         assert_eq!(encode_srgb(0.0), 0);
         assert_eq!(encode_srgb(1.0), 255);
+    }
+
+    #[test]
+    fn png_decodes_back_to_the_tone_mapped_pixels() {
+        let img = Image {
+            width: 4,
+            height: 3,
+            pixels: (0..12).map(|i| [i as f32 * 0.1, 0.5, 2.0]).collect(),
+        };
+        let mut out = Vec::new();
+        img.write_png(&mut out, 0.0).unwrap();
+        let mut reader = png::Decoder::new(std::io::Cursor::new(out))
+            .read_info()
+            .unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert_eq!((info.width, info.height), (4, 3));
+        let want: Vec<u8> = img.to_srgb8(0.0).into_iter().flatten().collect();
+        assert_eq!(&buf[..info.buffer_size()], &want[..]);
     }
 
     #[test]

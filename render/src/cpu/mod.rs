@@ -125,6 +125,7 @@ pub struct CpuScene<'a, 'w> {
     sky: Sky,
     max_bounces: u32,
     camera: crate::params::Camera,
+    rays: std::sync::atomic::AtomicU64,
 }
 
 impl<'a, 'w> CpuScene<'a, 'w> {
@@ -169,7 +170,17 @@ impl<'a, 'w> CpuScene<'a, 'w> {
             sky: params.sky.clone(),
             max_bounces: params.settings.max_bounces,
             camera: params.camera.clone(),
+            rays: std::sync::atomic::AtomicU64::new(0),
         }
+    }
+
+    fn count_ray(&self) {
+        self.rays.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// Rays traced so far (camera, continuation and shadow rays).
+    pub fn rays_traced(&self) -> u64 {
+        self.rays.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// Overrides the bounce count B.
@@ -199,6 +210,7 @@ impl<'a, 'w> CpuScene<'a, 'w> {
 
     /// The first interaction along a ray in a medium (`None`: air).
     fn trace(&self, o: DVec3, d: DVec3, start: Start, medium: Option<u8>) -> Option<RayHit> {
+        self.count_ray();
         let ray = Ray { origin: o, dir: d };
         let inf = f64::INFINITY;
         let hit = match (medium, start) {
@@ -228,6 +240,7 @@ impl<'a, 'w> CpuScene<'a, 'w> {
     /// Whether any voxel lies on the segment from a surface (leaving from `cell`) to a point
     /// at distance `dist` (dielectrics block shadow rays too).
     fn occluded(&self, o: DVec3, d: DVec3, cell: IVec3, dist: f64) -> bool {
+        self.count_ray();
         brickmap::cast_from_cell(self.view, &Ray { origin: o, dir: d }, cell, dist)
             .ok()
             .flatten()
