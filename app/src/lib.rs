@@ -2,6 +2,7 @@
 //! the `voxbrick` binary (and later the editor) use.
 
 pub mod atomic;
+pub mod editor;
 pub mod formats;
 pub mod scene;
 

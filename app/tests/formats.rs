@@ -446,7 +446,7 @@ fn import_into_an_existing_world_merges_materials() {
         offset: IVec3::new(x, y, z),
         ..Default::default()
     };
-    let report = vox::import_into(&scene.world, &bytes, &at(10, 40, 10), None).unwrap();
+    let (report, _) = vox::import_into(&scene.world, &bytes, &at(10, 40, 10), None).unwrap();
     assert!(report.voxels > 0 && report.dropped.is_empty(), "{report:?}");
     assert!(scene.world.materials().len() > materials);
     assert!(scene.world.read().solid_count() > before);
@@ -454,7 +454,7 @@ fn import_into_an_existing_world_merges_materials() {
     let len = scene.world.materials().len();
     vox::import_into(&scene.world, &bytes, &at(60, 40, 60), None).unwrap();
     // Poking out of the top: the outside part is dropped and reported.
-    let clipped = vox::import_into(&scene.world, &bytes, &at(90, 60, 90), None).unwrap();
+    let (clipped, _) = vox::import_into(&scene.world, &bytes, &at(90, 60, 90), None).unwrap();
     assert!(
         clipped
             .dropped

@@ -121,13 +121,14 @@ pub fn import_bytes(
 /// Imports `.vox` bytes into an existing world. With `material`, every voxel gets that
 /// material; otherwise colours are merged into the colour table (an identical colour is
 /// reused, else a slot no material uses) and identical materials are reused. Voxels that
-/// land outside the grid are dropped and reported. One edit: on error nothing changes.
+/// land outside the grid are dropped and reported. One voxel edit, whose inverse is returned
+/// (the editor's undo); colours and materials it added stay.
 pub fn import_into(
     world: &World,
     bytes: &[u8],
     options: &ImportOptions,
     material: Option<u8>,
-) -> Result<ImportReport, String> {
+) -> Result<(ImportReport, brickmap::EditInverse), String> {
     let (data, mut placed, mut report) = prepare(bytes, options)?;
     let dims = world.dims();
     let before = placed.len();
@@ -154,8 +155,9 @@ pub fn import_into(
             })?
         }
     };
-    write_voxels(world, &placed, |i| map[i as usize], &mut report).map_err(|e| e.to_string())?;
-    Ok(report)
+    let inverse = write_voxels(world, &placed, |i| map[i as usize], &mut report)
+        .map_err(|e| e.to_string())?;
+    Ok((report, inverse))
 }
 
 /// The size in voxels (voxbrick axes) of what importing `bytes` would place.
@@ -199,7 +201,7 @@ fn write_voxels(
     placed: &[(IVec3, u8)],
     material: impl Fn(u8) -> u8,
     report: &mut ImportReport,
-) -> brickmap::Result<()> {
+) -> brickmap::Result<brickmap::EditInverse> {
     let mut bricks: HashMap<glam::UVec3, (Mask, Box<[u8; 512]>)> = HashMap::new();
     for &(p, i) in placed {
         let b = (p / 8).as_uvec3();
@@ -230,10 +232,11 @@ fn write_voxels(
         })
         .collect();
     list.sort_by_key(|u| (u.brick.x, u.brick.z, u.brick.y));
-    world.apply(brickmap::EditOp::Restore(brickmap::EditInverse {
-        bricks: list,
-    }))?;
-    Ok(())
+    Ok(world
+        .apply(brickmap::EditOp::Restore(brickmap::EditInverse {
+            bricks: list,
+        }))?
+        .inverse)
 }
 
 fn palette_of(data: &DotVoxData) -> Vec<Color> {

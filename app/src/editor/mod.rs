@@ -1,0 +1,81 @@
+//! The editor's engine, without a window: a document (scene, file, dirty flag, history) and
+//! the commands that change it. The interactive editor and script replay drive it alike.
+
+pub mod command;
+pub mod history;
+
+use crate::scene::Scene;
+use anyhow::{Result, bail};
+use command::Command;
+use history::History;
+use std::path::{Path, PathBuf};
+
+/// An open scene and everything about it the editor tracks.
+#[derive(Debug)]
+pub struct Document {
+    /// The scene.
+    pub scene: Scene,
+    /// Where it was loaded from or last saved to.
+    pub path: Option<PathBuf>,
+    /// Changed since it was loaded or saved.
+    pub dirty: bool,
+    /// Undo and redo.
+    pub history: History,
+    /// Folder that relative paths in commands (imports) are resolved against.
+    pub folder: PathBuf,
+}
+
+impl Document {
+    /// A document for a scene.
+    pub fn new(scene: Scene, history: History) -> Self {
+        Self {
+            scene,
+            path: None,
+            dirty: false,
+            history,
+            folder: PathBuf::from("."),
+        }
+    }
+
+    /// Executes a command and records it; on error nothing changed (world, tables, history).
+    /// Returns how many old history steps were dropped to stay within the budget.
+    pub fn execute(&mut self, command: Command) -> Result<u64> {
+        let inverse = command.apply(&mut self.scene, &self.folder)?;
+        self.dirty = true;
+        Ok(self.history.push(command, inverse))
+    }
+
+    /// Undoes the latest step; the label of what was undone.
+    pub fn undo(&mut self) -> Result<String> {
+        let Some(step) = self.history.take_undo() else {
+            bail!("nothing to undo")
+        };
+        let (label, command, inverse) = step.into_parts();
+        let redo = inverse.apply(&mut self.scene)?;
+        self.history.push_redo(label.clone(), command, redo);
+        self.dirty = true;
+        Ok(label)
+    }
+
+    /// Redoes the latest undone step; its label.
+    pub fn redo(&mut self) -> Result<String> {
+        let Some(step) = self.history.take_redo() else {
+            bail!("nothing to redo")
+        };
+        let (label, command, inverse) = step.into_parts();
+        let undo = inverse.apply(&mut self.scene)?;
+        self.history.push_undone(label.clone(), command, undo);
+        self.dirty = true;
+        Ok(label)
+    }
+
+    /// Saves (project or .vox by extension) atomically; a project save clears the dirty flag.
+    pub fn save(&mut self, path: &Path) -> Result<()> {
+        self.scene.save(path)?;
+        if crate::formats::Format::of(path)? == crate::formats::Format::Project {
+            self.path = Some(path.to_path_buf());
+            self.dirty = false;
+        }
+        Ok(())
+    }
+}
