@@ -116,6 +116,24 @@ enum Command {
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
+    /// Replay an edit script headlessly, reporting each step; exits non-zero at the first
+    /// failed step.
+    Replay {
+        /// The script (.ron).
+        script: PathBuf,
+        /// Save the final scene here (.ron or .vox).
+        #[arg(long)]
+        save: Option<PathBuf>,
+        /// Render the final scene to this PNG (CPU: needs --device cpu).
+        #[arg(long)]
+        render: Option<PathBuf>,
+        /// Where the script's outputs go (default: next to the script).
+        #[arg(long)]
+        out_dir: Option<PathBuf>,
+        /// Render device for render steps: gpu or cpu.
+        #[arg(long, default_value = "gpu")]
+        device: String,
+    },
     /// Print a scene file's dimensions, voxel count, materials and memory.
     Info {
         /// A .ron or .vox file.
@@ -319,6 +337,56 @@ fn run(cli: Cli) -> Result<()> {
             seed,
             workers,
         }),
+        Command::Replay {
+            script,
+            save,
+            render,
+            out_dir,
+            device,
+        } => {
+            let options = app::editor::script::ReplayOptions {
+                workers: (workers > 0).then_some(workers),
+                out_dir,
+                device: device.clone(),
+                history_budget: None,
+            };
+            let started = Instant::now();
+            let mut lines = Vec::new();
+            let result = app::editor::script::replay_file(&script, &options, &mut |l| {
+                let _ = emit(&format!("{l}\n"));
+                lines.push(l.to_string());
+            });
+            let replayed = result?;
+            let doc = &replayed.document;
+            if let Some(path) = &save {
+                doc.scene.save(path)?;
+            }
+            if let Some(path) = &render {
+                if device != "cpu" {
+                    bail!(
+                        "--render: the Vulkan renderer is not built yet; replay with --device cpu"
+                    );
+                }
+                let view = doc.scene.world.read();
+                let image = render::cpu::CpuScene::new(&view, &doc.scene.params).render(
+                    &render::cpu::RenderJob {
+                        width: 512,
+                        height: 288,
+                        spp: 16,
+                        seed: 1,
+                    },
+                );
+                app::atomic::write_atomic(path, |w| {
+                    image.write_png(w, doc.scene.params.settings.exposure)
+                })?;
+            }
+            emit(&format!(
+                "replayed     {} steps in {:.2} s\ncontent hash {:016x}\n",
+                replayed.steps,
+                started.elapsed().as_secs_f64(),
+                doc.scene.world.read().content_hash()
+            ))
+        }
         Command::Info { file } => {
             let started = Instant::now();
             let scene = with_progress(format!("reading {}", file.display()), || {

@@ -3,6 +3,7 @@
 
 pub mod command;
 pub mod history;
+pub mod script;
 
 use crate::scene::Scene;
 use anyhow::{Result, bail};
@@ -23,6 +24,8 @@ pub struct Document {
     pub history: History,
     /// Folder that relative paths in commands (imports) are resolved against.
     pub folder: PathBuf,
+    /// When set, every successful command, undo, redo and save is recorded as a script step.
+    pub recorder: Option<script::Recorder>,
 }
 
 impl Document {
@@ -34,6 +37,7 @@ impl Document {
             dirty: false,
             history,
             folder: PathBuf::from("."),
+            recorder: None,
         }
     }
 
@@ -42,6 +46,9 @@ impl Document {
     pub fn execute(&mut self, command: Command) -> Result<u64> {
         let inverse = command.apply(&mut self.scene, &self.folder)?;
         self.dirty = true;
+        if let Some(r) = &mut self.recorder {
+            r.record(script::Step::Do(command.clone()));
+        }
         Ok(self.history.push(command, inverse))
     }
 
@@ -54,6 +61,9 @@ impl Document {
         let redo = inverse.apply(&mut self.scene)?;
         self.history.push_redo(label.clone(), command, redo);
         self.dirty = true;
+        if let Some(r) = &mut self.recorder {
+            r.record(script::Step::Undo);
+        }
         Ok(label)
     }
 
@@ -66,12 +76,18 @@ impl Document {
         let undo = inverse.apply(&mut self.scene)?;
         self.history.push_undone(label.clone(), command, undo);
         self.dirty = true;
+        if let Some(r) = &mut self.recorder {
+            r.record(script::Step::Redo);
+        }
         Ok(label)
     }
 
     /// Saves (project or .vox by extension) atomically; a project save clears the dirty flag.
     pub fn save(&mut self, path: &Path) -> Result<()> {
         self.scene.save(path)?;
+        if let Some(r) = &mut self.recorder {
+            r.record(script::Step::Save(path.display().to_string()));
+        }
         if crate::formats::Format::of(path)? == crate::formats::Format::Project {
             self.path = Some(path.to_path_buf());
             self.dirty = false;

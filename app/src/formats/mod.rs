@@ -11,12 +11,12 @@ use std::path::Path;
 #[derive(Debug, thiserror::Error)]
 pub enum FormatError {
     /// The file system refused.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: String,
-        /// The cause.
-        source: std::io::Error,
+        /// The cause (shown in the message, so not chained again).
+        error: std::io::Error,
     },
     /// The content is not a valid file of this format.
     #[error("{path}: {message}")]
@@ -39,12 +39,12 @@ pub enum FormatError {
         known: u32,
     },
     /// The content does not fit the world (grid, materials, budget).
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     World {
         /// The file.
         path: String,
-        /// The cause.
-        source: brickmap::BrickmapError,
+        /// The cause (shown in the message, so not chained again).
+        error: brickmap::BrickmapError,
     },
 }
 
@@ -58,13 +58,13 @@ impl FormatError {
     pub(crate) fn io(path: &Path, source: std::io::Error) -> Self {
         FormatError::Io {
             path: path.display().to_string(),
-            source,
+            error: source,
         }
     }
     pub(crate) fn world(path: &Path, source: brickmap::BrickmapError) -> Self {
         FormatError::World {
             path: path.display().to_string(),
-            source,
+            error: source,
         }
     }
 }

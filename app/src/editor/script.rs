@@ -1,0 +1,471 @@
+//! Replay scripts: a RON header (format version, how the document starts, worker count) and
+//! a list of steps (any command, undo, redo, save, export, open, render, and assertions).
+//! Replay reports each step and stops at the first failure with the step number and what
+//! differed. Paths to read (imports, start files) are relative to the script's folder; paths
+//! to write go to the output folder (the script's folder unless told otherwise).
+//!
+//! ```text
+//! (
+//!     format_version: 1,
+//!     start: New(size: (128, 64, 128)),
+//!     workers: Some(2),
+//!     steps: [
+//!         Do(Stroke((mode: Attach, shape: Sphere, size: 6.0, material: 0, points: [(40.0, 20.0, 40.0)]))),
+//!         Mark("one sphere"),
+//!         Undo,
+//!         ExpectSolidCount(0),
+//!         Redo,
+//!         ExpectHashOf("one sphere"),
+//!         ExpectVoxel(at: (40, 20, 40), material: Some(0)),
+//!         Save("sphere.ron"),
+//!         Render((spp: 4, width: 32, height: 18, out: Some("sphere.png"), mean_min: Some((0.01, 0.01, 0.01)))),
+//!     ],
+//! )
+//! ```
+
+use super::Document;
+use super::command::{Command, TerrainSpec};
+use super::history::History;
+use crate::scene::Scene;
+use anyhow::{Context, Result, bail, ensure};
+use brickmap::GridDims;
+use glam::{IVec3, UVec3};
+use render::Camera;
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// The script format version this program writes and reads.
+pub const SCRIPT_VERSION: u32 = 1;
+
+/// A replay script.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Script {
+    /// Format version (1).
+    pub format_version: u32,
+    /// How the document starts.
+    pub start: Start,
+    /// Worker threads (None: one per core); `voxbrick replay --workers` overrides it.
+    #[serde(default)]
+    pub workers: Option<usize>,
+    /// The steps.
+    pub steps: Vec<Step>,
+}
+
+/// The starting document.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Start {
+    /// A new empty scene of a size in voxels, optionally with generated terrain.
+    New {
+        /// Width, height, depth in voxels (rounded up to whole bricks).
+        size: (u32, u32, u32),
+        /// Terrain to generate first (not an undo step).
+        #[serde(default)]
+        terrain: Option<TerrainSpec>,
+    },
+    /// A .ron or .vox file, relative to the script.
+    File(String),
+}
+
+/// Bounds on a rendered image.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RenderStep {
+    /// Camera (None: the scene's).
+    #[serde(default)]
+    pub camera: Option<Camera>,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Bounces (None: the scene's).
+    #[serde(default)]
+    pub bounces: Option<u32>,
+    /// Seed.
+    #[serde(default)]
+    pub seed: u64,
+    /// PNG to write (output folder).
+    #[serde(default)]
+    pub out: Option<String>,
+    /// Lower bound of the image's mean linear RGB.
+    #[serde(default)]
+    pub mean_min: Option<(f32, f32, f32)>,
+    /// Upper bound of the image's mean linear RGB.
+    #[serde(default)]
+    pub mean_max: Option<(f32, f32, f32)>,
+}
+
+/// One script step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Step {
+    /// Execute a command.
+    Do(Command),
+    /// Undo the latest step.
+    Undo,
+    /// Redo the latest undone step.
+    Redo,
+    /// Save (project or .vox by extension) to the output folder.
+    Save(String),
+    /// Export .vox to the output folder.
+    Export(String),
+    /// Replace the document by a file (from the output folder if it exists there, else the
+    /// script's folder); the history starts empty.
+    Open(String),
+    /// Render on the CPU reference renderer, optionally checking the mean.
+    Render(RenderStep),
+    /// Remember the current content hash under a name.
+    Mark(String),
+    /// The content hash equals a mark's.
+    ExpectHashOf(String),
+    /// The content hash equals this value (hex, as `voxbrick info` prints it).
+    ExpectHash(String),
+    /// A voxel is solid with a material (`material: Some(m)`) or empty (`None`).
+    ExpectVoxel {
+        /// The voxel.
+        at: IVec3,
+        /// Its expected material, or None for empty.
+        material: Option<u8>,
+    },
+    /// The number of solid voxels.
+    ExpectSolidCount(u64),
+    /// Steps that can be undone and redone.
+    ExpectHistory {
+        /// Undoable steps.
+        undo: usize,
+        /// Redoable steps.
+        redo: usize,
+    },
+}
+
+impl Step {
+    fn name(&self) -> String {
+        match self {
+            Step::Do(c) => c.label(),
+            other => format!("{other:?}")
+                .split(['(', ' '])
+                .next()
+                .unwrap_or("step")
+                .to_string(),
+        }
+    }
+}
+
+/// How to replay.
+#[derive(Clone, Debug, Default)]
+pub struct ReplayOptions {
+    /// Overrides the script's worker count.
+    pub workers: Option<usize>,
+    /// Where written files go (default: the script's folder).
+    pub out_dir: Option<PathBuf>,
+    /// Render device: "cpu" runs render steps; anything else refuses them until the Vulkan
+    /// renderer exists.
+    pub device: String,
+    /// History budget in bytes (default 512 MiB).
+    pub history_budget: Option<usize>,
+}
+
+/// What a replay ends with.
+pub struct Replayed {
+    /// The document after the last step.
+    pub document: Document,
+    /// Steps run.
+    pub steps: usize,
+}
+
+/// Parses a script.
+pub fn parse(text: &str) -> Result<Script> {
+    #[derive(Deserialize)]
+    struct Probe {
+        format_version: u32,
+    }
+    let probe: Probe = ron::from_str(text).context("not a voxbrick script")?;
+    ensure!(
+        probe.format_version == SCRIPT_VERSION,
+        "script format version {} is not {SCRIPT_VERSION}",
+        probe.format_version
+    );
+    Ok(ron::from_str(text)?)
+}
+
+/// Replays a script file; `report` receives one line per step.
+pub fn replay_file(
+    path: &Path,
+    options: &ReplayOptions,
+    report: &mut dyn FnMut(&str),
+) -> Result<Replayed> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let script = parse(&text).with_context(|| path.display().to_string())?;
+    let folder = path
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."));
+    replay(&script, &folder, options, report)
+}
+
+/// Replays a parsed script whose relative paths start at `folder`.
+pub fn replay(
+    script: &Script,
+    folder: &Path,
+    options: &ReplayOptions,
+    report: &mut dyn FnMut(&str),
+) -> Result<Replayed> {
+    let workers = options.workers.or(script.workers).unwrap_or(0);
+    let out_dir = options
+        .out_dir
+        .clone()
+        .unwrap_or_else(|| folder.to_path_buf());
+    std::fs::create_dir_all(&out_dir)
+        .with_context(|| format!("creating the output folder {}", out_dir.display()))?;
+    let history = || {
+        History::with_budget(
+            options
+                .history_budget
+                .unwrap_or(super::history::DEFAULT_BUDGET),
+        )
+    };
+    let scene = match &script.start {
+        Start::New { size, terrain } => {
+            let dims = GridDims::from_voxels(UVec3::new(size.0, size.1, size.2))
+                .context("start: grid size")?;
+            let mut doc = Document::new(Scene::empty(dims, workers)?, history());
+            if let Some(t) = terrain {
+                Command::GenerateTerrain(t.clone())
+                    .apply(&mut doc.scene, folder)
+                    .context("start: terrain")?;
+            }
+            doc.scene
+        }
+        Start::File(f) => Scene::load(&folder.join(f), workers).context("start")?,
+    };
+    let mut doc = Document::new(scene, history());
+    doc.folder = folder.to_path_buf();
+    let mut marks: HashMap<String, u64> = HashMap::new();
+    for (i, step) in script.steps.iter().enumerate() {
+        let n = i + 1;
+        let line = run_step(&mut doc, step, &out_dir, options, &mut marks)
+            .with_context(|| format!("step {n} ({})", step.name()))?;
+        report(&format!("step {n:>4}  {line}"));
+    }
+    Ok(Replayed {
+        document: doc,
+        steps: script.steps.len(),
+    })
+}
+
+fn hash(doc: &Document) -> u64 {
+    doc.scene.world.read().content_hash()
+}
+
+fn run_step(
+    doc: &mut Document,
+    step: &Step,
+    out_dir: &Path,
+    options: &ReplayOptions,
+    marks: &mut HashMap<String, u64>,
+) -> Result<String> {
+    Ok(match step {
+        Step::Do(command) => {
+            let dropped = doc.execute(command.clone())?;
+            let note = if dropped > 0 {
+                format!(" ({dropped} old history steps dropped to fit the budget)")
+            } else {
+                String::new()
+            };
+            format!("{}{note}", command.label())
+        }
+        Step::Undo => format!("undo {}", doc.undo()?),
+        Step::Redo => format!("redo {}", doc.redo()?),
+        Step::Save(p) | Step::Export(p) => {
+            let path = out_dir.join(p);
+            if matches!(step, Step::Export(_)) {
+                ensure!(
+                    crate::formats::Format::of(&path)? == crate::formats::Format::Vox,
+                    "export writes .vox files"
+                );
+            }
+            doc.save(&path)?;
+            format!("wrote {}", path.display())
+        }
+        Step::Open(p) => {
+            let in_out = out_dir.join(p);
+            let path = if in_out.exists() {
+                in_out
+            } else {
+                doc.folder.join(p)
+            };
+            let scene = Scene::load(&path, doc.scene.world.workers())?;
+            let budget = options
+                .history_budget
+                .unwrap_or(super::history::DEFAULT_BUDGET);
+            let folder = std::mem::take(&mut doc.folder);
+            *doc = Document::new(scene, History::with_budget(budget));
+            doc.folder = folder;
+            doc.path = Some(path.clone());
+            format!("opened {}", path.display())
+        }
+        Step::Render(r) => render_step(doc, r, out_dir, options)?,
+        Step::Mark(name) => {
+            marks.insert(name.clone(), hash(doc));
+            format!("mark {name:?} = {:016x}", hash(doc))
+        }
+        Step::ExpectHashOf(name) => {
+            let want = *marks
+                .get(name)
+                .with_context(|| format!("no mark {name:?}"))?;
+            ensure!(
+                hash(doc) == want,
+                "content hash {:016x}, mark {name:?} has {want:016x}",
+                hash(doc)
+            );
+            format!("hash equals mark {name:?}")
+        }
+        Step::ExpectHash(hex) => {
+            let want = u64::from_str_radix(hex.trim_start_matches("0x"), 16)
+                .with_context(|| format!("{hex:?} is not a hex hash"))?;
+            ensure!(
+                hash(doc) == want,
+                "content hash {:016x}, expected {want:016x}",
+                hash(doc)
+            );
+            format!("hash {want:016x}")
+        }
+        Step::ExpectVoxel { at, material } => {
+            let got = doc.scene.world.read().voxel(*at)?;
+            ensure!(
+                got == *material,
+                "voxel {at} is {got:?}, expected {material:?}"
+            );
+            format!("voxel {at} is {material:?}")
+        }
+        Step::ExpectSolidCount(want) => {
+            let got = doc.scene.world.read().solid_count();
+            ensure!(got == *want, "{got} solid voxels, expected {want}");
+            format!("{want} solid voxels")
+        }
+        Step::ExpectHistory { undo, redo } => {
+            let got = (doc.history.undo_len(), doc.history.redo_len());
+            ensure!(
+                got == (*undo, *redo),
+                "history has {} undo and {} redo steps, expected {undo} and {redo}",
+                got.0,
+                got.1
+            );
+            format!("history {undo} undo, {redo} redo")
+        }
+    })
+}
+
+fn render_step(
+    doc: &Document,
+    r: &RenderStep,
+    out_dir: &Path,
+    options: &ReplayOptions,
+) -> Result<String> {
+    if options.device != "cpu" {
+        bail!(
+            "render device {:?}: the Vulkan renderer is not built yet; replay with --device cpu",
+            options.device
+        );
+    }
+    ensure!(
+        r.spp > 0 && r.width > 0 && r.height > 0 && r.width <= 4096 && r.height <= 4096,
+        "render size and samples must be positive (at most 4096 pixels a side)"
+    );
+    let mut params = doc.scene.params.clone();
+    if let Some(c) = &r.camera {
+        c.validate()?;
+        params.camera = c.clone();
+    }
+    if let Some(b) = r.bounces {
+        ensure!((1..=64).contains(&b), "bounces {b} is outside 1..=64");
+        params.settings.max_bounces = b;
+    }
+    let view = doc.scene.world.read();
+    let image = render::cpu::CpuScene::new(&view, &params).render(&render::cpu::RenderJob {
+        width: r.width,
+        height: r.height,
+        spp: r.spp,
+        seed: r.seed,
+    });
+    ensure!(image.all_finite(), "the image has NaN or infinite pixels");
+    let mean = image.mean();
+    if let Some((a, b, c)) = r.mean_min {
+        ensure!(
+            mean[0] >= a as f64 && mean[1] >= b as f64 && mean[2] >= c as f64,
+            "image mean {mean:?} is below {:?}",
+            (a, b, c)
+        );
+    }
+    if let Some((a, b, c)) = r.mean_max {
+        ensure!(
+            mean[0] <= a as f64 && mean[1] <= b as f64 && mean[2] <= c as f64,
+            "image mean {mean:?} is above {:?}",
+            (a, b, c)
+        );
+    }
+    if let Some(out) = &r.out {
+        let path = out_dir.join(out);
+        crate::atomic::write_atomic(&path, |w| image.write_png(w, params.settings.exposure))
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(format!(
+        "rendered {}x{} at {} spp, mean ({:.4}, {:.4}, {:.4})",
+        r.width, r.height, r.spp, mean[0], mean[1], mean[2]
+    ))
+}
+
+/// Records what an editor session does, as a script.
+#[derive(Clone, Debug, Default)]
+pub struct Recorder {
+    steps: Vec<Step>,
+}
+
+impl Recorder {
+    /// Records a step (call after it succeeded).
+    pub fn record(&mut self, step: Step) {
+        self.steps.push(step);
+    }
+    /// The script of everything recorded, starting from `start`.
+    pub fn script(&self, start: Start, workers: Option<usize>) -> Script {
+        Script {
+            format_version: SCRIPT_VERSION,
+            start,
+            workers,
+            steps: self.steps.clone(),
+        }
+    }
+    /// The script as RON text, one step per line.
+    pub fn to_ron(&self, start: Start, workers: Option<usize>) -> String {
+        let script = self.script(start, workers);
+        let compact = ron::ser::PrettyConfig::new()
+            .compact_structs(true)
+            .compact_arrays(true);
+        let one = |v: &dyn erased::Ron| v.ron(&compact);
+        let steps: Vec<String> = script
+            .steps
+            .iter()
+            .map(|s| format!("        {},", one(s)))
+            .collect();
+        format!(
+            "(\n    format_version: {},\n    start: {},\n    workers: {},\n    steps: [\n{}\n    ],\n)\n",
+            script.format_version,
+            one(&script.start),
+            one(&script.workers),
+            steps.join("\n")
+        )
+    }
+}
+
+mod erased {
+    /// Serializes any value to compact RON (a tiny object-safe wrapper).
+    pub trait Ron {
+        fn ron(&self, config: &ron::ser::PrettyConfig) -> String;
+    }
+    impl<T: serde::Serialize> Ron for T {
+        fn ron(&self, config: &ron::ser::PrettyConfig) -> String {
+            ron::ser::to_string_pretty(self, config.clone()).expect("script values serialize")
+        }
+    }
+}
