@@ -11,6 +11,15 @@ use command::Command;
 use history::History;
 use std::path::{Path, PathBuf};
 
+/// What executing a command did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Executed {
+    /// Old history steps dropped to stay within the budget.
+    pub dropped: u64,
+    /// Voxels the command changed.
+    pub changed_voxels: u64,
+}
+
 /// An open scene and everything about it the editor tracks.
 #[derive(Debug)]
 pub struct Document {
@@ -42,14 +51,14 @@ impl Document {
     }
 
     /// Executes a command and records it; on error nothing changed (world, tables, history).
-    /// Returns how many old history steps were dropped to stay within the budget.
-    pub fn execute(&mut self, command: Command) -> Result<u64> {
-        let inverse = command.apply(&mut self.scene, &self.folder)?;
+    pub fn execute(&mut self, command: Command) -> Result<Executed> {
+        let applied = command.apply(&mut self.scene, &self.folder)?;
         self.dirty = true;
         if let Some(r) = &mut self.recorder {
             r.record(script::Step::Do(command.clone()));
         }
-        Ok(self.history.push(command, inverse))
+        let dropped = self.history.push(command, applied.inverse);
+        Ok(Executed { dropped, changed_voxels: applied.changed_voxels })
     }
 
     /// Undoes the latest step; the label of what was undone.

@@ -267,7 +267,7 @@ fn run_step(
 ) -> Result<String> {
     Ok(match step {
         Step::Do(command) => {
-            let dropped = doc.execute(command.clone())?;
+            let dropped = doc.execute(command.clone())?.dropped;
             let note = if dropped > 0 {
                 format!(" ({dropped} old history steps dropped to fit the budget)")
             } else {
