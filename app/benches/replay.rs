@@ -28,16 +28,42 @@ fn session() -> Script {
             12..17 => BrushMode::Erase,
             _ => BrushMode::Paint,
         };
-        let shape = [BrushShape::Sphere, BrushShape::Cube, BrushShape::Cylinder, BrushShape::Line][(r >> 8) as usize % 4];
+        let shape = [
+            BrushShape::Sphere,
+            BrushShape::Cube,
+            BrushShape::Cylinder,
+            BrushShape::Line,
+        ][(r >> 8) as usize % 4];
         let size = 2.0 + ((r >> 16) % 7) as f64;
-        let start = DVec3::new(((r >> 24) % 240) as f64 + 8.0, ((r >> 32) % 48) as f64 + 8.0, ((r >> 40) % 240) as f64 + 8.0);
-        let points = (0..1 + (r >> 48) % 4).map(|k| start + DVec3::new(k as f64 * 6.0, 0.0, k as f64 * 3.0)).collect();
-        steps.push(Step::Do(Command::Stroke(Stroke { mode, shape, size, material: 0, mirror: Mirror::default(), points })));
+        let start = DVec3::new(
+            ((r >> 24) % 240) as f64 + 8.0,
+            ((r >> 32) % 48) as f64 + 8.0,
+            ((r >> 40) % 240) as f64 + 8.0,
+        );
+        let points = (0..1 + (r >> 48) % 4)
+            .map(|k| start + DVec3::new(k as f64 * 6.0, 0.0, k as f64 * 3.0))
+            .collect();
+        steps.push(Step::Do(Command::Stroke(Stroke {
+            mode,
+            shape,
+            size,
+            material: 0,
+            mirror: Mirror::default(),
+            points,
+        })));
         if i % 20 == 19 {
             steps.extend([Step::Undo, Step::Undo, Step::Undo, Step::Redo, Step::Redo]);
         }
     }
-    Script { format_version: 1, start: Start::New { size: (256, 64, 256), terrain: None }, workers: None, steps }
+    Script {
+        format_version: 1,
+        start: Start::New {
+            size: (256, 64, 256),
+            terrain: None,
+        },
+        workers: None,
+        steps,
+    }
 }
 
 fn main() {
@@ -69,6 +95,14 @@ fn main() {
 fn replay_sculpt_session(bencher: divan::Bencher) {
     let script = session();
     let out = std::env::temp_dir().join(format!("voxbrick-replay-bench-{}", std::process::id()));
-    let options = ReplayOptions { out_dir: Some(out), device: "cpu".into(), ..Default::default() };
-    bencher.bench_local(|| script::replay(&script, std::path::Path::new("."), &options, &mut |_| {}).unwrap().steps);
+    let options = ReplayOptions {
+        out_dir: Some(out),
+        device: "cpu".into(),
+        ..Default::default()
+    };
+    bencher.bench_local(|| {
+        script::replay(&script, std::path::Path::new("."), &options, &mut |_| {})
+            .unwrap()
+            .steps
+    });
 }

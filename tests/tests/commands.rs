@@ -335,7 +335,8 @@ fn history_memory_is_bounded_and_reports_drops() {
                 6.0,
                 &[[x, 45.0, 20.0 + (i / 10) as f64 * 25.0]],
             ))
-            .unwrap().dropped;
+            .unwrap()
+            .dropped;
     }
     assert!(dropped > 0, "the budget forces drops");
     assert_eq!(doc.history.dropped(), dropped);

@@ -206,3 +206,19 @@ fn a_recorded_session_replays_to_the_same_content() {
     let replayed = script::replay(&parsed, &out, &options(1, &out), &mut |_| {}).unwrap();
     assert_eq!(replayed.document.scene.world.read().content_hash(), want);
 }
+
+#[test]
+fn the_readme_example_is_a_tested_script() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("../README.md")).unwrap();
+    let section = &readme[readme
+        .find("## Replay scripts")
+        .expect("README has the section")..];
+    let start = section.find("```ron\n").unwrap() + "```ron\n".len();
+    let block = &section[start..start + section[start..].find("```").unwrap()];
+    let file = std::fs::read_to_string(root.join("scripts/readme_example.ron")).unwrap();
+    assert_eq!(
+        block, file,
+        "README's example must be tests/scripts/readme_example.ron"
+    );
+}

@@ -300,7 +300,10 @@ impl Command {
     /// Executes the command. On error the scene is as it was.
     pub fn apply(&self, scene: &mut Scene, folder: &std::path::Path) -> Result<Applied> {
         let world = &scene.world;
-        let unchanged = |inverse| Applied { inverse, changed_voxels: 0 };
+        let unchanged = |inverse| Applied {
+            inverse,
+            changed_voxels: 0,
+        };
         Ok(match self {
             Command::Stroke(s) => apply_all(scene, stroke_edits(s)?)?,
             Command::FloodFill { start, material } => {
@@ -310,38 +313,64 @@ impl Command {
             }
             Command::Clear => {
                 let max = world.dims().voxels() - 1;
-                let clear = EditOp::Shape { shape: Shape::Box { min: IVec3::ZERO, max }, mode: Mode::Remove };
+                let clear = EditOp::Shape {
+                    shape: Shape::Box {
+                        min: IVec3::ZERO,
+                        max,
+                    },
+                    mode: Mode::Remove,
+                };
                 apply_all(scene, vec![clear])?
             }
-            Command::AddMaterial(m) => with_table(scene, |w| w.push_material((*m).into()).map(|_| ()))?,
-            Command::SetMaterial { index, material } => with_table(scene, |w| w.set_material(*index, (*material).into()).map(|_| ()))?,
+            Command::AddMaterial(m) => {
+                with_table(scene, |w| w.push_material((*m).into()).map(|_| ()))?
+            }
+            Command::SetMaterial { index, material } => with_table(scene, |w| {
+                w.set_material(*index, (*material).into()).map(|_| ())
+            })?,
             Command::SetColour { index, rgb } => with_table(scene, |w| {
                 w.set_colour(*index, *rgb);
                 Ok(())
             })?,
-            Command::SetParam { kind, index, value } => with_table(scene, |w| w.set_param((*kind).into(), *index, *value).map(|_| ()))?,
+            Command::SetParam { kind, index, value } => with_table(scene, |w| {
+                w.set_param((*kind).into(), *index, *value).map(|_| ())
+            })?,
             Command::SetSun(v) => {
                 v.validate()?;
-                unchanged(Inverse::Sun(std::mem::replace(&mut scene.params.sun, v.clone())))
+                unchanged(Inverse::Sun(std::mem::replace(
+                    &mut scene.params.sun,
+                    v.clone(),
+                )))
             }
             Command::SetSky(v) => {
                 v.validate()?;
-                unchanged(Inverse::Sky(std::mem::replace(&mut scene.params.sky, v.clone())))
+                unchanged(Inverse::Sky(std::mem::replace(
+                    &mut scene.params.sky,
+                    v.clone(),
+                )))
             }
             Command::SetCamera(v) => {
                 v.validate()?;
-                unchanged(Inverse::Camera(std::mem::replace(&mut scene.params.camera, v.clone())))
+                unchanged(Inverse::Camera(std::mem::replace(
+                    &mut scene.params.camera,
+                    v.clone(),
+                )))
             }
             Command::SetSettings(v) => {
                 v.validate()?;
-                unchanged(Inverse::Settings(std::mem::replace(&mut scene.params.settings, v.clone())))
+                unchanged(Inverse::Settings(std::mem::replace(
+                    &mut scene.params.settings,
+                    v.clone(),
+                )))
             }
             Command::GenerateTerrain(t) => {
                 let before = world.materials().clone();
                 let result = (|| {
                     let materials = crate::scene::terrain_materials(world)?;
-                    let mut params = crate::scene::thesis_terrain(materials, world.dims().voxels().y as u32);
-                    (params.seed, params.noise, params.scale, params.octaves) = (t.seed, NoiseKind::Perlin, t.scale, t.octaves);
+                    let mut params =
+                        crate::scene::thesis_terrain(materials, world.dims().voxels().y as u32);
+                    (params.seed, params.noise, params.scale, params.octaves) =
+                        (t.seed, NoiseKind::Perlin, t.scale, t.octaves);
                     (params.height_range, params.water_level) = (t.height_range, t.water_level);
                     let edit = NoiseTerrain::new(params, world.dims())?.edit();
                     Ok::<_, anyhow::Error>(world.apply(edit)?)
@@ -359,9 +388,13 @@ impl Command {
             }
             Command::ImportVox { path, offset } => {
                 let file = folder.join(path);
-                let bytes = std::fs::read(&file).with_context(|| format!("reading {}", file.display()))?;
+                let bytes =
+                    std::fs::read(&file).with_context(|| format!("reading {}", file.display()))?;
                 let before = world.materials().clone();
-                let options = crate::formats::vox::ImportOptions { offset: *offset, ..Default::default() };
+                let options = crate::formats::vox::ImportOptions {
+                    offset: *offset,
+                    ..Default::default()
+                };
                 match crate::formats::vox::import_into(world, &bytes, &options, None) {
                     Ok((report, inv)) => Applied {
                         inverse: Inverse::Voxels(vec![inv], Some(Box::new(before))),
@@ -388,13 +421,19 @@ pub struct Applied {
 }
 
 /// Runs a table edit, keeping the previous table as the inverse (and putting it back on error).
-fn with_table(scene: &Scene, edit: impl FnOnce(&brickmap::World) -> brickmap::Result<()>) -> Result<Applied> {
+fn with_table(
+    scene: &Scene,
+    edit: impl FnOnce(&brickmap::World) -> brickmap::Result<()>,
+) -> Result<Applied> {
     let before = scene.world.materials().clone();
     if let Err(e) = edit(&scene.world) {
         scene.world.replace_materials(before)?;
         return Err(e.into());
     }
-    Ok(Applied { inverse: Inverse::Table(Box::new(before)), changed_voxels: 0 })
+    Ok(Applied {
+        inverse: Inverse::Table(Box::new(before)),
+        changed_voxels: 0,
+    })
 }
 
 /// Applies edits in order; if one fails, the ones applied are undone and the error returned.
@@ -415,7 +454,10 @@ fn apply_all(scene: &Scene, edits: Vec<EditOp>) -> Result<Applied> {
             }
         }
     }
-    Ok(Applied { inverse: Inverse::Voxels(done, None), changed_voxels: changed })
+    Ok(Applied {
+        inverse: Inverse::Voxels(done, None),
+        changed_voxels: changed,
+    })
 }
 
 /// The world edits of a stroke, mirror images included, validated before any is applied.

@@ -58,7 +58,10 @@ impl Document {
             r.record(script::Step::Do(command.clone()));
         }
         let dropped = self.history.push(command, applied.inverse);
-        Ok(Executed { dropped, changed_voxels: applied.changed_voxels })
+        Ok(Executed {
+            dropped,
+            changed_voxels: applied.changed_voxels,
+        })
     }
 
     /// Undoes the latest step; the label of what was undone.
