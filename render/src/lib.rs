@@ -4,6 +4,7 @@
 pub mod cpu;
 pub mod image;
 pub mod params;
+pub mod vulkan;
 
 pub use image::Image;
 pub use params::{Camera, ParamError, RenderSettings, SceneParams, Sky, Sun};

@@ -1,0 +1,104 @@
+//! Host-visible storage buffers (CPU writes, GPU reads and writes, CPU reads back).
+
+use super::{GpuContext, GpuError, vk_call};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+
+/// A storage buffer in host-visible memory.
+pub struct HostBuffer {
+    /// The Vulkan buffer.
+    pub raw: vk::Buffer,
+    allocation: Option<Allocation>,
+    /// Size in bytes.
+    pub size: u64,
+}
+
+impl HostBuffer {
+    /// A buffer of `size` bytes (at least 4) at `location` (CpuToGpu or GpuToCpu).
+    pub fn new(
+        ctx: &GpuContext,
+        name: &str,
+        size: u64,
+        location: MemoryLocation,
+    ) -> Result<Self, GpuError> {
+        let size = size.max(4);
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(vk::BufferUsageFlags::STORAGE_BUFFER)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: the create info outlives the call; the buffer is destroyed in `destroy`.
+        let raw = vk_call("vkCreateBuffer", unsafe {
+            ctx.device.create_buffer(&info, None)
+        })?;
+        // SAFETY: plain query on a live buffer.
+        let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
+        let mut guard = ctx.allocator.lock().expect("allocator lock");
+        let allocator = guard
+            .as_mut()
+            .expect("allocator lives as long as the context");
+        let allocation = match allocator.allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location,
+            linear: true,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        }) {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: the buffer was never bound or used.
+                unsafe { ctx.device.destroy_buffer(raw, None) };
+                return Err(e.into());
+            }
+        };
+        // SAFETY: the allocation satisfies the buffer's requirements.
+        if let Err(result) = unsafe {
+            ctx.device
+                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
+        } {
+            let _ = allocator.free(allocation);
+            unsafe { ctx.device.destroy_buffer(raw, None) };
+            return Err(GpuError::Vk {
+                call: "vkBindBufferMemory",
+                result,
+            });
+        }
+        Ok(Self {
+            raw,
+            allocation: Some(allocation),
+            size,
+        })
+    }
+
+    /// Copies bytes into the start of the buffer.
+    pub fn write(&mut self, bytes: &[u8]) {
+        let slice = self
+            .allocation
+            .as_mut()
+            .and_then(|a| a.mapped_slice_mut())
+            .expect("host-visible buffers are mapped");
+        slice[..bytes.len()].copy_from_slice(bytes);
+    }
+
+    /// The buffer's bytes (after the GPU finished writing them).
+    pub fn read(&self) -> &[u8] {
+        let slice = self
+            .allocation
+            .as_ref()
+            .and_then(|a| a.mapped_slice())
+            .expect("host-visible buffers are mapped");
+        &slice[..self.size as usize]
+    }
+
+    /// Frees the buffer (the GPU must be done with it).
+    pub fn destroy(mut self, ctx: &GpuContext) {
+        if let Some(a) = self.allocation.take()
+            && let Ok(mut guard) = ctx.allocator.lock()
+            && let Some(allocator) = guard.as_mut()
+        {
+            let _ = allocator.free(a);
+        }
+        // SAFETY: the caller guarantees the GPU no longer uses the buffer.
+        unsafe { ctx.device.destroy_buffer(self.raw, None) };
+    }
+}
