@@ -4,6 +4,8 @@
 //! without a driver gets [`GpuError::NoVulkan`], not a link failure.
 
 pub mod buffer;
+pub mod pass;
+pub mod primary;
 pub mod tonemap;
 
 use ash::vk;

@@ -1,0 +1,185 @@
+//! A compute pass: one SPIR-V module, N storage buffers in set 0 (bindings 0..N), push
+//! constants, dispatched synchronously with the results made visible to the host.
+
+use super::buffer::HostBuffer;
+use super::{GpuContext, GpuError, vk_call};
+use ash::vk;
+
+/// A compute pipeline and what it needs to be bound.
+pub struct ComputePass {
+    module: vk::ShaderModule,
+    set_layout: vk::DescriptorSetLayout,
+    layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+    pool: vk::DescriptorPool,
+    buffers: u32,
+}
+
+impl ComputePass {
+    /// Builds the pipeline for SPIR-V bytes with `buffers` storage buffers and `push` bytes
+    /// of push constants.
+    pub fn new(ctx: &GpuContext, spirv: &[u8], buffers: u32, push: u32) -> Result<Self, GpuError> {
+        let d = &ctx.device;
+        let words: Vec<u32> = spirv
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        let bindings: Vec<_> = (0..buffers)
+            .map(|b| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(b)
+                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
+            })
+            .collect();
+        let ranges = [vk::PushConstantRange::default()
+            .stage_flags(vk::ShaderStageFlags::COMPUTE)
+            .size(push)];
+        let sizes = [vk::DescriptorPoolSize::default()
+            .ty(vk::DescriptorType::STORAGE_BUFFER)
+            .descriptor_count(buffers)];
+        // SAFETY: create infos outlive each call; objects are destroyed in `destroy`.
+        unsafe {
+            let module = vk_call(
+                "vkCreateShaderModule",
+                d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None),
+            )?;
+            let set_layout = vk_call(
+                "vkCreateDescriptorSetLayout",
+                d.create_descriptor_set_layout(
+                    &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
+                    None,
+                ),
+            )?;
+            let set_layouts = [set_layout];
+            let info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
+            let info = if push > 0 {
+                info.push_constant_ranges(&ranges)
+            } else {
+                info
+            };
+            let layout = vk_call(
+                "vkCreatePipelineLayout",
+                d.create_pipeline_layout(&info, None),
+            )?;
+            let stage = vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::COMPUTE)
+                .module(module)
+                .name(c"main");
+            let info = [vk::ComputePipelineCreateInfo::default()
+                .stage(stage)
+                .layout(layout)];
+            let pipeline = d
+                .create_compute_pipelines(vk::PipelineCache::null(), &info, None)
+                .map_err(|(_, result)| GpuError::Vk {
+                    call: "vkCreateComputePipelines",
+                    result,
+                })?[0];
+            let pool_info = vk::DescriptorPoolCreateInfo::default()
+                .max_sets(1)
+                .pool_sizes(&sizes)
+                .flags(vk::DescriptorPoolCreateFlags::FREE_DESCRIPTOR_SET);
+            let pool = vk_call(
+                "vkCreateDescriptorPool",
+                d.create_descriptor_pool(&pool_info, None),
+            )?;
+            Ok(Self {
+                module,
+                set_layout,
+                layout,
+                pipeline,
+                pool,
+                buffers,
+            })
+        }
+    }
+
+    /// Binds `buffers` to bindings 0.., pushes `push`, dispatches `groups` and waits; shader
+    /// writes are visible to the host afterwards.
+    pub fn run(
+        &self,
+        ctx: &GpuContext,
+        buffers: &[&HostBuffer],
+        push: &[u8],
+        groups: u32,
+    ) -> Result<(), GpuError> {
+        assert_eq!(buffers.len() as u32, self.buffers, "one buffer per binding");
+        let d = &ctx.device;
+        let layouts = [self.set_layout];
+        // SAFETY: the set is written before use and freed after the fence wait.
+        unsafe {
+            let set = vk_call(
+                "vkAllocateDescriptorSets",
+                d.allocate_descriptor_sets(
+                    &vk::DescriptorSetAllocateInfo::default()
+                        .descriptor_pool(self.pool)
+                        .set_layouts(&layouts),
+                ),
+            )?[0];
+            let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
+                .iter()
+                .map(|b| {
+                    [vk::DescriptorBufferInfo::default()
+                        .buffer(b.raw)
+                        .range(vk::WHOLE_SIZE)]
+                })
+                .collect();
+            let writes: Vec<vk::WriteDescriptorSet> = infos
+                .iter()
+                .enumerate()
+                .map(|(b, info)| {
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(set)
+                        .dst_binding(b as u32)
+                        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                        .buffer_info(info)
+                })
+                .collect();
+            d.update_descriptor_sets(&writes, &[]);
+            let result = ctx.submit_and_wait(|cmd| {
+                // Host writes before the submit are visible to the device (submission order).
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+                d.cmd_bind_descriptor_sets(
+                    cmd,
+                    vk::PipelineBindPoint::COMPUTE,
+                    self.layout,
+                    0,
+                    &[set],
+                    &[],
+                );
+                if !push.is_empty() {
+                    d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
+                }
+                d.cmd_dispatch(cmd, groups, 1, 1);
+                let barrier = [vk::MemoryBarrier::default()
+                    .src_access_mask(vk::AccessFlags::SHADER_WRITE)
+                    .dst_access_mask(vk::AccessFlags::HOST_READ)];
+                d.cmd_pipeline_barrier(
+                    cmd,
+                    vk::PipelineStageFlags::COMPUTE_SHADER,
+                    vk::PipelineStageFlags::HOST,
+                    vk::DependencyFlags::empty(),
+                    &barrier,
+                    &[],
+                    &[],
+                );
+            });
+            let _ = d.free_descriptor_sets(self.pool, &[set]);
+            result
+        }
+    }
+
+    /// Destroys the pipeline's objects.
+    pub fn destroy(self, ctx: &GpuContext) {
+        let d = &ctx.device;
+        // SAFETY: no submission using them is pending (every run waits for its fence).
+        unsafe {
+            d.destroy_descriptor_pool(self.pool, None);
+            d.destroy_pipeline(self.pipeline, None);
+            d.destroy_pipeline_layout(self.layout, None);
+            d.destroy_descriptor_set_layout(self.set_layout, None);
+            d.destroy_shader_module(self.module, None);
+        }
+    }
+}

@@ -1,0 +1,159 @@
+//! The world on the GPU and first-hit traversal of rays (`shaders/primary.comp`): the
+//! brickmap's GPU buffers uploaded as they are, and the same DDA as `brickmap::raycast` in f32.
+//! Buffers are host-visible for now; device-local buffers fed by a staging ring come next.
+
+use super::buffer::HostBuffer;
+use super::pass::ComputePass;
+use super::{GpuContext, GpuError};
+use brickmap::{GpuBuffer, WorldView};
+use glam::{IVec3, Vec3};
+use gpu_allocator::MemoryLocation;
+
+const SPIRV: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/primary.comp.spv"));
+const GROUP: u32 = 64;
+
+/// Push constants. Keep in sync with `Push` in shaders/primary.comp (std430: uvec3 then two
+/// uints).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Push {
+    dims: [u32; 3],
+    count: u32,
+    words_per_column: u32,
+}
+const _: () = assert!(std::mem::size_of::<Push>() == 20);
+
+/// The world's traversal buffers on the GPU (brick index, bricks, coarse grid).
+pub struct GpuWorld {
+    buffers: Vec<HostBuffer>,
+    dims: [u32; 3],
+    words_per_column: u32,
+}
+
+impl GpuWorld {
+    /// Uploads a world's current buffers.
+    pub fn upload(ctx: &GpuContext, view: &WorldView<'_>) -> Result<Self, GpuError> {
+        let mut buffers = Vec::new();
+        for (name, which) in [
+            ("brick index", GpuBuffer::BrickIndex),
+            ("bricks", GpuBuffer::Bricks),
+            ("coarse", GpuBuffer::Coarse),
+        ] {
+            let bytes = view.gpu_image(which);
+            match HostBuffer::new(ctx, name, bytes.len() as u64, MemoryLocation::CpuToGpu) {
+                Ok(mut b) => {
+                    b.write(&bytes);
+                    buffers.push(b);
+                }
+                Err(e) => {
+                    buffers.into_iter().for_each(|b| b.destroy(ctx));
+                    return Err(e);
+                }
+            }
+        }
+        let dims = view.dims();
+        Ok(Self {
+            buffers,
+            dims: dims.bricks().to_array(),
+            words_per_column: dims.coarse_words_per_column() as u32,
+        })
+    }
+
+    /// Frees the buffers.
+    pub fn destroy(self, ctx: &GpuContext) {
+        self.buffers.into_iter().for_each(|b| b.destroy(ctx));
+    }
+}
+
+/// The first hit of a ray on the GPU.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GpuHit {
+    /// The voxel.
+    pub voxel: IVec3,
+    /// Ray parameter.
+    pub t: f32,
+}
+
+/// The traversal pipeline.
+pub struct PrimaryTracer(ComputePass);
+
+impl PrimaryTracer {
+    /// Builds the pipeline.
+    pub fn new(ctx: &GpuContext) -> Result<Self, GpuError> {
+        Ok(Self(ComputePass::new(
+            ctx,
+            SPIRV,
+            5,
+            std::mem::size_of::<Push>() as u32,
+        )?))
+    }
+
+    /// The first solid voxel along each ray (origin, direction), or None.
+    pub fn trace(
+        &self,
+        ctx: &GpuContext,
+        world: &GpuWorld,
+        rays: &[(Vec3, Vec3)],
+    ) -> Result<Vec<Option<GpuHit>>, GpuError> {
+        let packed: Vec<[f32; 4]> = rays
+            .iter()
+            .flat_map(|(o, d)| [o.extend(0.0).to_array(), d.extend(0.0).to_array()])
+            .collect();
+        let mut input = HostBuffer::new(
+            ctx,
+            "rays",
+            packed.len() as u64 * 16,
+            MemoryLocation::CpuToGpu,
+        )?;
+        let output = match HostBuffer::new(
+            ctx,
+            "hits",
+            rays.len() as u64 * 16,
+            MemoryLocation::GpuToCpu,
+        ) {
+            Ok(b) => b,
+            Err(e) => {
+                input.destroy(ctx);
+                return Err(e);
+            }
+        };
+        input.write(bytemuck::cast_slice(&packed));
+        let push = Push {
+            dims: world.dims,
+            count: rays.len() as u32,
+            words_per_column: world.words_per_column,
+        };
+        let bound = [
+            &world.buffers[0],
+            &world.buffers[1],
+            &world.buffers[2],
+            &input,
+            &output,
+        ];
+        let result = self.0.run(
+            ctx,
+            &bound,
+            bytemuck::bytes_of(&push),
+            (rays.len() as u32).div_ceil(GROUP),
+        );
+        let hits = result.map(|_| {
+            let raw: &[[f32; 4]] = bytemuck::cast_slice(&output.read()[..rays.len() * 16]);
+            raw.iter()
+                .map(|h| {
+                    (h[0] >= 0.0).then(|| GpuHit {
+                        voxel: IVec3::new(h[0] as i32, h[1] as i32, h[2] as i32),
+                        t: h[3],
+                    })
+                })
+                .collect()
+        });
+        input.destroy(ctx);
+        output.destroy(ctx);
+        hits
+    }
+
+    /// Destroys the pipeline.
+    pub fn destroy(self, ctx: &GpuContext) {
+        self.0.destroy(ctx);
+    }
+}
