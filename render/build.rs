@@ -1,5 +1,6 @@
 //! Compiles every `shaders/*.comp` to SPIR-V (Vulkan 1.2 / SPIR-V 1.5) with glslang at build
-//! time; a compile error fails the build with glslang's message.
+//! time; a compile error fails the build with glslang's message. `#include "name.glsl"` lines
+//! are replaced by that file from `shaders/` (one level, each file once).
 
 use glslang::{
     Compiler, CompilerOptions, ShaderInput, ShaderSource, ShaderStage, SpirvVersion, Target,
@@ -29,7 +30,10 @@ fn main() {
         .filter(|p| p.extension().is_some_and(|e| e == "comp"))
     {
         println!("cargo:rerun-if-changed={}", path.display());
-        let text = std::fs::read_to_string(&path).expect("shader is UTF-8");
+        let text = expand_includes(
+            &shaders,
+            &std::fs::read_to_string(&path).expect("shader is UTF-8"),
+        );
         let source = ShaderSource::from(text);
         let name = path.file_name().unwrap().to_string_lossy().to_string();
         let spirv = ShaderInput::new(
@@ -45,4 +49,25 @@ fn main() {
         let bytes: Vec<u8> = spirv.iter().flat_map(|w| w.to_le_bytes()).collect();
         std::fs::write(out.join(format!("{name}.spv")), bytes).expect("OUT_DIR is writable");
     }
+}
+
+fn expand_includes(dir: &std::path::Path, text: &str) -> String {
+    text.lines()
+        .map(|line| {
+            match line
+                .trim()
+                .strip_prefix("#include \"")
+                .and_then(|r| r.strip_suffix('"'))
+            {
+                Some(name) => {
+                    let file = dir.join(name);
+                    println!("cargo:rerun-if-changed={}", file.display());
+                    std::fs::read_to_string(&file)
+                        .unwrap_or_else(|e| panic!("#include {name}: {e}"))
+                }
+                None => line.to_string(),
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
 }

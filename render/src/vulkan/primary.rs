@@ -23,7 +23,7 @@ struct Push {
 }
 const _: () = assert!(std::mem::size_of::<Push>() == 20);
 
-/// The world's traversal buffers on the GPU (brick index, bricks, coarse grid).
+/// The world's five buffers on the GPU, bound at 0..4 by every shader.
 pub struct GpuWorld {
     buffers: Vec<HostBuffer>,
     dims: [u32; 3],
@@ -38,6 +38,8 @@ impl GpuWorld {
             ("brick index", GpuBuffer::BrickIndex),
             ("bricks", GpuBuffer::Bricks),
             ("coarse", GpuBuffer::Coarse),
+            ("material bytes", GpuBuffer::MaterialBytes),
+            ("material tables", GpuBuffer::MaterialTables),
         ] {
             let bytes = view.gpu_image(which);
             match HostBuffer::new(ctx, name, bytes.len() as u64, MemoryLocation::CpuToGpu) {
@@ -83,7 +85,7 @@ impl PrimaryTracer {
         Ok(Self(ComputePass::new(
             ctx,
             SPIRV,
-            5,
+            7,
             std::mem::size_of::<Push>() as u32,
         )?))
     }
@@ -123,13 +125,8 @@ impl PrimaryTracer {
             count: rays.len() as u32,
             words_per_column: world.words_per_column,
         };
-        let bound = [
-            &world.buffers[0],
-            &world.buffers[1],
-            &world.buffers[2],
-            &input,
-            &output,
-        ];
+        let mut bound: Vec<&HostBuffer> = world.buffers.iter().collect();
+        bound.extend([&input, &output]);
         let result = self.0.run(
             ctx,
             &bound,
