@@ -113,7 +113,8 @@ fn gpu_traversal_matches_the_cpu_ray_cast() {
         EditOp, GridDims, Mode, Ray, Shape, VoxelEdit, VoxelOp, World, WorldConfig, terrain,
     };
     use glam::{DVec3, IVec3, Vec3};
-    use render::vulkan::primary::{GpuWorld, PrimaryTracer};
+    use render::vulkan::primary::PrimaryTracer;
+    use render::vulkan::world::GpuWorld;
     let Some(ctx) = context(DeviceChoice::Best) else {
         return;
     };
@@ -217,4 +218,319 @@ fn gpu_traversal_matches_the_cpu_ray_cast() {
     tracer.destroy(&ctx);
     gpu_world.destroy(&ctx);
     assert_eq!(ctx.validation_errors(), 0, "validation errors");
+}
+
+mod trace {
+    //! The GPU path tracer against closed forms and against the CPU reference.
+    use super::*;
+    use brickmap::{
+        EditOp, GridDims, Material, MaterialKind, Mode, Shape, VoxelEdit, VoxelOp, World,
+        WorldConfig,
+    };
+    use glam::{DVec3, IVec3};
+    use render::cpu::{CpuScene, RenderJob};
+    use render::vulkan::trace::PathTracer;
+    use render::vulkan::world::GpuWorld;
+    use render::{Camera, RenderSettings, SceneParams, Sky, Sun};
+
+    fn no_sun() -> Sun {
+        Sun {
+            enabled: false,
+            position: DVec3::new(0.0, 1000.0, 0.0),
+            radius: 1.0,
+            colour: [1.0; 3],
+            intensity: 0.0,
+            animate: false,
+            speed_deg_per_s: 0.0,
+        }
+    }
+
+    fn params(camera: Camera, sky: Sky, sun: Sun, bounces: u32) -> SceneParams {
+        SceneParams {
+            camera,
+            sun,
+            sky,
+            settings: RenderSettings {
+                samples_per_pixel: 1,
+                max_bounces: bounces,
+                internal_resolution: (32, 32),
+                exposure: 0.0,
+            },
+        }
+    }
+
+    fn add(w: &World, kind: MaterialKind, param: u8, rgb: [u8; 3]) -> u8 {
+        let colour = 250 - w.materials().len() as u8;
+        w.set_colour(colour, rgb);
+        w.push_material(Material {
+            kind,
+            param,
+            colour,
+        })
+        .unwrap()
+    }
+
+    fn gpu_render(
+        ctx: &GpuContext,
+        w: &World,
+        p: &SceneParams,
+        size: u32,
+        spp: u32,
+        seed: u64,
+    ) -> Image {
+        let view = w.read();
+        let world = GpuWorld::upload(ctx, &view).unwrap();
+        let tracer = PathTracer::new(ctx).unwrap();
+        let image = tracer
+            .render(
+                ctx,
+                &world,
+                &view,
+                p,
+                &RenderJob {
+                    width: size,
+                    height: size,
+                    spp,
+                    seed,
+                },
+            )
+            .unwrap();
+        tracer.destroy(ctx);
+        world.destroy(ctx);
+        image
+    }
+
+    fn cpu_render(w: &World, p: &SceneParams, size: u32, spp: u32, seed: u64) -> Image {
+        let view = w.read();
+        CpuScene::new(&view, p).render(&RenderJob {
+            width: size,
+            height: size,
+            spp,
+            seed,
+        })
+    }
+
+    #[test]
+    fn gpu_white_furnace_is_exact() {
+        let Some(ctx) = context(DeviceChoice::Best) else {
+            return;
+        };
+        for kind in [MaterialKind::Lambertian, MaterialKind::Metal] {
+            let w = World::new(
+                GridDims::new(4, 4, 4).unwrap(),
+                WorldConfig::with_workers(2),
+            )
+            .unwrap();
+            let m = add(&w, kind, 0, [255, 255, 255]);
+            w.apply(EditOp::Shape {
+                shape: Shape::Box {
+                    min: IVec3::splat(10),
+                    max: IVec3::splat(21),
+                },
+                mode: Mode::Add(m),
+            })
+            .unwrap();
+            let cam = Camera::looking_at(DVec3::new(-6.0, 40.0, -8.0), DVec3::splat(16.0), 40.0);
+            let sky = [0.7, 0.5, 0.3];
+            let img = gpu_render(
+                &ctx,
+                &w,
+                &params(cam, Sky::Uniform { colour: sky }, no_sun(), 4),
+                24,
+                4,
+                1,
+            );
+            for px in &img.pixels {
+                for c in 0..3 {
+                    assert!((px[c] - sky[c]).abs() < 1e-4, "{kind:?}: {px:?}");
+                }
+            }
+        }
+        assert_eq!(ctx.validation_errors(), 0);
+    }
+
+    #[test]
+    fn gpu_sun_disc_irradiance_matches_the_closed_form() {
+        let Some(ctx) = context(DeviceChoice::Best) else {
+            return;
+        };
+        let w = World::new(
+            GridDims::new(8, 2, 8).unwrap(),
+            WorldConfig::with_workers(2),
+        )
+        .unwrap();
+        let m = add(&w, MaterialKind::Lambertian, 0, [200, 200, 200]);
+        w.apply(EditOp::Shape {
+            shape: Shape::Box {
+                min: IVec3::ZERO,
+                max: IVec3::new(63, 3, 63),
+            },
+            mode: Mode::Add(m),
+        })
+        .unwrap();
+        let (r, d, l) = (6.0, 30.0, 5.0);
+        let sun = Sun {
+            enabled: true,
+            position: DVec3::new(32.0, 4.0 + d, 32.0),
+            radius: r,
+            colour: [1.0; 3],
+            intensity: l as f32,
+            animate: false,
+            speed_deg_per_s: 0.0,
+        };
+        let cam = Camera {
+            position: DVec3::new(32.0, 7.0, 32.0),
+            yaw_deg: 0.0,
+            pitch_deg: -89.0,
+            fov_y_deg: 0.5,
+        };
+        let expected = render::cpu::srgb_to_linear(200) * l * r * r / (r * r + d * d);
+        let img = gpu_render(
+            &ctx,
+            &w,
+            &params(cam, Sky::Uniform { colour: [0.0; 3] }, sun, 1),
+            16,
+            256,
+            5,
+        );
+        let v: Vec<f64> = img.pixels.iter().map(|p| p[0] as f64).collect();
+        let mean = v.iter().sum::<f64>() / v.len() as f64;
+        let se = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>()
+            / (v.len() as f64 - 1.0)
+            / v.len() as f64)
+            .sqrt();
+        assert!(
+            (mean - expected).abs() < 4.0 * se + 1e-3 * expected,
+            "{mean} ± {se}, expected {expected}"
+        );
+        assert_eq!(ctx.validation_errors(), 0);
+    }
+
+    #[test]
+    fn gpu_and_cpu_agree_within_sampling_noise() {
+        // If the GPU estimator is the CPU one, RMS(GPU − CPU₁) ≈ RMS(CPU₂ − CPU₁) for
+        // independent renders; a bias shows as a larger ratio (and a shifted mean).
+        let Some(ctx) = context(DeviceChoice::Best) else {
+            return;
+        };
+        let w = World::new(
+            GridDims::new(6, 4, 6).unwrap(),
+            WorldConfig::with_workers(2),
+        )
+        .unwrap();
+        let floor = add(&w, MaterialKind::Lambertian, 0, [150, 140, 120]);
+        let glass = add(&w, MaterialKind::Dielectric, 0, [240, 250, 255]);
+        let water = add(&w, MaterialKind::Dielectric, 1, [200, 230, 255]);
+        let rough = add(&w, MaterialKind::Metal, 30, [230, 200, 120]);
+        let mirror = add(&w, MaterialKind::Metal, 0, [250, 250, 250]);
+        w.set_param(MaterialKind::Emissive, 2, 6.0).unwrap();
+        let lamp = add(&w, MaterialKind::Emissive, 2, [255, 220, 180]);
+        for (shape, m) in [
+            (
+                Shape::Box {
+                    min: IVec3::ZERO,
+                    max: IVec3::new(47, 2, 47),
+                },
+                floor,
+            ),
+            (
+                Shape::Box {
+                    min: IVec3::new(0, 3, 28),
+                    max: IVec3::new(47, 5, 47),
+                },
+                water,
+            ),
+            (
+                Shape::Box {
+                    min: IVec3::new(8, 3, 8),
+                    max: IVec3::new(15, 10, 15),
+                },
+                glass,
+            ),
+            (
+                Shape::Sphere {
+                    centre: DVec3::new(30.0, 8.0, 14.0),
+                    radius: 5.0,
+                },
+                rough,
+            ),
+            (
+                Shape::Box {
+                    min: IVec3::new(40, 3, 4),
+                    max: IVec3::new(41, 14, 20),
+                },
+                mirror,
+            ),
+        ] {
+            w.apply(EditOp::Shape {
+                shape,
+                mode: Mode::Add(m),
+            })
+            .unwrap();
+        }
+        w.apply(EditOp::Voxels(vec![VoxelEdit {
+            pos: IVec3::new(22, 12, 30),
+            op: VoxelOp::Set(lamp),
+        }]))
+        .unwrap();
+        let sun = Sun {
+            enabled: true,
+            position: DVec3::new(80.0, 90.0, 60.0),
+            radius: 8.0,
+            colour: [1.0, 0.9, 0.8],
+            intensity: 15.0,
+            animate: false,
+            speed_deg_per_s: 0.0,
+        };
+        let cam = Camera::looking_at(
+            DVec3::new(-8.0, 26.0, -8.0),
+            DVec3::new(24.0, 6.0, 24.0),
+            55.0,
+        );
+        let p = params(
+            cam,
+            Sky::Gradient {
+                horizon: [0.8, 0.85, 1.0],
+                zenith: [0.2, 0.35, 0.8],
+            },
+            sun,
+            4,
+        );
+        let (size, spp) = (32, 64);
+        let g = gpu_render(&ctx, &w, &p, size, spp, 11);
+        let c1 = cpu_render(&w, &p, size, spp, 12);
+        let c2 = cpu_render(&w, &p, size, spp, 13);
+        assert!(g.all_finite());
+        let rms = |a: &Image, b: &Image| {
+            (a.pixels
+                .iter()
+                .zip(&b.pixels)
+                .map(|(x, y)| {
+                    (0..3)
+                        .map(|k| (x[k] as f64 - y[k] as f64).powi(2))
+                        .sum::<f64>()
+                })
+                .sum::<f64>()
+                / (3.0 * a.pixels.len() as f64))
+                .sqrt()
+        };
+        let (gc, cc) = (rms(&g, &c1), rms(&c2, &c1));
+        eprintln!(
+            "RMS(GPU − CPU) = {gc:.5}, RMS(CPU − CPU) = {cc:.5}, means {:?} vs {:?}",
+            g.mean(),
+            c1.mean()
+        );
+        assert!(
+            gc < 1.3 * cc,
+            "GPU differs from the CPU more than sampling noise: {gc} vs {cc}"
+        );
+        for k in 0..3 {
+            let (a, b) = (g.mean()[k], c1.mean()[k]);
+            assert!(
+                (a - b).abs() < 0.02 * b.max(1e-3) + 4.0 * cc / (g.pixels.len() as f64).sqrt(),
+                "channel {k}: {a} vs {b}"
+            );
+        }
+        assert_eq!(ctx.validation_errors(), 0);
+    }
 }

@@ -7,6 +7,8 @@ pub mod buffer;
 pub mod pass;
 pub mod primary;
 pub mod tonemap;
+pub mod trace;
+pub mod world;
 
 use ash::vk;
 use std::ffi::{CStr, c_void};

@@ -102,7 +102,7 @@ impl ComputePass {
         ctx: &GpuContext,
         buffers: &[&HostBuffer],
         push: &[u8],
-        groups: u32,
+        groups: [u32; 2],
     ) -> Result<(), GpuError> {
         assert_eq!(buffers.len() as u32, self.buffers, "one buffer per binding");
         let d = &ctx.device;
@@ -151,7 +151,7 @@ impl ComputePass {
                 if !push.is_empty() {
                     d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
                 }
-                d.cmd_dispatch(cmd, groups, 1, 1);
+                d.cmd_dispatch(cmd, groups[0], groups[1], 1);
                 let barrier = [vk::MemoryBarrier::default()
                     .src_access_mask(vk::AccessFlags::SHADER_WRITE)
                     .dst_access_mask(vk::AccessFlags::HOST_READ)];

@@ -4,8 +4,8 @@
 
 use super::buffer::HostBuffer;
 use super::pass::ComputePass;
+use super::world::GpuWorld;
 use super::{GpuContext, GpuError};
-use brickmap::{GpuBuffer, WorldView};
 use glam::{IVec3, Vec3};
 use gpu_allocator::MemoryLocation;
 
@@ -22,50 +22,6 @@ struct Push {
     words_per_column: u32,
 }
 const _: () = assert!(std::mem::size_of::<Push>() == 20);
-
-/// The world's five buffers on the GPU, bound at 0..4 by every shader.
-pub struct GpuWorld {
-    buffers: Vec<HostBuffer>,
-    dims: [u32; 3],
-    words_per_column: u32,
-}
-
-impl GpuWorld {
-    /// Uploads a world's current buffers.
-    pub fn upload(ctx: &GpuContext, view: &WorldView<'_>) -> Result<Self, GpuError> {
-        let mut buffers = Vec::new();
-        for (name, which) in [
-            ("brick index", GpuBuffer::BrickIndex),
-            ("bricks", GpuBuffer::Bricks),
-            ("coarse", GpuBuffer::Coarse),
-            ("material bytes", GpuBuffer::MaterialBytes),
-            ("material tables", GpuBuffer::MaterialTables),
-        ] {
-            let bytes = view.gpu_image(which);
-            match HostBuffer::new(ctx, name, bytes.len() as u64, MemoryLocation::CpuToGpu) {
-                Ok(mut b) => {
-                    b.write(&bytes);
-                    buffers.push(b);
-                }
-                Err(e) => {
-                    buffers.into_iter().for_each(|b| b.destroy(ctx));
-                    return Err(e);
-                }
-            }
-        }
-        let dims = view.dims();
-        Ok(Self {
-            buffers,
-            dims: dims.bricks().to_array(),
-            words_per_column: dims.coarse_words_per_column() as u32,
-        })
-    }
-
-    /// Frees the buffers.
-    pub fn destroy(self, ctx: &GpuContext) {
-        self.buffers.into_iter().for_each(|b| b.destroy(ctx));
-    }
-}
 
 /// The first hit of a ray on the GPU.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -121,17 +77,17 @@ impl PrimaryTracer {
         };
         input.write(bytemuck::cast_slice(&packed));
         let push = Push {
-            dims: world.dims,
+            dims: world.dims(),
             count: rays.len() as u32,
-            words_per_column: world.words_per_column,
+            words_per_column: world.words_per_column(),
         };
-        let mut bound: Vec<&HostBuffer> = world.buffers.iter().collect();
+        let mut bound: Vec<&HostBuffer> = world.buffers();
         bound.extend([&input, &output]);
         let result = self.0.run(
             ctx,
             &bound,
             bytemuck::bytes_of(&push),
-            (rays.len() as u32).div_ceil(GROUP),
+            [(rays.len() as u32).div_ceil(GROUP), 1],
         );
         let hits = result.map(|_| {
             let raw: &[[f32; 4]] = bytemuck::cast_slice(&output.read()[..rays.len() * 16]);

@@ -58,7 +58,7 @@ impl ToneMapper {
             ctx,
             &[&hdr, &ldr],
             bytemuck::bytes_of(&push),
-            pixels.div_ceil(GROUP),
+            [pixels.div_ceil(GROUP), 1],
         );
         let out = result.map(|_| {
             ldr.read()[..pixels as usize * 4]

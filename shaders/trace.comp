@@ -1,0 +1,301 @@
+// The path tracer: DESIGN.md's light transport, a line-by-line port of
+// render/src/cpu/mod.rs (CpuScene::radiance) in f32. Keep in sync with it and with
+// render/src/vulkan/trace.rs (TraceParams).
+#version 450
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#include "brickmap.glsl"
+
+struct Params {
+    vec4 cam_pos;       // xyz
+    vec4 cam_forward;   // xyz
+    vec4 cam_right;     // xyz, scaled by tan(fov/2)·aspect
+    vec4 cam_up;        // xyz, scaled by tan(fov/2)
+    vec4 sun_centre;    // xyz, w: radius
+    vec4 sun_normal;    // xyz, w: 1 when the sun is on
+    vec4 sun_e1;
+    vec4 sun_e2;
+    vec4 sun_radiance;  // rgb
+    vec4 sky_horizon;   // rgb
+    vec4 sky_zenith;    // rgb, w: 1 for a gradient, 0 for uniform (horizon colour)
+    uvec4 grid;         // bricks xyz, coarse words per column
+    uvec4 image;        // width, height, samples per pixel, max bounces B
+    uvec4 seed;         // seed, camera medium (material + 1, 0 for air), first sample index, unused
+};
+
+layout(std430, set = 0, binding = 5) readonly buffer ParamBuffer { Params p; };
+layout(std430, set = 0, binding = 6) writeonly buffer Accum { vec4 accum[]; };
+
+const float PI = 3.14159265358979;
+const int LAMBERTIAN = 0;
+const int METAL = 1;
+const int DIELECTRIC = 2;
+const int EMISSIVE = 3;
+
+uint rng;
+uint hash(uint x) {
+    x = x * 747796405u + 2891336453u;
+    x = ((x >> ((x >> 28u) + 4u)) ^ x) * 277803737u;
+    return (x >> 22u) ^ x;
+}
+float rand() {
+    rng = hash(rng);
+    return float(rng >> 8) * (1.0 / 16777216.0);
+}
+
+struct Shading { int kind; vec3 albedo; float param; };
+
+float srgb_to_linear(uint c) {
+    float x = float(c) / 255.0;
+    return x <= 0.04045 ? x / 12.92 : pow((x + 0.055) / 1.055, 2.4);
+}
+
+Shading material(int index) {
+    uint v = (tables.packed_materials[index / 2] >> (16 * (index % 2))) & 0xFFFFu;
+    Shading s;
+    s.kind = int(v & 3u);
+    uint param = (v >> 2) & 63u;
+    uint colour = tables.colours[v >> 8];
+    s.albedo = vec3(srgb_to_linear(colour & 0xFFu), srgb_to_linear((colour >> 8) & 0xFFu), srgb_to_linear((colour >> 16) & 0xFFu));
+    s.param = s.kind == METAL ? tables.roughness[param] : (s.kind == DIELECTRIC ? tables.ior[param] : (s.kind == EMISSIVE ? tables.strength[param] : 0.0));
+    return s;
+}
+
+vec3 sky(vec3 d) {
+    if (p.sky_zenith.w == 0.0) return p.sky_horizon.rgb;
+    float t = clamp(d.y, 0.0, 1.0);
+    return p.sky_horizon.rgb * (1.0 - t) + p.sky_zenith.rgb * t;
+}
+
+float sun_area() { return PI * p.sun_centre.w * p.sun_centre.w; }
+
+// Distance to the sun disc's front face along a unit ray, or -1; also its cosine.
+float sun_hit(vec3 o, vec3 d, out float cos_l) {
+    cos_l = 0.0;
+    if (p.sun_normal.w == 0.0) return -1.0;
+    float denom = dot(d, p.sun_normal.xyz);
+    if (denom >= 0.0) return -1.0;
+    float t = dot(p.sun_centre.xyz - o, p.sun_normal.xyz) / denom;
+    vec3 q = o + d * t - p.sun_centre.xyz;
+    if (!(t > 0.0) || dot(q, q) > p.sun_centre.w * p.sun_centre.w) return -1.0;
+    cos_l = -denom;
+    return t;
+}
+
+float power_heuristic(float a, float b) {
+    float s = a * a + b * b;
+    return s > 0.0 ? a * a / s : 0.0;
+}
+
+float ggx_d(vec3 h, float alpha) {
+    float a2 = alpha * alpha;
+    float t = (h.x * h.x + h.y * h.y) / a2 + h.z * h.z;
+    return 1.0 / (PI * a2 * t * t);
+}
+
+float ggx_lambda(vec3 w, float alpha) {
+    float tan2 = (w.x * w.x + w.y * w.y) / (w.z * w.z);
+    return (sqrt(1.0 + alpha * alpha * tan2) - 1.0) * 0.5;
+}
+
+vec3 ggx_sample_visible(vec3 wo, float alpha, float u1, float u2) {
+    vec3 vh = normalize(vec3(alpha * wo.x, alpha * wo.y, wo.z));
+    float lensq = vh.x * vh.x + vh.y * vh.y;
+    vec3 t1 = lensq > 0.0 ? vec3(-vh.y, vh.x, 0.0) / sqrt(lensq) : vec3(1.0, 0.0, 0.0);
+    vec3 t2 = cross(vh, t1);
+    float r = sqrt(u1);
+    float phi = 2.0 * PI * u2;
+    float p1 = r * cos(phi);
+    float s = 0.5 * (1.0 + vh.z);
+    float p2 = (1.0 - s) * sqrt(max(0.0, 1.0 - p1 * p1)) + s * r * sin(phi);
+    vec3 nh = t1 * p1 + t2 * p2 + vh * sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2));
+    return normalize(vec3(alpha * nh.x, alpha * nh.y, max(0.0, nh.z)));
+}
+
+// Frame around an axis-aligned normal: z = n.
+void frame(vec3 n, out vec3 t, out vec3 b) {
+    t = n.x != 0.0 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+    b = cross(n, t);
+}
+
+// BSDF value and the pdf the sampler would have chosen wi with.
+vec3 eval_bsdf(Shading s, vec3 wo, vec3 wi, out float pdf) {
+    pdf = 0.0;
+    if (wo.z <= 0.0 || wi.z <= 0.0) return vec3(0.0);
+    if (s.kind == LAMBERTIAN) {
+        pdf = wi.z / PI;
+        return s.albedo / PI;
+    }
+    if (s.kind == METAL && s.param > 0.0) {
+        float alpha = s.param * s.param;
+        vec3 h = normalize(wo + wi);
+        float d = ggx_d(h, alpha);
+        float g2 = 1.0 / (1.0 + ggx_lambda(wo, alpha) + ggx_lambda(wi, alpha));
+        float g1 = 1.0 / (1.0 + ggx_lambda(wo, alpha));
+        pdf = g1 * d / (4.0 * wo.z);
+        return s.albedo * (d * g2 / (4.0 * wo.z * wi.z));
+    }
+    return vec3(0.0);
+}
+
+// Samples wi: returns false when the path ends; weight = f·cos/pdf; pdf < 0 for delta lobes.
+bool sample_bsdf(Shading s, vec3 wo, out vec3 wi, out vec3 weight, out float pdf) {
+    weight = vec3(0.0);
+    pdf = -1.0;
+    wi = vec3(0.0, 0.0, 1.0);
+    if (s.kind == LAMBERTIAN) {
+        float u1 = rand();
+        float r = sqrt(u1);
+        float phi = 2.0 * PI * rand();
+        wi = vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - u1)));
+        weight = s.albedo;
+        pdf = wi.z / PI;
+        return wi.z > 0.0;
+    }
+    if (s.kind == METAL && s.param <= 0.0) {
+        wi = vec3(-wo.x, -wo.y, wo.z);
+        weight = s.albedo;
+        return true;
+    }
+    if (s.kind == METAL) {
+        float alpha = s.param * s.param;
+        if (wo.z <= 0.0) return false;
+        vec3 h = ggx_sample_visible(wo, alpha, rand(), rand());
+        wi = h * (2.0 * dot(wo, h)) - wo;
+        if (wi.z <= 0.0) return false;
+        float lo = ggx_lambda(wo, alpha);
+        weight = s.albedo * ((1.0 + lo) / (1.0 + lo + ggx_lambda(wi, alpha)));
+        pdf = ggx_d(h, alpha) / (4.0 * wo.z * (1.0 + lo));
+        return true;
+    }
+    return false;
+}
+
+vec3 radiance(vec3 origin, vec3 dir) {
+    vec3 l = vec3(0.0);
+    vec3 beta = vec3(1.0);
+    vec3 o = origin;
+    vec3 d = dir;
+    bool from_camera = true;
+    ivec3 start = ivec3(0);
+    int medium = int(p.seed.y) - 1;
+    float bsdf_pdf = -1.0; // < 0: delta or camera
+    uint bounces = p.image.w;
+    for (uint vertex = 1u; vertex <= bounces + 1u; vertex++) {
+        ivec3 voxel;
+        ivec3 normal;
+        float t_voxel;
+        bool hit = from_camera ? trace_from_origin(o, d, medium, 1.0 / 0.0, voxel, normal, t_voxel)
+                               : trace_from_cell(o, d, start, medium, 1.0 / 0.0, voxel, normal, t_voxel);
+        if (!hit) t_voxel = 1.0 / 0.0;
+        float cos_l;
+        float t_sun = sun_hit(o, d, cos_l);
+        if (t_sun > 0.0 && t_sun < t_voxel) {
+            float w = bsdf_pdf < 0.0 ? 1.0 : power_heuristic(bsdf_pdf, t_sun * t_sun / (cos_l * sun_area()));
+            l += beta * p.sun_radiance.rgb * w;
+            break;
+        }
+        if (!hit) {
+            l += beta * sky(d);
+            break;
+        }
+        vec3 pt = o + d * t_voxel;
+        vec3 n = vec3(normal);
+        int here = material_at(voxel);
+        Shading s;
+        if (here >= 0) s = material(here);
+        bool crossing = (here >= 0 && s.kind == DIELECTRIC) || (here < 0 && medium >= 0);
+        if (here >= 0 && s.kind == EMISSIVE) {
+            l += beta * s.albedo * s.param;
+            break;
+        }
+        if (vertex == bounces + 1u) break;
+        ivec3 front = voxel + normal;
+        if (crossing) {
+            float eta_i = medium >= 0 ? material(medium).param : 1.0;
+            float eta_t = here >= 0 ? s.param : 1.0;
+            vec3 tint = here >= 0 ? s.albedo : material(medium).albedo;
+            float cos_i = -dot(d, n);
+            float eta = eta_i / eta_t;
+            float sin2_t = eta * eta * max(0.0, 1.0 - cos_i * cos_i);
+            float f = 1.0;
+            float cos_t = 0.0;
+            if (sin2_t < 1.0) {
+                cos_t = sqrt(1.0 - sin2_t);
+                float rs = (eta_i * cos_i - eta_t * cos_t) / (eta_i * cos_i + eta_t * cos_t);
+                float rp = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
+                f = 0.5 * (rs * rs + rp * rp);
+            }
+            if (rand() < f) {
+                d = normalize(d + n * (2.0 * cos_i));
+                start = front;
+            } else {
+                d = normalize(d * eta + n * (eta * cos_i - cos_t));
+                start = voxel;
+                beta *= tint * (eta * eta);
+                medium = here;
+            }
+            bsdf_pdf = -1.0;
+        } else {
+            vec3 ft;
+            vec3 fb;
+            frame(n, ft, fb);
+            vec3 wo = vec3(dot(-d, ft), dot(-d, fb), dot(-d, n));
+            bool delta = s.kind == METAL && s.param <= 0.0;
+            if (!delta && p.sun_normal.w != 0.0) {
+                float r = p.sun_centre.w * sqrt(rand());
+                float phi = 2.0 * PI * rand();
+                vec3 y = p.sun_centre.xyz + (p.sun_e1.xyz * cos(phi) + p.sun_e2.xyz * sin(phi)) * r;
+                vec3 to = y - pt;
+                float dist = length(to);
+                vec3 w = to / dist;
+                float cl = -dot(w, p.sun_normal.xyz);
+                vec3 wi = vec3(dot(w, ft), dot(w, fb), dot(w, n));
+                if (cl > 0.0 && wi.z > 0.0) {
+                    float pdf_bsdf;
+                    vec3 fv = eval_bsdf(s, wo, wi, pdf_bsdf);
+                    ivec3 sv;
+                    ivec3 sn;
+                    float st;
+                    if (fv != vec3(0.0) && !trace_from_cell(pt, w, front, AIR, dist, sv, sn, st)) {
+                        float pdf_light = dist * dist / (cl * sun_area());
+                        l += beta * fv * wi.z * p.sun_radiance.rgb * power_heuristic(pdf_light, pdf_bsdf) / pdf_light;
+                    }
+                }
+            }
+            vec3 wi;
+            vec3 weight;
+            float pdf;
+            if (!sample_bsdf(s, wo, wi, weight, pdf)) break;
+            beta *= weight;
+            bsdf_pdf = pdf;
+            d = ft * wi.x + fb * wi.y + n * wi.z;
+            start = front;
+        }
+        o = pt;
+        from_camera = false;
+        if (vertex >= 4u) {
+            float q = clamp(max(beta.r, max(beta.g, beta.b)), 0.05, 1.0);
+            if (rand() >= q) break;
+            beta /= q;
+        }
+    }
+    return l;
+}
+
+void main() {
+    uvec2 px = gl_GlobalInvocationID.xy;
+    if (px.x >= p.image.x || px.y >= p.image.y) return;
+    g_dims = p.grid.xyz;
+    g_words_per_column = p.grid.w;
+    uint index = px.y * p.image.x + px.x;
+    vec3 sum = vec3(0.0);
+    for (uint s = 0u; s < p.image.z; s++) {
+        rng = hash(p.seed.x ^ hash(index * 9781u + (p.seed.z + s) * 6271u + 1u));
+        float u = (2.0 * (float(px.x) + rand()) / float(p.image.x) - 1.0);
+        float v = (1.0 - 2.0 * (float(px.y) + rand()) / float(p.image.y));
+        vec3 dir = normalize(p.cam_forward.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v);
+        sum += radiance(p.cam_pos.xyz, dir);
+    }
+    accum[index] = vec4(sum / float(max(p.image.z, 1u)), 1.0);
+}
