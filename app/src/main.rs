@@ -109,7 +109,8 @@ enum Command {
         /// .vox, framing the whole scene).
         #[arg(long)]
         camera: Option<String>,
-        /// gpu (the Vulkan renderer), cpu (the reference path tracer), or a device name.
+        /// gpu (the Vulkan path tracer on the best device), cpu (the reference path tracer), or
+        /// part of a Vulkan device's name.
         #[arg(long, default_value = "gpu")]
         device: String,
         /// Random seed.
@@ -133,6 +134,22 @@ enum Command {
         /// Render device for render steps: gpu or cpu.
         #[arg(long, default_value = "gpu")]
         device: String,
+    },
+    /// Time the GPU path tracer on the thesis scene with Vulkan timestamp queries: medians
+    /// after warm-up for the thesis's complexities 1, 2 and 3.
+    BenchGpu {
+        /// Internal resolution width.
+        #[arg(long, default_value_t = 1024)]
+        width: u32,
+        /// Internal resolution height.
+        #[arg(long, default_value_t = 576)]
+        height: u32,
+        /// Timed frames per complexity (after 5 warm-up frames).
+        #[arg(long, default_value_t = 50)]
+        frames: usize,
+        /// Device name filter (default: a discrete GPU if any).
+        #[arg(long)]
+        device: Option<String>,
     },
     /// Print a scene file's dimensions, voxel count, materials and memory.
     Info {
@@ -387,6 +404,12 @@ fn run(cli: Cli) -> Result<()> {
                 doc.scene.world.read().content_hash()
             ))
         }
+        Command::BenchGpu {
+            width,
+            height,
+            frames,
+            device,
+        } => bench_gpu(width, height, frames.max(1), device, workers),
         Command::Info { file } => {
             let started = Instant::now();
             let scene = with_progress(format!("reading {}", file.display()), || {
@@ -519,12 +542,6 @@ struct RenderArgs {
 }
 
 fn render_command(a: RenderArgs) -> Result<()> {
-    if a.device != "cpu" {
-        bail!(
-            "device {:?}: the Vulkan renderer is not built yet; the CPU reference renderer runs with --device cpu",
-            a.device
-        );
-    }
     if a.spp == 0 || a.width == 0 || a.height == 0 || a.width > 16384 || a.height > 16384 {
         bail!("--spp, --width and --height must be positive (sizes at most 16384)");
     }
@@ -548,7 +565,6 @@ fn render_command(a: RenderArgs) -> Result<()> {
         params.settings.max_bounces = b;
     }
     let view = scene.world.read();
-    let cpu = render::cpu::CpuScene::new(&view, &params);
     let job = render::cpu::RenderJob {
         width: a.width,
         height: a.height,
@@ -556,14 +572,67 @@ fn render_command(a: RenderArgs) -> Result<()> {
         seed: a.seed,
     };
     let started = Instant::now();
-    let image = with_progress(
-        format!(
-            "rendering {}x{} at {} spp on the CPU",
-            a.width, a.height, a.spp
-        ),
-        || Ok(cpu.render(&job)),
-    )?;
-    let seconds = started.elapsed().as_secs_f64();
+    let (image, backend, timing) = if a.device == "cpu" {
+        let cpu = render::cpu::CpuScene::new(&view, &params);
+        let image = with_progress(
+            format!(
+                "rendering {}x{} at {} spp on the CPU",
+                a.width, a.height, a.spp
+            ),
+            || Ok(cpu.render(&job)),
+        )?;
+        let seconds = started.elapsed().as_secs_f64();
+        let rays = cpu.rays_traced();
+        (
+            image,
+            "the CPU".to_string(),
+            format!(
+                "time         {seconds:.2} s\nrays         {rays} ({:.2} Mrays/s)\n",
+                rays as f64 / seconds / 1e6
+            ),
+        )
+    } else {
+        use render::vulkan::{
+            ContextOptions, DeviceChoice, GpuContext, trace::PathTracer, world::GpuWorld,
+        };
+        let choice = if a.device == "gpu" {
+            DeviceChoice::Best
+        } else {
+            DeviceChoice::Name(a.device.clone())
+        };
+        let ctx = GpuContext::new(&ContextOptions {
+            device: choice,
+            validation: false,
+        })
+        .with_context(
+            || "no usable Vulkan device (the CPU reference renderer runs with --device cpu)",
+        )?;
+        let world = GpuWorld::upload(&ctx, &view)?;
+        let tracer = PathTracer::new(&ctx)?;
+        let rendered = with_progress(
+            format!(
+                "rendering {}x{} at {} spp on {}",
+                a.width, a.height, a.spp, ctx.name
+            ),
+            || Ok(tracer.render(&ctx, &world, &view, &params, &job)?),
+        );
+        tracer.destroy(&ctx);
+        world.destroy(&ctx);
+        let (image, gpu) = rendered?;
+        let primary = a.width as f64 * a.height as f64 * a.spp as f64;
+        let timing = match gpu {
+            Some(t) => format!(
+                "gpu time     {:.3} ms (timestamp queries)\nprimary rays {:.1} M/s\n",
+                t * 1e3,
+                primary / t / 1e6
+            ),
+            None => format!(
+                "time         {:.2} s (this queue cannot take timestamps)\n",
+                started.elapsed().as_secs_f64()
+            ),
+        };
+        (image, ctx.name.clone(), timing)
+    };
     let write = |path: &PathBuf, f: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
         app::atomic::write_atomic(path, f).with_context(|| format!("writing {}", path.display()))
     };
@@ -573,13 +642,11 @@ fn render_command(a: RenderArgs) -> Result<()> {
     }
     let samples = a.width as u64 * a.height as u64 * a.spp as u64;
     emit(&format!(
-        "rendered     {samples} samples ({}x{} at {} spp, {} bounces) on the CPU in {seconds:.2} s\nrays         {} ({:.2} Mrays/s)\nwrote        {}\n",
+        "rendered     {samples} samples ({}x{} at {} spp, {} bounces) on {backend}\n{timing}wrote        {}\n",
         a.width,
         a.height,
         a.spp,
         params.settings.max_bounces,
-        cpu.rays_traced(),
-        cpu.rays_traced() as f64 / seconds / 1e6,
         a.out.display()
     ))
 }
@@ -594,4 +661,80 @@ fn parse_ivec3_f(s: &str) -> Result<DVec3> {
         [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(DVec3::new(x, y, z)),
         _ => bail!("{s:?} is not three finite numbers X,Y,Z"),
     }
+}
+
+fn bench_gpu(
+    width: u32,
+    height: u32,
+    frames: usize,
+    device: Option<String>,
+    workers: usize,
+) -> Result<()> {
+    use render::vulkan::{
+        ContextOptions, DeviceChoice, GpuContext, trace::PathTracer, world::GpuWorld,
+    };
+    let scene = thesis_scene(workers)?;
+    let choice = device.map_or(DeviceChoice::Best, DeviceChoice::Name);
+    let ctx = GpuContext::new(&ContextOptions {
+        device: choice,
+        validation: false,
+    })?;
+    let view = scene.world.read();
+    let world = GpuWorld::upload(&ctx, &view)?;
+    let tracer = PathTracer::new(&ctx)?;
+    let mut text = format!(
+        "device       {}\nscene        thesis (512x256x512, {} solid voxels), {width}x{height}\n",
+        ctx.name,
+        view.solid_count()
+    );
+    let mut failure = None;
+    for (label, bounces, spp, sun) in [
+        ("complexity 1 (1 bounce, 1 spp, no sun)", 1, 1, false),
+        ("complexity 2 (1 bounce, 1 spp, sun)", 1, 1, true),
+        ("complexity 3 (3 bounces, 2 spp, sun)", 3, 2, true),
+    ] {
+        let mut params = scene.params.clone();
+        params.settings.max_bounces = bounces;
+        params.sun.enabled = sun;
+        let mut times = Vec::with_capacity(frames);
+        for frame in 0..frames + 5 {
+            let job = render::cpu::RenderJob {
+                width,
+                height,
+                spp,
+                seed: frame as u64,
+            };
+            match tracer.time_frame(&ctx, &world, &view, &params, &job) {
+                Ok(Some(t)) if frame >= 5 => times.push(t),
+                Ok(_) => {}
+                Err(e) => {
+                    failure = Some(e);
+                    break;
+                }
+            }
+        }
+        if failure.is_some() {
+            break;
+        }
+        if times.is_empty() {
+            text += &format!("{label}: this queue cannot take timestamps\n");
+            continue;
+        }
+        times.sort_by(|a, b| a.total_cmp(b));
+        let median = times[times.len() / 2];
+        let primary = width as f64 * height as f64 * spp as f64 / median / 1e6;
+        text += &format!(
+            "{label}: median {:.3} ms (p10 {:.3}, p90 {:.3}, {} frames), {primary:.1} M primary rays/s\n",
+            median * 1e3,
+            times[times.len() / 10] * 1e3,
+            times[times.len() * 9 / 10] * 1e3,
+            times.len()
+        );
+    }
+    tracer.destroy(&ctx);
+    world.destroy(&ctx);
+    if let Some(e) = failure {
+        return Err(e.into());
+    }
+    emit(&text)
 }

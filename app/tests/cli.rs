@@ -188,8 +188,15 @@ fn render_on_the_cpu_writes_png_and_pfm() {
     let pfm_bytes = std::fs::read(&pfm).unwrap();
     assert!(pfm_bytes.starts_with(b"PF\n40 30\n"));
     assert_eq!(pfm_bytes.len(), b"PF\n40 30\n-1.0\n".len() + 40 * 30 * 12);
-    // The GPU renderer does not exist yet: a clear error, not a silent fallback.
-    let err = fails(&["render", s(&scene), "--out", s(&d.join("x.png"))]);
+    // A device that does not exist is a clear error naming the fallback, never a silent one.
+    let err = fails(&[
+        "render",
+        s(&scene),
+        "--out",
+        s(&d.join("x.png")),
+        "--device",
+        "no such gpu 9000",
+    ]);
     assert!(err.contains("--device cpu"), "{err}");
     assert!(!d.join("x.png").exists());
     assert!(

@@ -294,7 +294,8 @@ mod trace {
                     seed,
                 },
             )
-            .unwrap();
+            .unwrap()
+            .0;
         tracer.destroy(ctx);
         world.destroy(ctx);
         image

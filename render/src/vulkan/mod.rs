@@ -85,6 +85,8 @@ pub struct GpuContext {
     pub allocator: Mutex<Option<gpu_allocator::vulkan::Allocator>>,
     /// Device name.
     pub name: String,
+    /// Nanoseconds per timestamp tick (0 when the queue cannot time).
+    pub timestamp_period: f32,
 }
 
 unsafe extern "system" fn count_errors(
@@ -245,6 +247,13 @@ impl GpuContext {
                 return Err(e.into());
             }
         };
+        // SAFETY: plain query.
+        let limits = unsafe { instance.get_physical_device_properties(physical) }.limits;
+        let timestamp_period = if families[queue_family as usize].timestamp_valid_bits > 0 {
+            limits.timestamp_period
+        } else {
+            0.0
+        };
         let (instance, debug) = partial.take();
         Ok(Self {
             _entry: entry,
@@ -257,6 +266,7 @@ impl GpuContext {
             queue_family,
             allocator: Mutex::new(Some(allocator)),
             name,
+            timestamp_period,
         })
     }
 

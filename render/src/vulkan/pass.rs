@@ -104,6 +104,20 @@ impl ComputePass {
         push: &[u8],
         groups: [u32; 2],
     ) -> Result<(), GpuError> {
+        self.run_timed(ctx, buffers, push, groups, false)
+            .map(|_| ())
+    }
+
+    /// [`ComputePass::run`], also measuring the dispatch's GPU time with timestamp queries
+    /// when `time` is set (None when the queue cannot time).
+    pub fn run_timed(
+        &self,
+        ctx: &GpuContext,
+        buffers: &[&HostBuffer],
+        push: &[u8],
+        groups: [u32; 2],
+        time: bool,
+    ) -> Result<Option<f64>, GpuError> {
         assert_eq!(buffers.len() as u32, self.buffers, "one buffer per binding");
         let d = &ctx.device;
         let layouts = [self.set_layout];
@@ -137,6 +151,18 @@ impl ComputePass {
                 })
                 .collect();
             d.update_descriptor_sets(&writes, &[]);
+            let timed = time && ctx.timestamp_period > 0.0;
+            let queries = if timed {
+                let info = vk::QueryPoolCreateInfo::default()
+                    .query_type(vk::QueryType::TIMESTAMP)
+                    .query_count(2);
+                Some(vk_call(
+                    "vkCreateQueryPool",
+                    d.create_query_pool(&info, None),
+                )?)
+            } else {
+                None
+            };
             let result = ctx.submit_and_wait(|cmd| {
                 // Host writes before the submit are visible to the device (submission order).
                 d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
@@ -151,7 +177,14 @@ impl ComputePass {
                 if !push.is_empty() {
                     d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
                 }
+                if let Some(q) = queries {
+                    d.cmd_reset_query_pool(cmd, q, 0, 2);
+                    d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, q, 0);
+                }
                 d.cmd_dispatch(cmd, groups[0], groups[1], 1);
+                if let Some(q) = queries {
+                    d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, q, 1);
+                }
                 let barrier = [vk::MemoryBarrier::default()
                     .src_access_mask(vk::AccessFlags::SHADER_WRITE)
                     .dst_access_mask(vk::AccessFlags::HOST_READ)];
@@ -166,7 +199,25 @@ impl ComputePass {
                 );
             });
             let _ = d.free_descriptor_sets(self.pool, &[set]);
-            result
+            let mut elapsed = None;
+            if let Some(q) = queries {
+                let mut ticks = [0u64; 2];
+                if result.is_ok()
+                    && d.get_query_pool_results(
+                        q,
+                        0,
+                        &mut ticks,
+                        vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                    )
+                    .is_ok()
+                {
+                    elapsed = Some(
+                        ticks[1].wrapping_sub(ticks[0]) as f64 * ctx.timestamp_period as f64 * 1e-9,
+                    );
+                }
+                d.destroy_query_pool(q, None);
+            }
+            result.map(|_| elapsed)
         }
     }
 

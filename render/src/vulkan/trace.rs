@@ -118,7 +118,8 @@ impl PathTracer {
         Ok(Self(ComputePass::new(ctx, SPIRV, 7, 0)?))
     }
 
-    /// Renders `job.spp` samples per pixel; returns the linear image. Samples go in batches
+    /// Renders `job.spp` samples per pixel; returns the linear image and the GPU time spent
+    /// (timestamp queries summed over the dispatches; None when the queue cannot time). Samples go in batches
     /// of at most [`SAMPLES_PER_DISPATCH`] per dispatch (averaged on the host): long-running
     /// invocations lose samples on lavapipe (measured: 256 samples per invocation came out 9%
     /// dark there, exact on the H100), and short dispatches are what a viewport does anyway.
@@ -129,7 +130,7 @@ impl PathTracer {
         view: &WorldView<'_>,
         params: &SceneParams,
         job: &RenderJob,
-    ) -> Result<Image, GpuError> {
+    ) -> Result<(Image, Option<f64>), GpuError> {
         let pixels = job.width as u64 * job.height as u64;
         let mut uniforms = HostBuffer::new(
             ctx,
@@ -149,6 +150,7 @@ impl PathTracer {
         let mut sum = vec![[0f64; 3]; pixels as usize];
         let mut result = Ok(());
         let mut done = 0;
+        let mut gpu_seconds = Some(0.0);
         while done < job.spp && result.is_ok() {
             let batch = (job.spp - done).min(SAMPLES_PER_DISPATCH);
             let mut p = base;
@@ -157,12 +159,16 @@ impl PathTracer {
             uniforms.write(bytemuck::bytes_of(&p));
             let mut bound = world.buffers();
             bound.extend([&uniforms, &accum]);
-            result = self.0.run(
-                ctx,
-                &bound,
-                &[],
-                [job.width.div_ceil(8), job.height.div_ceil(8)],
-            );
+            result = self
+                .0
+                .run_timed(
+                    ctx,
+                    &bound,
+                    &[],
+                    [job.width.div_ceil(8), job.height.div_ceil(8)],
+                    true,
+                )
+                .map(|t| gpu_seconds = gpu_seconds.zip(t).map(|(a, b)| a + b));
             if result.is_ok() {
                 let raw: &[[f32; 4]] = bytemuck::cast_slice(&accum.read()[..pixels as usize * 16]);
                 for (s, px) in sum.iter_mut().zip(raw) {
@@ -174,17 +180,66 @@ impl PathTracer {
             done += batch;
         }
         let n = job.spp.max(1) as f64;
-        let image = result.map(|_| Image {
-            width: job.width,
-            height: job.height,
-            pixels: sum
-                .iter()
-                .map(|s| [(s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32])
-                .collect(),
+        let image = result.map(|_| {
+            (
+                Image {
+                    width: job.width,
+                    height: job.height,
+                    pixels: sum
+                        .iter()
+                        .map(|s| [(s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32])
+                        .collect(),
+                },
+                gpu_seconds,
+            )
         });
         uniforms.destroy(ctx);
         accum.destroy(ctx);
         image
+    }
+
+    /// One dispatch of `job.spp` (at most [`SAMPLES_PER_DISPATCH`]) samples per pixel, timed
+    /// on the GPU with timestamp queries; seconds (None when the queue cannot time).
+    pub fn time_frame(
+        &self,
+        ctx: &GpuContext,
+        world: &GpuWorld,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        job: &RenderJob,
+    ) -> Result<Option<f64>, GpuError> {
+        assert!(
+            job.spp <= SAMPLES_PER_DISPATCH,
+            "one dispatch holds at most {SAMPLES_PER_DISPATCH} samples"
+        );
+        let pixels = job.width as u64 * job.height as u64;
+        let mut uniforms = HostBuffer::new(
+            ctx,
+            "trace params",
+            std::mem::size_of::<TraceParams>() as u64,
+            MemoryLocation::CpuToGpu,
+        )?;
+        let accum =
+            match HostBuffer::new(ctx, "accumulation", pixels * 16, MemoryLocation::GpuToCpu) {
+                Ok(b) => b,
+                Err(e) => {
+                    uniforms.destroy(ctx);
+                    return Err(e);
+                }
+            };
+        uniforms.write(bytemuck::bytes_of(&TraceParams::new(view, params, job)));
+        let mut bound = world.buffers();
+        bound.extend([&uniforms, &accum]);
+        let result = self.0.run_timed(
+            ctx,
+            &bound,
+            &[],
+            [job.width.div_ceil(8), job.height.div_ceil(8)],
+            true,
+        );
+        uniforms.destroy(ctx);
+        accum.destroy(ctx);
+        result
     }
 
     /// Destroys the pipeline.
