@@ -1,4 +1,5 @@
-//! Host-visible storage buffers (CPU writes, GPU reads and writes, CPU reads back).
+//! Storage buffers: host-visible ones the CPU writes and reads back, and device-local ones
+//! filled by a copy from a host-visible staging buffer.
 
 use super::{GpuContext, GpuError, vk_call};
 use ash::vk;
@@ -15,7 +16,8 @@ pub struct HostBuffer {
 }
 
 impl HostBuffer {
-    /// A buffer of `size` bytes (at least 4) at `location` (CpuToGpu or GpuToCpu).
+    /// A buffer of `size` bytes (at least 4) at `location` (CpuToGpu, GpuToCpu, or GpuOnly for
+    /// device-local memory, which only [`HostBuffer::upload`] fills).
     pub fn new(
         ctx: &GpuContext,
         name: &str,
@@ -25,7 +27,11 @@ impl HostBuffer {
         let size = size.max(4);
         let info = vk::BufferCreateInfo::default()
             .size(size)
-            .usage(vk::BufferUsageFlags::STORAGE_BUFFER)
+            .usage(
+                vk::BufferUsageFlags::STORAGE_BUFFER
+                    | vk::BufferUsageFlags::TRANSFER_SRC
+                    | vk::BufferUsageFlags::TRANSFER_DST,
+            )
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: the create info outlives the call; the buffer is destroyed in `destroy`.
         let raw = vk_call("vkCreateBuffer", unsafe {
@@ -68,6 +74,53 @@ impl HostBuffer {
             allocation: Some(allocation),
             size,
         })
+    }
+
+    /// A device-local buffer holding `bytes`, copied there through a staging buffer; the
+    /// copy is made visible to compute shaders.
+    pub fn upload(ctx: &GpuContext, name: &str, bytes: &[u8]) -> Result<Self, GpuError> {
+        let mut staging =
+            HostBuffer::new(ctx, "staging", bytes.len() as u64, MemoryLocation::CpuToGpu)?;
+        staging.write(bytes);
+        let target = match HostBuffer::new(ctx, name, bytes.len() as u64, MemoryLocation::GpuOnly) {
+            Ok(b) => b,
+            Err(e) => {
+                staging.destroy(ctx);
+                return Err(e);
+            }
+        };
+        let size = staging.size.min(target.size);
+        let copied = ctx.submit_and_wait(|cmd| {
+            // SAFETY: both buffers live until after the fence wait inside submit_and_wait.
+            unsafe {
+                ctx.device.cmd_copy_buffer(
+                    cmd,
+                    staging.raw,
+                    target.raw,
+                    &[vk::BufferCopy::default().size(size)],
+                );
+                let barrier = [vk::MemoryBarrier::default()
+                    .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
+                    .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE)];
+                ctx.device.cmd_pipeline_barrier(
+                    cmd,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::PipelineStageFlags::COMPUTE_SHADER,
+                    vk::DependencyFlags::empty(),
+                    &barrier,
+                    &[],
+                    &[],
+                );
+            }
+        });
+        staging.destroy(ctx);
+        match copied {
+            Ok(()) => Ok(target),
+            Err(e) => {
+                target.destroy(ctx);
+                Err(e)
+            }
+        }
     }
 
     /// Copies bytes into the start of the buffer.

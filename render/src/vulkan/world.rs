@@ -1,12 +1,11 @@
 //! The world on the GPU: the brickmap's five buffers (brick index, bricks, coarse grid,
 //! material bytes, material tables) uploaded as they are, bound at 0..4 by every shader
-//! (`shaders/brickmap.glsl`). Host-visible for now; device-local buffers fed by a staging ring
-//! from `World::take_dirty` + `WorldView::copy_gpu_range` come next.
+//! (`shaders/brickmap.glsl`), in device-local memory through a staging copy. Incremental
+//! updates (a staging ring fed by `World::take_dirty` + `WorldView::copy_gpu_range`) come next.
 
 use super::buffer::HostBuffer;
 use super::{GpuContext, GpuError};
 use brickmap::{GpuBuffer, WorldView};
-use gpu_allocator::MemoryLocation;
 
 /// The world's five buffers on the GPU, bound at 0..4 by every shader.
 pub struct GpuWorld {
@@ -27,9 +26,8 @@ impl GpuWorld {
             ("material tables", GpuBuffer::MaterialTables),
         ] {
             let bytes = view.gpu_image(which);
-            match HostBuffer::new(ctx, name, bytes.len() as u64, MemoryLocation::CpuToGpu) {
-                Ok(mut b) => {
-                    b.write(&bytes);
+            match HostBuffer::upload(ctx, name, &bytes) {
+                Ok(b) => {
                     buffers.push(b);
                 }
                 Err(e) => {
