@@ -7,4 +7,4 @@ pub mod params;
 pub mod vulkan;
 
 pub use image::Image;
-pub use params::{Camera, ParamError, RenderSettings, SceneParams, Sky, Sun};
+pub use params::{Camera, ParamError, RenderSettings, SceneParams, Sky, Sun, SunDisc};

@@ -65,6 +65,17 @@ impl Camera {
             -yaw.cos() * pitch.cos(),
         )
     }
+    /// The image-plane basis for an aspect ratio (width / height): (forward, right, up), with
+    /// right and up scaled so that pixel (u, v) in [−1, 1]² looks along
+    /// forward + right·u + up·v. Both renderers derive camera rays from this.
+    pub fn basis(&self, aspect: f64) -> (DVec3, DVec3, DVec3) {
+        let forward = self.forward();
+        let right = forward.cross(DVec3::Y).normalize();
+        let up = right.cross(forward);
+        let tan = (self.fov_y_deg.to_radians() * 0.5).tan();
+        (forward, right * tan * aspect, up * tan)
+    }
+
     /// A camera at `position` looking at `target`.
     pub fn looking_at(position: DVec3, target: DVec3, fov_y_deg: f64) -> Self {
         let d = (target - position).normalize_or(DVec3::NEG_Z);
@@ -125,7 +136,47 @@ pub struct Sun {
     pub speed_deg_per_s: f64,
 }
 
+/// The sun as both renderers sample it: a one-sided disc facing the grid centre.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SunDisc {
+    /// Disc centre.
+    pub centre: DVec3,
+    /// Unit normal of the emitting face (towards the grid centre).
+    pub normal: DVec3,
+    /// Unit vectors spanning the disc.
+    pub e1: DVec3,
+    /// See `e1`.
+    pub e2: DVec3,
+    /// Radius.
+    pub radius: f64,
+    /// Emitted radiance (colour × intensity).
+    pub radiance: DVec3,
+}
+
 impl Sun {
+    /// The disc facing `grid_centre`, or None when the sun is off, dark, or at the centre.
+    pub fn disc(&self, grid_centre: DVec3) -> Option<SunDisc> {
+        if !self.enabled || self.intensity <= 0.0 || self.position == grid_centre {
+            return None;
+        }
+        let normal = (grid_centre - self.position).normalize();
+        let helper = if normal.x.abs() < 0.9 {
+            DVec3::X
+        } else {
+            DVec3::Y
+        };
+        let e1 = normal.cross(helper).normalize();
+        let c = self.colour;
+        Some(SunDisc {
+            centre: self.position,
+            normal,
+            e1,
+            e2: normal.cross(e1),
+            radius: self.radius,
+            radiance: DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64) * self.intensity as f64,
+        })
+    }
+
     /// Checks every field.
     pub fn validate(&self) -> Result<(), ParamError> {
         check(

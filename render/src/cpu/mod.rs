@@ -15,7 +15,7 @@
 pub mod sampling;
 
 use crate::image::Image;
-use crate::params::{SceneParams, Sky};
+use crate::params::{SceneParams, Sky, SunDisc};
 use brickmap::{MaterialKind, Occupancy, Ray, RayHit, WorldView};
 use glam::{DVec3, IVec3, UVec3};
 use sampling::{
@@ -31,17 +31,6 @@ struct Shading {
     albedo: DVec3,
     /// Roughness (metal), IOR (dielectric) or strength (emissive).
     param: f64,
-}
-
-/// The sun as the integrator sees it: a one-sided disc facing the grid centre.
-#[derive(Clone, Copy, Debug)]
-struct SunDisc {
-    centre: DVec3,
-    normal: DVec3,
-    e1: DVec3,
-    e2: DVec3,
-    radius: f64,
-    radiance: DVec3,
 }
 
 impl SunDisc {
@@ -143,26 +132,7 @@ impl<'a, 'w> CpuScene<'a, 'w> {
                 }
             })
             .collect();
-        let centre = view.dims().voxels().as_dvec3() * 0.5;
-        let s = &params.sun;
-        let sun = (s.enabled && s.intensity > 0.0 && s.position != centre).then(|| {
-            let normal = (centre - s.position).normalize();
-            let helper = if normal.x.abs() < 0.9 {
-                DVec3::X
-            } else {
-                DVec3::Y
-            };
-            let e1 = normal.cross(helper).normalize();
-            SunDisc {
-                centre: s.position,
-                normal,
-                e1,
-                e2: normal.cross(e1),
-                radius: s.radius,
-                radiance: DVec3::new(s.colour[0] as f64, s.colour[1] as f64, s.colour[2] as f64)
-                    * s.intensity as f64,
-            }
-        });
+        let sun = params.sun.disc(view.dims().voxels().as_dvec3() * 0.5);
         Self {
             view,
             materials,
@@ -250,15 +220,13 @@ impl<'a, 'w> CpuScene<'a, 'w> {
     /// The camera ray through image position (x, y) in pixels (fractional: the box filter
     /// comes from jittering within the pixel).
     pub fn camera_ray(&self, x: f64, y: f64, width: u32, height: u32) -> (DVec3, DVec3) {
-        let c = &self.camera;
-        let forward = c.forward();
-        let right = forward.cross(DVec3::Y).normalize();
-        let up = right.cross(forward);
-        let tan = (c.fov_y_deg.to_radians() * 0.5).tan();
-        let aspect = width as f64 / height as f64;
-        let u = (2.0 * x / width as f64 - 1.0) * tan * aspect;
-        let v = (1.0 - 2.0 * y / height as f64) * tan;
-        (c.position, (forward + right * u + up * v).normalize())
+        let (forward, right, up) = self.camera.basis(width as f64 / height as f64);
+        let u = 2.0 * x / width as f64 - 1.0;
+        let v = 1.0 - 2.0 * y / height as f64;
+        (
+            self.camera.position,
+            (forward + right * u + up * v).normalize(),
+        )
     }
 
     /// One sample of the radiance arriving at `origin` from direction `−dir` (unit `dir`).

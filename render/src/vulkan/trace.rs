@@ -9,7 +9,7 @@ use crate::cpu::RenderJob;
 use crate::image::Image;
 use crate::params::{SceneParams, Sky};
 use brickmap::{MaterialKind, WorldView};
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use gpu_allocator::MemoryLocation;
 
 const SPIRV: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/trace.comp.spv"));
@@ -46,19 +46,14 @@ impl TraceParams {
     /// The parameters of a render, derived exactly as `CpuScene::new` derives them.
     pub fn new(view: &WorldView<'_>, params: &SceneParams, job: &RenderJob) -> Self {
         let c = &params.camera;
-        let forward = c.forward();
-        let right = forward.cross(DVec3::Y).normalize();
-        let up = right.cross(forward);
-        let tan = (c.fov_y_deg.to_radians() * 0.5).tan();
-        let aspect = job.width as f64 / job.height as f64;
+        let (forward, right, up) = c.basis(job.width as f64 / job.height as f64);
         let dims = view.dims();
         let centre = dims.voxels().as_dvec3() * 0.5;
-        let s = &params.sun;
         let mut p = TraceParams {
             cam_pos: v4(c.position, 0.0),
             cam_forward: v4(forward, 0.0),
-            cam_right: v4(right * tan * aspect, 0.0),
-            cam_up: v4(up * tan, 0.0),
+            cam_right: v4(right, 0.0),
+            cam_up: v4(up, 0.0),
             grid: [
                 dims.bricks().x,
                 dims.bricks().y,
@@ -68,20 +63,12 @@ impl TraceParams {
             image: [job.width, job.height, job.spp, params.settings.max_bounces],
             ..Default::default()
         };
-        if s.enabled && s.intensity > 0.0 && s.position != centre {
-            let normal = (centre - s.position).normalize();
-            let helper = if normal.x.abs() < 0.9 {
-                DVec3::X
-            } else {
-                DVec3::Y
-            };
-            let e1 = normal.cross(helper).normalize();
-            p.sun_centre = v4(s.position, s.radius as f32);
-            p.sun_normal = v4(normal, 1.0);
-            p.sun_e1 = v4(e1, 0.0);
-            p.sun_e2 = v4(normal.cross(e1), 0.0);
-            let r = Vec3::from_array(s.colour) * s.intensity;
-            p.sun_radiance = [r.x, r.y, r.z, 0.0];
+        if let Some(sun) = params.sun.disc(centre) {
+            p.sun_centre = v4(sun.centre, sun.radius as f32);
+            p.sun_normal = v4(sun.normal, 1.0);
+            p.sun_e1 = v4(sun.e1, 0.0);
+            p.sun_e2 = v4(sun.e2, 0.0);
+            p.sun_radiance = v4(sun.radiance, 0.0);
         }
         match &params.sky {
             Sky::Uniform { colour } => p.sky_horizon = [colour[0], colour[1], colour[2], 0.0],
@@ -109,6 +96,23 @@ impl TraceParams {
     }
 }
 
+/// The parameter buffer and the accumulation buffer of a frame of `pixels` pixels.
+fn frame_buffers(ctx: &GpuContext, pixels: u64) -> Result<(HostBuffer, HostBuffer), GpuError> {
+    let uniforms = HostBuffer::new(
+        ctx,
+        "trace params",
+        std::mem::size_of::<TraceParams>() as u64,
+        MemoryLocation::CpuToGpu,
+    )?;
+    match HostBuffer::new(ctx, "accumulation", pixels * 16, MemoryLocation::GpuToCpu) {
+        Ok(accum) => Ok((uniforms, accum)),
+        Err(e) => {
+            uniforms.destroy(ctx);
+            Err(e)
+        }
+    }
+}
+
 /// The path-tracing pipeline.
 pub struct PathTracer(ComputePass);
 
@@ -132,20 +136,7 @@ impl PathTracer {
         job: &RenderJob,
     ) -> Result<(Image, Option<f64>), GpuError> {
         let pixels = job.width as u64 * job.height as u64;
-        let mut uniforms = HostBuffer::new(
-            ctx,
-            "trace params",
-            std::mem::size_of::<TraceParams>() as u64,
-            MemoryLocation::CpuToGpu,
-        )?;
-        let accum =
-            match HostBuffer::new(ctx, "accumulation", pixels * 16, MemoryLocation::GpuToCpu) {
-                Ok(b) => b,
-                Err(e) => {
-                    uniforms.destroy(ctx);
-                    return Err(e);
-                }
-            };
+        let (mut uniforms, accum) = frame_buffers(ctx, pixels)?;
         let base = TraceParams::new(view, params, job);
         let mut sum = vec![[0f64; 3]; pixels as usize];
         let mut result = Ok(());
@@ -213,20 +204,7 @@ impl PathTracer {
             "one dispatch holds at most {SAMPLES_PER_DISPATCH} samples"
         );
         let pixels = job.width as u64 * job.height as u64;
-        let mut uniforms = HostBuffer::new(
-            ctx,
-            "trace params",
-            std::mem::size_of::<TraceParams>() as u64,
-            MemoryLocation::CpuToGpu,
-        )?;
-        let accum =
-            match HostBuffer::new(ctx, "accumulation", pixels * 16, MemoryLocation::GpuToCpu) {
-                Ok(b) => b,
-                Err(e) => {
-                    uniforms.destroy(ctx);
-                    return Err(e);
-                }
-            };
+        let (mut uniforms, accum) = frame_buffers(ctx, pixels)?;
         uniforms.write(bytemuck::bytes_of(&TraceParams::new(view, params, job)));
         let mut bound = world.buffers();
         bound.extend([&uniforms, &accum]);
