@@ -379,20 +379,14 @@ fn run(cli: Cli) -> Result<()> {
                 doc.scene.save(path)?;
             }
             if let Some(path) = &render {
-                if device != "cpu" {
-                    bail!(
-                        "--render: the Vulkan renderer is not built yet; replay with --device cpu"
-                    );
-                }
                 let view = doc.scene.world.read();
-                let image = render::cpu::CpuScene::new(&view, &doc.scene.params).render(
-                    &render::cpu::RenderJob {
-                        width: 512,
-                        height: 288,
-                        spp: 16,
-                        seed: 1,
-                    },
-                );
+                let job = render::cpu::RenderJob {
+                    width: 512,
+                    height: 288,
+                    spp: 16,
+                    seed: 1,
+                };
+                let (image, _, _) = render_on(&device, &view, &doc.scene.params, &job)?;
                 app::atomic::write_atomic(path, |w| {
                     image.write_png(w, doc.scene.params.settings.exposure)
                 })?;
@@ -571,68 +565,7 @@ fn render_command(a: RenderArgs) -> Result<()> {
         spp: a.spp,
         seed: a.seed,
     };
-    let started = Instant::now();
-    let (image, backend, timing) = if a.device == "cpu" {
-        let cpu = render::cpu::CpuScene::new(&view, &params);
-        let image = with_progress(
-            format!(
-                "rendering {}x{} at {} spp on the CPU",
-                a.width, a.height, a.spp
-            ),
-            || Ok(cpu.render(&job)),
-        )?;
-        let seconds = started.elapsed().as_secs_f64();
-        let rays = cpu.rays_traced();
-        (
-            image,
-            "the CPU".to_string(),
-            format!(
-                "time         {seconds:.2} s\nrays         {rays} ({:.2} Mrays/s)\n",
-                rays as f64 / seconds / 1e6
-            ),
-        )
-    } else {
-        use render::vulkan::{
-            ContextOptions, DeviceChoice, GpuContext, trace::PathTracer, world::GpuWorld,
-        };
-        let choice = if a.device == "gpu" {
-            DeviceChoice::Best
-        } else {
-            DeviceChoice::Name(a.device.clone())
-        };
-        let ctx = GpuContext::new(&ContextOptions {
-            device: choice,
-            validation: false,
-        })
-        .with_context(
-            || "no usable Vulkan device (the CPU reference renderer runs with --device cpu)",
-        )?;
-        let world = GpuWorld::upload(&ctx, &view)?;
-        let tracer = PathTracer::new(&ctx)?;
-        let rendered = with_progress(
-            format!(
-                "rendering {}x{} at {} spp on {}",
-                a.width, a.height, a.spp, ctx.name
-            ),
-            || Ok(tracer.render(&ctx, &world, &view, &params, &job)?),
-        );
-        tracer.destroy(&ctx);
-        world.destroy(&ctx);
-        let (image, gpu) = rendered?;
-        let primary = a.width as f64 * a.height as f64 * a.spp as f64;
-        let timing = match gpu {
-            Some(t) => format!(
-                "gpu time     {:.3} ms (timestamp queries)\nprimary rays {:.1} M/s\n",
-                t * 1e3,
-                primary / t / 1e6
-            ),
-            None => format!(
-                "time         {:.2} s (this queue cannot take timestamps)\n",
-                started.elapsed().as_secs_f64()
-            ),
-        };
-        (image, ctx.name.clone(), timing)
-    };
+    let (image, backend, timing) = render_on(&a.device, &view, &params, &job)?;
     let write = |path: &PathBuf, f: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
         app::atomic::write_atomic(path, f).with_context(|| format!("writing {}", path.display()))
     };
@@ -737,4 +670,76 @@ fn bench_gpu(
         return Err(e.into());
     }
     emit(&text)
+}
+
+/// Renders on a device: "cpu" (the reference), "gpu" (the best Vulkan device) or part of a
+/// device's name. Returns the image, the device's name and a timing report.
+fn render_on(
+    device: &str,
+    view: &brickmap::WorldView<'_>,
+    params: &render::SceneParams,
+    job: &render::cpu::RenderJob,
+) -> Result<(render::Image, String, String)> {
+    let started = Instant::now();
+    Ok(if device == "cpu" {
+        let cpu = render::cpu::CpuScene::new(view, params);
+        let image = with_progress(
+            format!(
+                "rendering {}x{} at {} spp on the CPU",
+                job.width, job.height, job.spp
+            ),
+            || Ok(cpu.render(job)),
+        )?;
+        let seconds = started.elapsed().as_secs_f64();
+        let rays = cpu.rays_traced();
+        (
+            image,
+            "the CPU".to_string(),
+            format!(
+                "time         {seconds:.2} s\nrays         {rays} ({:.2} Mrays/s)\n",
+                rays as f64 / seconds / 1e6
+            ),
+        )
+    } else {
+        use render::vulkan::{
+            ContextOptions, DeviceChoice, GpuContext, trace::PathTracer, world::GpuWorld,
+        };
+        let choice = if device == "gpu" {
+            DeviceChoice::Best
+        } else {
+            DeviceChoice::Name(device.to_string())
+        };
+        let ctx = GpuContext::new(&ContextOptions {
+            device: choice,
+            validation: false,
+        })
+        .with_context(
+            || "no usable Vulkan device (the CPU reference renderer runs with --device cpu)",
+        )?;
+        let world = GpuWorld::upload(&ctx, view)?;
+        let tracer = PathTracer::new(&ctx)?;
+        let rendered = with_progress(
+            format!(
+                "rendering {}x{} at {} spp on {}",
+                job.width, job.height, job.spp, ctx.name
+            ),
+            || Ok(tracer.render(&ctx, &world, view, params, job)?),
+        );
+        tracer.destroy(&ctx);
+        world.destroy(&ctx);
+        let (image, gpu) = rendered?;
+        let primary = job.width as f64 * job.height as f64 * job.spp as f64;
+        let timing = match gpu {
+            Some(t) => format!(
+                "gpu time     {:.3} ms (timestamp queries)\nprimary rays {:.1} M/s\n",
+                t * 1e3,
+                primary / t / 1e6
+            ),
+            None => format!(
+                "time         {:.2} s (this queue cannot take timestamps)\n",
+                started.elapsed().as_secs_f64()
+            ),
+        };
+        (image, ctx.name.clone(), timing)
+    })
 }

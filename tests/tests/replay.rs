@@ -142,11 +142,11 @@ fn failures_name_the_step_and_what_differed() {
     // The project saved before the failing step is complete.
     let kept = app::formats::project::load(&out.join("kept.ron"), 1).unwrap();
     assert!(kept.world.read().solid_count() > 0);
-    // Rendering on a device that does not exist yet is refused by name.
+    // Rendering on a device that does not exist is refused, naming the CPU alternative.
     let parsed =
         script::parse(&format!("{head} Render((spp: 1, width: 4, height: 4)) ])")).unwrap();
     let gpu = ReplayOptions {
-        device: "gpu".into(),
+        device: "no such gpu 9000".into(),
         ..options(1, &out)
     };
     let err = format!(
@@ -221,4 +221,41 @@ fn the_readme_example_is_a_tested_script() {
         block, file,
         "README's example must be tests/scripts/readme_example.ron"
     );
+}
+
+#[test]
+fn gpu_renders_in_scripts_match_the_cpu_reference() {
+    // Needs a Vulkan driver (lavapipe in CI); skips, saying so, only where there is none and
+    // VOXBRICK_REQUIRE_GPU is not set.
+    if render::vulkan::GpuContext::new(&Default::default()).is_err() {
+        assert_ne!(
+            std::env::var("VOXBRICK_REQUIRE_GPU").as_deref(),
+            Ok("1"),
+            "no Vulkan device, and VOXBRICK_REQUIRE_GPU=1"
+        );
+        eprintln!("SKIPPED: no Vulkan driver on this machine");
+        return;
+    }
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/gpu/gpu_vs_cpu.ron");
+    let out = scratch("gpu");
+    let gpu = ReplayOptions {
+        device: "gpu".into(),
+        ..options(2, &out)
+    };
+    let mut lines = Vec::new();
+    script::replay_file(&path, &gpu, &mut |l| lines.push(l.to_string()))
+        .unwrap_or_else(|e| panic!("{e:#}\n{}", lines.join("\n")));
+    let compared = lines
+        .iter()
+        .filter(|l| l.contains("matches the CPU reference"))
+        .count();
+    assert_eq!(compared, 2, "{lines:#?}");
+    // The same script on the CPU refuses compare_cpu by name rather than comparing nothing.
+    let err = format!(
+        "{:#}",
+        script::replay_file(&path, &options(2, &out), &mut |_| {})
+            .err()
+            .unwrap()
+    );
+    assert!(err.contains("compare_cpu needs a GPU"), "{err}");
 }

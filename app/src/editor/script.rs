@@ -27,7 +27,7 @@ use super::Document;
 use super::command::{Command, TerrainSpec};
 use super::history::History;
 use crate::scene::Scene;
-use anyhow::{Context, Result, bail, ensure};
+use anyhow::{Context, Result, ensure};
 use brickmap::GridDims;
 use glam::{IVec3, UVec3};
 use render::Camera;
@@ -94,6 +94,12 @@ pub struct RenderStep {
     /// Upper bound of the image's mean linear RGB.
     #[serde(default)]
     pub mean_max: Option<(f32, f32, f32)>,
+    /// On the GPU, also render twice on the CPU reference and require the GPU image to differ
+    /// from it by no more than sampling noise: RMS(GPU − CPU₁) < 1.3·RMS(CPU₂ − CPU₁) (each
+    /// leaving out the largest 1% of squared differences), and channel means within 2% plus
+    /// four standard errors.
+    #[serde(default)]
+    pub compare_cpu: bool,
 }
 
 /// One script step.
@@ -158,8 +164,8 @@ pub struct ReplayOptions {
     pub workers: Option<usize>,
     /// Where written files go (default: the script's folder).
     pub out_dir: Option<PathBuf>,
-    /// Render device: "cpu" runs render steps; anything else refuses them until the Vulkan
-    /// renderer exists.
+    /// Render device for render steps: "cpu" (the reference), "gpu" (the best Vulkan device)
+    /// or part of a Vulkan device's name.
     pub device: String,
     /// History budget in bytes (default 512 MiB).
     pub history_budget: Option<usize>,
@@ -363,12 +369,6 @@ fn render_step(
     out_dir: &Path,
     options: &ReplayOptions,
 ) -> Result<String> {
-    if options.device != "cpu" {
-        bail!(
-            "render device {:?}: the Vulkan renderer is not built yet; replay with --device cpu",
-            options.device
-        );
-    }
     ensure!(
         r.spp > 0 && r.width > 0 && r.height > 0 && r.width <= 4096 && r.height <= 4096,
         "render size and samples must be positive (at most 4096 pixels a side)"
@@ -383,12 +383,37 @@ fn render_step(
         params.settings.max_bounces = b;
     }
     let view = doc.scene.world.read();
-    let image = render::cpu::CpuScene::new(&view, &params).render(&render::cpu::RenderJob {
+    let job = |seed| render::cpu::RenderJob {
         width: r.width,
         height: r.height,
         spp: r.spp,
-        seed: r.seed,
-    });
+        seed,
+    };
+    let cpu = |seed| render::cpu::CpuScene::new(&view, &params).render(&job(seed));
+    let (image, device) = if options.device == "cpu" {
+        ensure!(
+            !r.compare_cpu,
+            "compare_cpu needs a GPU device (replay with --device gpu)"
+        );
+        (cpu(r.seed), "cpu".to_string())
+    } else {
+        use render::vulkan::{
+            ContextOptions, DeviceChoice, GpuContext, trace::PathTracer, world::GpuWorld,
+        };
+        let choice = if options.device == "gpu" {
+            DeviceChoice::Best
+        } else {
+            DeviceChoice::Name(options.device.clone())
+        };
+        let ctx = GpuContext::new(&ContextOptions { device: choice, validation: false })
+            .context("no usable Vulkan device for render steps (replay with --device cpu for the CPU reference)")?;
+        let world = GpuWorld::upload(&ctx, &view)?;
+        let tracer = PathTracer::new(&ctx)?;
+        let rendered = tracer.render(&ctx, &world, &view, &params, &job(r.seed));
+        tracer.destroy(&ctx);
+        world.destroy(&ctx);
+        (rendered?.0, ctx.name.clone())
+    };
     ensure!(image.all_finite(), "the image has NaN or infinite pixels");
     let mean = image.mean();
     if let Some((a, b, c)) = r.mean_min {
@@ -405,15 +430,52 @@ fn render_step(
             (a, b, c)
         );
     }
+    let mut note = String::new();
+    if r.compare_cpu {
+        let (c1, c2) = (cpu(r.seed.wrapping_add(1)), cpu(r.seed.wrapping_add(2)));
+        let (gc, cc) = (rms(&image, &c1), rms(&c2, &c1));
+        ensure!(
+            gc < 1.3 * cc + 1e-6,
+            "GPU image differs from the CPU reference more than sampling noise: RMS {gc:.5} vs {cc:.5}; means GPU {:?}, CPU {:?}, CPU again {:?}",
+            mean,
+            c1.mean(),
+            c2.mean()
+        );
+        for (k, (g, c)) in mean.iter().zip(c1.mean()).enumerate() {
+            let g = *g;
+            let tolerance =
+                0.02 * c.abs().max(1e-3) + 4.0 * cc / (image.pixels.len() as f64).sqrt();
+            ensure!(
+                (g - c).abs() <= tolerance,
+                "channel {k}: GPU mean {g:.5}, CPU mean {c:.5}"
+            );
+        }
+        note = format!(", matches the CPU reference (RMS {gc:.4} vs noise {cc:.4})");
+    }
     if let Some(out) = &r.out {
         let path = out_dir.join(out);
         crate::atomic::write_atomic(&path, |w| image.write_png(w, params.settings.exposure))
             .with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(format!(
-        "rendered {}x{} at {} spp, mean ({:.4}, {:.4}, {:.4})",
+        "rendered {}x{} at {} spp on {device}, mean ({:.4}, {:.4}, {:.4}){note}",
         r.width, r.height, r.spp, mean[0], mean[1], mean[2]
     ))
+}
+
+/// Root-mean-square difference of two images over every channel, leaving out the largest 1%
+/// of squared differences: caustics make pixel values heavy-tailed, and a few pixels would
+/// otherwise decide the comparison. Applied alike to GPU−CPU and CPU−CPU.
+fn rms(a: &render::Image, b: &render::Image) -> f64 {
+    let mut sq: Vec<f64> = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .flat_map(|(x, y)| (0..3).map(move |k| (x[k] as f64 - y[k] as f64).powi(2)))
+        .collect();
+    sq.sort_by(f64::total_cmp);
+    let keep = sq.len() - sq.len() / 100;
+    (sq[..keep].iter().sum::<f64>() / keep.max(1) as f64).sqrt()
 }
 
 /// Records what an editor session does, as a script.
