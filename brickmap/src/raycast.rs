@@ -151,9 +151,9 @@ struct Dda<'r> {
 }
 
 impl<'r> Dda<'r> {
-    fn new(ray: &'r Ray, dims: &GridDims) -> Option<Self> {
-        let size = dims.voxels().as_i64vec3().to_array();
-        let sign = std::array::from_fn(|i| {
+    /// A walker for a ray before its start cell is known (None for a zero direction).
+    fn blank(ray: &'r Ray, dims: &GridDims) -> Option<Self> {
+        let sign: [i8; 3] = std::array::from_fn(|i| {
             let d = ray.dir[i];
             if d > 0.0 {
                 1
@@ -163,26 +163,51 @@ impl<'r> Dda<'r> {
                 0
             }
         });
-        let mut dda = Dda {
+        // Start from an axis the ray moves along: with denormal components every entry
+        // time can be −∞, and the normal must still name a real face.
+        let normal_axis = (0..3).find(|&i| sign[i] != 0)?;
+        let size = dims.voxels().as_i64vec3().to_array();
+        Some(Dda {
             ray,
             size,
             sign,
             cell: [0; 3],
             t: 0.0,
-            normal_axis: 0,
-        };
+            normal_axis,
+        })
+    }
+
+    /// The face entered last: the latest plane crossed into the current cell.
+    fn set_entry_axis(&mut self) {
+        let mut latest = f64::NEG_INFINITY;
+        for i in 0..3 {
+            let e = match self.sign[i] {
+                0 => continue,
+                1 => self.ray.plane_time(i, self.cell[i] as f64),
+                _ => self.ray.plane_time(i, (self.cell[i] + 1) as f64),
+            };
+            if e > latest {
+                latest = e;
+                self.normal_axis = i;
+            }
+        }
+    }
+
+    /// A walker for a ray from anywhere: finds the first cell inside the grid.
+    fn new(ray: &'r Ray, dims: &GridDims) -> Option<Self> {
+        let mut dda = Self::blank(ray, dims)?;
         // Earliest time the ray can be in the grid; t stays ≥ 0.
         let mut t0 = 0.0f64;
         for i in 0..3 {
-            match sign[i] {
+            match dda.sign[i] {
                 0 => {
                     let o = ray.origin[i];
-                    if !(o >= 0.0 && o < size[i] as f64) {
+                    if !(o >= 0.0 && o < dda.size[i] as f64) {
                         return None;
                     }
                 }
                 1 => t0 = t0.max(ray.plane_time(i, 0.0)),
-                _ => t0 = t0.max(ray.plane_time(i, size[i] as f64)),
+                _ => t0 = t0.max(ray.plane_time(i, dda.size[i] as f64)),
             }
         }
         if !t0.is_finite() {
@@ -192,60 +217,15 @@ impl<'r> Dda<'r> {
         for i in 0..3 {
             dda.cell[i] = dda.cell_at(i, dda.t, false);
         }
-        // The face entered last: the latest plane crossed into the current cell.
-        // Start from an axis the ray moves along: with denormal components every entry
-        // time can be −∞, and the normal must still name a real face.
-        dda.normal_axis = (0..3).find(|&i| sign[i] != 0)?;
-        let mut latest = f64::NEG_INFINITY;
-        for i in 0..3 {
-            let e = match sign[i] {
-                0 => continue,
-                1 => ray.plane_time(i, dda.cell[i] as f64),
-                _ => ray.plane_time(i, (dda.cell[i] + 1) as f64),
-            };
-            if e > latest {
-                latest = e;
-                dda.normal_axis = i;
-            }
-        }
+        dda.set_entry_axis();
         Some(dda)
     }
 
+    /// A walker for a ray leaving a surface from a known cell.
     fn at_cell(ray: &'r Ray, dims: &GridDims, cell: IVec3) -> Option<Self> {
-        let size = dims.voxels().as_i64vec3().to_array();
-        let sign = std::array::from_fn(|i| {
-            let d = ray.dir[i];
-            if d > 0.0 {
-                1
-            } else if d < 0.0 {
-                -1
-            } else {
-                0
-            }
-        });
-        let normal_axis = (0..3).find(|&i| sign[i] != 0)?;
-        let cell = cell.as_i64vec3().to_array();
-        let mut dda = Dda {
-            ray,
-            size,
-            sign,
-            cell,
-            t: 0.0,
-            normal_axis,
-        };
-        // The face behind the origin: the axis whose entry plane was crossed last.
-        let mut latest = f64::NEG_INFINITY;
-        for i in 0..3 {
-            let e = match sign[i] {
-                0 => continue,
-                1 => ray.plane_time(i, cell[i] as f64),
-                _ => ray.plane_time(i, (cell[i] + 1) as f64),
-            };
-            if e > latest {
-                latest = e;
-                dda.normal_axis = i;
-            }
-        }
+        let mut dda = Self::blank(ray, dims)?;
+        dda.cell = cell.as_i64vec3().to_array();
+        dda.set_entry_axis();
         Some(dda)
     }
 
