@@ -2,6 +2,8 @@
 //! synchronization validation on: every validation error fails the test. Machines without
 //! any Vulkan driver skip, saying so, unless VOXBRICK_REQUIRE_GPU=1 (CI) makes that a failure.
 
+mod common;
+
 use render::Image;
 use render::vulkan::tonemap::ToneMapper;
 use render::vulkan::{ContextOptions, DeviceChoice, GpuContext, GpuError};
@@ -224,51 +226,14 @@ mod trace {
     //! The GPU path tracer against closed forms and against the CPU reference.
     use super::*;
     use brickmap::{
-        EditOp, GridDims, Material, MaterialKind, Mode, Shape, VoxelEdit, VoxelOp, World,
-        WorldConfig,
+        EditOp, GridDims, MaterialKind, Mode, Shape, VoxelEdit, VoxelOp, World, WorldConfig,
     };
+    use common::{add_material as add, params, sun_floor};
     use glam::{DVec3, IVec3};
     use render::cpu::{CpuScene, RenderJob};
     use render::vulkan::trace::PathTracer;
     use render::vulkan::world::GpuWorld;
-    use render::{Camera, RenderSettings, SceneParams, Sky, Sun};
-
-    fn no_sun() -> Sun {
-        Sun {
-            enabled: false,
-            position: DVec3::new(0.0, 1000.0, 0.0),
-            radius: 1.0,
-            colour: [1.0; 3],
-            intensity: 0.0,
-            animate: false,
-            speed_deg_per_s: 0.0,
-        }
-    }
-
-    fn params(camera: Camera, sky: Sky, sun: Sun, bounces: u32) -> SceneParams {
-        SceneParams {
-            camera,
-            sun,
-            sky,
-            settings: RenderSettings {
-                samples_per_pixel: 1,
-                max_bounces: bounces,
-                internal_resolution: (32, 32),
-                exposure: 0.0,
-            },
-        }
-    }
-
-    fn add(w: &World, kind: MaterialKind, param: u8, rgb: [u8; 3]) -> u8 {
-        let colour = 250 - w.materials().len() as u8;
-        w.set_colour(colour, rgb);
-        w.push_material(Material {
-            kind,
-            param,
-            colour,
-        })
-        .unwrap()
-    }
+    use render::{Camera, SceneParams, Sky, Sun};
 
     fn gpu_render(
         ctx: &GpuContext,
@@ -336,7 +301,7 @@ mod trace {
             let img = gpu_render(
                 &ctx,
                 &w,
-                &params(cam, Sky::Uniform { colour: sky }, no_sun(), 4),
+                &params(cam, Sky::Uniform { colour: sky }, None, 4),
                 24,
                 4,
                 1,
@@ -355,45 +320,8 @@ mod trace {
         let Some(ctx) = context(DeviceChoice::Best) else {
             return;
         };
-        let w = World::new(
-            GridDims::new(8, 2, 8).unwrap(),
-            WorldConfig::with_workers(2),
-        )
-        .unwrap();
-        let m = add(&w, MaterialKind::Lambertian, 0, [200, 200, 200]);
-        w.apply(EditOp::Shape {
-            shape: Shape::Box {
-                min: IVec3::ZERO,
-                max: IVec3::new(63, 3, 63),
-            },
-            mode: Mode::Add(m),
-        })
-        .unwrap();
-        let (r, d, l) = (6.0, 30.0, 5.0);
-        let sun = Sun {
-            enabled: true,
-            position: DVec3::new(32.0, 4.0 + d, 32.0),
-            radius: r,
-            colour: [1.0; 3],
-            intensity: l as f32,
-            animate: false,
-            speed_deg_per_s: 0.0,
-        };
-        let cam = Camera {
-            position: DVec3::new(32.0, 7.0, 32.0),
-            yaw_deg: 0.0,
-            pitch_deg: -89.0,
-            fov_y_deg: 0.5,
-        };
-        let expected = render::cpu::srgb_to_linear(200) * l * r * r / (r * r + d * d);
-        let img = gpu_render(
-            &ctx,
-            &w,
-            &params(cam, Sky::Uniform { colour: [0.0; 3] }, sun, 1),
-            16,
-            256,
-            5,
-        );
+        let (w, p, expected) = sun_floor();
+        let img = gpu_render(&ctx, &w, &p, 16, 256, 5);
         let v: Vec<f64> = img.pixels.iter().map(|p| p[0] as f64).collect();
         let mean = v.iter().sum::<f64>() / v.len() as f64;
         let se = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>()
@@ -494,7 +422,7 @@ mod trace {
                 horizon: [0.8, 0.85, 1.0],
                 zenith: [0.2, 0.35, 0.8],
             },
-            sun,
+            Some(sun),
             4,
         );
         let (size, spp) = (32, 64);
