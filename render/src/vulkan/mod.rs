@@ -182,6 +182,12 @@ impl GpuContext {
         let devices = vk_call("vkEnumeratePhysicalDevices", unsafe {
             instance.enumerate_physical_devices()
         })?;
+        if devices.is_empty() {
+            // A loader without any driver: the same as no Vulkan at all.
+            return Err(GpuError::NoVulkan(
+                "the Vulkan loader found no device (no driver installed)".into(),
+            ));
+        }
         let described: Vec<(vk::PhysicalDevice, String, vk::PhysicalDeviceType)> = devices
             .iter()
             .map(|&d| {
