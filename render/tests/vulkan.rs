@@ -336,6 +336,47 @@ mod trace {
     }
 
     #[test]
+    fn gpu_has_no_nan_in_hard_places() {
+        let Some(ctx) = context(DeviceChoice::Best) else {
+            return;
+        };
+        let (w, views) = common::hard_places();
+        for (i, p) in views.iter().enumerate() {
+            let img = gpu_render(&ctx, &w, p, 20, 4, i as u64);
+            assert!(img.all_finite(), "camera {i}");
+            assert!(
+                img.pixels.iter().all(|px| px.iter().all(|c| *c >= 0.0)),
+                "camera {i}"
+            );
+        }
+        assert_eq!(ctx.validation_errors(), 0);
+    }
+
+    #[test]
+    fn gpu_error_falls_as_one_over_sqrt_spp() {
+        // RMS error against the closed form at 4, 16 and 64 spp: each 4× more samples must
+        // halve it (no plateau, so no bias), within sampling slack.
+        let Some(ctx) = context(DeviceChoice::Best) else {
+            return;
+        };
+        let (w, p, expected) = sun_floor();
+        let rms = |spp: u32| {
+            let img = gpu_render(&ctx, &w, &p, 24, spp, 100 + spp as u64);
+            (img.pixels
+                .iter()
+                .map(|px| (px[0] as f64 - expected).powi(2))
+                .sum::<f64>()
+                / img.pixels.len() as f64)
+                .sqrt()
+        };
+        let (e4, e16, e64) = (rms(4), rms(16), rms(64));
+        for (a, b) in [(e4, e16), (e16, e64)] {
+            assert!((1.6..2.5).contains(&(a / b)), "errors {e4} {e16} {e64}");
+        }
+        assert_eq!(ctx.validation_errors(), 0);
+    }
+
+    #[test]
     fn gpu_and_cpu_agree_within_sampling_noise() {
         // If the GPU estimator is the CPU one, RMS(GPU − CPU₁) ≈ RMS(CPU₂ − CPU₁) for
         // independent renders; a bias shows as a larger ratio (and a shifted mean).

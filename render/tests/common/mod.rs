@@ -2,7 +2,9 @@
 //! checked against the same closed forms.
 #![allow(dead_code)] // each test file uses part of it
 
-use brickmap::{EditOp, GridDims, Material, MaterialKind, Mode, Shape, World, WorldConfig};
+use brickmap::{
+    EditOp, GridDims, Material, MaterialKind, Mode, Shape, VoxelEdit, VoxelOp, World, WorldConfig,
+};
 use glam::{DVec3, IVec3};
 use render::{Camera, RenderSettings, SceneParams, Sky, Sun};
 
@@ -85,4 +87,112 @@ pub fn sun_floor() -> (World, SceneParams, f64) {
         params(cam, Sky::Uniform { colour: [0.0; 3] }, Some(sun), 1),
         expected,
     )
+}
+
+/// Glass boxes forcing total internal reflection, water on a floor, rough and mirror metal, an
+/// emissive voxel and the sun, with cameras on faces, edges, inside voxels and along axes:
+/// every image must be finite and non-negative.
+pub fn hard_places() -> (World, Vec<SceneParams>) {
+    let w = world((6, 4, 6));
+    let glass = add_material(&w, MaterialKind::Dielectric, 0, [240, 250, 255]);
+    let water = add_material(&w, MaterialKind::Dielectric, 1, [200, 230, 255]);
+    let rough = add_material(&w, MaterialKind::Metal, 30, [230, 200, 120]);
+    let mirror = add_material(&w, MaterialKind::Metal, 0, [250, 250, 250]);
+    let lamp = add_material(&w, MaterialKind::Emissive, 0, [255, 255, 255]);
+    let floor = add_material(&w, MaterialKind::Lambertian, 0, [120, 120, 120]);
+    let shapes = [
+        (
+            Shape::Box {
+                min: IVec3::ZERO,
+                max: IVec3::new(47, 2, 47),
+            },
+            floor,
+        ),
+        (
+            Shape::Box {
+                min: IVec3::new(0, 3, 0),
+                max: IVec3::new(47, 6, 20),
+            },
+            water,
+        ),
+        (
+            Shape::Box {
+                min: IVec3::new(8, 8, 8),
+                max: IVec3::new(15, 15, 15),
+            },
+            glass,
+        ),
+        (
+            Shape::Sphere {
+                centre: DVec3::new(30.0, 12.0, 30.0),
+                radius: 5.0,
+            },
+            rough,
+        ),
+        (
+            Shape::Box {
+                min: IVec3::new(36, 3, 8),
+                max: IVec3::new(37, 20, 20),
+            },
+            mirror,
+        ),
+    ];
+    for (shape, m) in shapes {
+        w.apply(EditOp::Shape {
+            shape,
+            mode: Mode::Add(m),
+        })
+        .unwrap();
+    }
+    w.apply(EditOp::Voxels(vec![VoxelEdit {
+        pos: IVec3::new(20, 9, 20),
+        op: VoxelOp::Set(lamp),
+    }]))
+    .unwrap();
+    let sun = Sun {
+        enabled: true,
+        position: DVec3::new(80.0, 90.0, 60.0),
+        radius: 6.0,
+        colour: [1.0, 0.9, 0.8],
+        intensity: 20.0,
+        animate: false,
+        speed_deg_per_s: 0.0,
+    };
+    let cams = [
+        Camera::looking_at(
+            DVec3::new(-10.0, 30.0, -10.0),
+            DVec3::new(24.0, 8.0, 24.0),
+            60.0,
+        ),
+        Camera::looking_at(
+            DVec3::new(12.0, 12.0, 12.0),
+            DVec3::new(12.0, 12.0, 40.0),
+            90.0,
+        ), // inside glass
+        Camera::looking_at(
+            DVec3::new(10.0, 4.0, 10.0),
+            DVec3::new(30.0, 20.0, 30.0),
+            90.0,
+        ), // under water
+        Camera::looking_at(DVec3::new(8.0, 8.0, 0.0), DVec3::new(8.0, 8.0, 40.0), 60.0), // on brick edges, along z
+        Camera::looking_at(
+            DVec3::new(30.0, 12.0, 30.0),
+            DVec3::new(0.0, 12.0, 0.0),
+            60.0,
+        ), // inside metal
+        Camera::looking_at(
+            DVec3::new(16.0, 16.0, 16.0),
+            DVec3::new(48.0, 48.0, 48.0),
+            60.0,
+        ), // diagonal through a corner
+    ];
+    let sky = Sky::Gradient {
+        horizon: [0.9, 0.9, 1.0],
+        zenith: [0.2, 0.4, 0.9],
+    };
+    let views = cams
+        .into_iter()
+        .map(|cam| params(cam, sky.clone(), Some(sun.clone()), 6))
+        .collect();
+    (w, views)
 }
