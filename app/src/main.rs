@@ -637,7 +637,10 @@ fn bench_gpu(
                 spp,
                 seed: frame as u64,
             };
-            match tracer.time_frame(&ctx, &world, &view, &params, &job) {
+            match tracer
+                .render(&ctx, &world, &view, &params, &job)
+                .map(|(_, gpu)| gpu)
+            {
                 Ok(Some(t)) if frame >= 5 => times.push(t),
                 Ok(_) => {}
                 Err(e) => {

@@ -157,23 +157,7 @@ fn error_falls_as_one_over_sqrt_spp() {
     // RMS error against the closed form at 4, 16 and 64 spp: each 4× more samples must
     // halve it (no plateau, so no bias), within sampling slack.
     let (w, p, expected) = sun_floor();
-    let rms = |spp: u32| {
-        let img = render(&w, &p, 24, spp, 100 + spp as u64);
-        (img.pixels
-            .iter()
-            .map(|px| (px[0] as f64 - expected).powi(2))
-            .sum::<f64>()
-            / img.pixels.len() as f64)
-            .sqrt()
-    };
-    let (e4, e16, e64) = (rms(4), rms(16), rms(64));
-    for (a, b) in [(e4, e16), (e16, e64)] {
-        let ratio = a / b;
-        assert!(
-            (1.6..2.5).contains(&ratio),
-            "errors {e4} {e16} {e64}: ratio {ratio}"
-        );
-    }
+    common::assert_error_halves(|spp| render(&w, &p, 24, spp, 100 + spp as u64), expected);
 }
 
 #[test]

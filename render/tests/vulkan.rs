@@ -360,19 +360,10 @@ mod trace {
             return;
         };
         let (w, p, expected) = sun_floor();
-        let rms = |spp: u32| {
-            let img = gpu_render(&ctx, &w, &p, 24, spp, 100 + spp as u64);
-            (img.pixels
-                .iter()
-                .map(|px| (px[0] as f64 - expected).powi(2))
-                .sum::<f64>()
-                / img.pixels.len() as f64)
-                .sqrt()
-        };
-        let (e4, e16, e64) = (rms(4), rms(16), rms(64));
-        for (a, b) in [(e4, e16), (e16, e64)] {
-            assert!((1.6..2.5).contains(&(a / b)), "errors {e4} {e16} {e64}");
-        }
+        common::assert_error_halves(
+            |spp| gpu_render(&ctx, &w, &p, 24, spp, 100 + spp as u64),
+            expected,
+        );
         assert_eq!(ctx.validation_errors(), 0);
     }
 

@@ -189,37 +189,6 @@ impl PathTracer {
         image
     }
 
-    /// One dispatch of `job.spp` (at most [`SAMPLES_PER_DISPATCH`]) samples per pixel, timed
-    /// on the GPU with timestamp queries; seconds (None when the queue cannot time).
-    pub fn time_frame(
-        &self,
-        ctx: &GpuContext,
-        world: &GpuWorld,
-        view: &WorldView<'_>,
-        params: &SceneParams,
-        job: &RenderJob,
-    ) -> Result<Option<f64>, GpuError> {
-        assert!(
-            job.spp <= SAMPLES_PER_DISPATCH,
-            "one dispatch holds at most {SAMPLES_PER_DISPATCH} samples"
-        );
-        let pixels = job.width as u64 * job.height as u64;
-        let (mut uniforms, accum) = frame_buffers(ctx, pixels)?;
-        uniforms.write(bytemuck::bytes_of(&TraceParams::new(view, params, job)));
-        let mut bound = world.buffers();
-        bound.extend([&uniforms, &accum]);
-        let result = self.0.run_timed(
-            ctx,
-            &bound,
-            &[],
-            [job.width.div_ceil(8), job.height.div_ceil(8)],
-            true,
-        );
-        uniforms.destroy(ctx);
-        accum.destroy(ctx);
-        result
-    }
-
     /// Destroys the pipeline.
     pub fn destroy(self, ctx: &GpuContext) {
         self.0.destroy(ctx);

@@ -196,3 +196,26 @@ pub fn hard_places() -> (World, Vec<SceneParams>) {
         .collect();
     (w, views)
 }
+
+/// Renders the sun floor at 4, 16 and 64 spp with `render(spp)` and requires the per-pixel
+/// RMS error against the closed form to halve with each 4× more samples (no plateau, so no
+/// bias), within sampling slack.
+pub fn assert_error_halves(mut render: impl FnMut(u32) -> render::Image, expected: f64) {
+    let mut rms = |spp: u32| {
+        let img = render(spp);
+        (img.pixels
+            .iter()
+            .map(|px| (px[0] as f64 - expected).powi(2))
+            .sum::<f64>()
+            / img.pixels.len() as f64)
+            .sqrt()
+    };
+    let (e4, e16, e64) = (rms(4), rms(16), rms(64));
+    for (a, b) in [(e4, e16), (e16, e64)] {
+        assert!(
+            (1.6..2.5).contains(&(a / b)),
+            "errors {e4} {e16} {e64}: ratio {}",
+            a / b
+        );
+    }
+}
