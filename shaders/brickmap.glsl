@@ -48,14 +48,13 @@ int material_at(ivec3 v) {
     if (w >= FULL_BASE) return int(w & 0xFFu);
     ivec3 l = v & 7;
     uint bit = uint(l.x + 8 * l.y + 64 * l.z);
-    // Index the buffer directly: copying the 17-word Brick would load every word per call.
-    uint word = bricks[w].mask[bit >> 5];
-    if (((word >> (bit & 31u)) & 1u) == 0u) return -1;
-    uint material = bricks[w].material;
-    if ((material & UNIFORM_FLAG) != 0u) return int(material & 0xFFu);
-    uint rank = uint(bitCount(word & ((1u << (bit & 31u)) - 1u)));
-    for (uint k = 0u; k < (bit >> 5); k++) rank += uint(bitCount(bricks[w].mask[k]));
-    uint at = material + rank;
+    Brick b = bricks[w];
+    if (((b.mask[bit >> 5] >> (bit & 31u)) & 1u) == 0u) return -1;
+    if ((b.material & UNIFORM_FLAG) != 0u) return int(b.material & 0xFFu);
+    uint rank = 0u;
+    for (uint k = 0u; k < (bit >> 5); k++) rank += uint(bitCount(b.mask[k]));
+    rank += uint(bitCount(b.mask[bit >> 5] & ((1u << (bit & 31u)) - 1u)));
+    uint at = b.material + rank;
     return int((material_bytes[at >> 2] >> (8u * (at & 3u))) & 0xFFu);
 }
 

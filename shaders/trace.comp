@@ -212,11 +212,9 @@ vec3 radiance(vec3 origin, vec3 dir) {
         if (vertex == bounces + 1u) break;
         ivec3 front = voxel + normal;
         if (crossing) {
-            Shading m;
-            if (medium >= 0) m = material(medium);
-            float eta_i = medium >= 0 ? m.param : 1.0;
+            float eta_i = medium >= 0 ? material(medium).param : 1.0;
             float eta_t = here >= 0 ? s.param : 1.0;
-            vec3 tint = here >= 0 ? s.albedo : m.albedo;
+            vec3 tint = here >= 0 ? s.albedo : material(medium).albedo;
             float cos_i = -dot(d, n);
             float eta = eta_i / eta_t;
             float sin2_t = eta * eta * max(0.0, 1.0 - cos_i * cos_i);
