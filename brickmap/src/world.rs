@@ -808,6 +808,11 @@ impl WorldView<'_> {
         }
     }
 
+    /// Current size in bytes of a GPU buffer ([`World::gpu_buffer_size`]).
+    pub fn gpu_buffer_size(&self, buffer: GpuBuffer) -> u64 {
+        self.world.gpu_buffer_size(buffer)
+    }
+
     /// The whole of a GPU buffer, as the renderer's copy of it must be.
     pub fn gpu_image(&self, buffer: GpuBuffer) -> Vec<u8> {
         let size = self.world.gpu_buffer_size(buffer) as usize;

@@ -495,3 +495,162 @@ mod trace {
         assert_eq!(ctx.validation_errors(), 0);
     }
 }
+
+#[test]
+fn gpu_world_equals_the_cpu_world_byte_for_byte_after_random_edit_batches() {
+    // Random edit batches (shapes added and removed, scattered voxels, paint, table edits)
+    // on a world that starts empty, so the buffer grows; a small staging ring, so uploads
+    // are deferred across frames. After each batch's frames the GPU's five regions must
+    // equal the CPU world's bytes, and the bytes uploaded must be within 2× of the bytes
+    // changed (counted as the 4-byte words that differ: buffers are u32 arrays to shaders).
+    use brickmap::{
+        EditOp, GpuBuffer, GridDims, MaterialKind, Mode, Shape, VoxelEdit, VoxelOp, World,
+        WorldConfig,
+    };
+    use common::add_material;
+    use glam::{DVec3, IVec3};
+    use render::vulkan::world::GpuWorld;
+    let Some(ctx) = context(DeviceChoice::Best) else {
+        return;
+    };
+    let w = World::new(
+        GridDims::new(8, 4, 8).unwrap(),
+        WorldConfig::with_workers(2),
+    )
+    .unwrap();
+    let mats: Vec<u8> = (0..6)
+        .map(|i| add_material(&w, MaterialKind::Lambertian, 0, [40 * i, 100, 200 - 30 * i]))
+        .collect();
+    let images = |w: &World| {
+        let v = w.read();
+        GpuBuffer::ALL.map(|b| v.gpu_image(b))
+    };
+    let mut gpu = GpuWorld::with_ring(&ctx, &w.read(), 2, 1024).unwrap();
+    let mut prev = images(&w);
+    let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+    let mut rand = move |n: u64| {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed % n
+    };
+    let (mut grew, mut deferred, mut total_up, mut total_changed) = (false, false, 0, 0);
+    let mut interleaved = 0;
+    for batch in 0..14 {
+        // Every third batch edits again while the previous edits' uploads are deferred:
+        // the queued bytes are owned, so the later frames must still end byte-equal.
+        let rounds = if batch % 3 == 2 { 2 } else { 1 };
+        for round in 0..rounds {
+            if round == 1 && gpu.update(&ctx, &w).unwrap().deferred_bytes > 0 {
+                interleaved += 1;
+            }
+            for _ in 0..1 + rand(4) {
+                let m = mats[rand(mats.len() as u64) as usize];
+                let centre = DVec3::new(rand(64) as f64, rand(32) as f64, rand(64) as f64);
+                let op = match rand(5) {
+                    0 => EditOp::Shape {
+                        shape: Shape::Sphere {
+                            centre,
+                            radius: 2.0 + rand(14) as f64,
+                        },
+                        mode: Mode::Add(m),
+                    },
+                    1 => EditOp::Shape {
+                        shape: Shape::Sphere {
+                            centre,
+                            radius: 2.0 + rand(6) as f64,
+                        },
+                        mode: Mode::Remove,
+                    },
+                    2 => EditOp::Shape {
+                        shape: Shape::Box {
+                            min: centre.as_ivec3(),
+                            max: centre.as_ivec3()
+                                + IVec3::new(3, 20, 5).min(IVec3::splat(63) - centre.as_ivec3()),
+                        },
+                        mode: Mode::Paint(m),
+                    },
+                    3 => EditOp::Voxels(
+                        (0..1 + rand(60))
+                            .map(|_| VoxelEdit {
+                                pos: IVec3::new(rand(64) as i32, rand(32) as i32, rand(64) as i32),
+                                op: if rand(3) == 0 {
+                                    VoxelOp::Clear
+                                } else {
+                                    VoxelOp::Set(mats[rand(mats.len() as u64) as usize])
+                                },
+                            })
+                            .collect(),
+                    ),
+                    _ => {
+                        w.set_colour(rand(256) as u8, [rand(256) as u8, 7, 9]);
+                        continue;
+                    }
+                };
+                w.apply(op).unwrap();
+            }
+        }
+        let now = images(&w);
+        let changed: u64 = prev
+            .iter()
+            .zip(&now)
+            .map(|(a, b)| {
+                b.chunks(4)
+                    .enumerate()
+                    // Bytes past the old end count against zeros: a grown region starts
+                    // zeroed, and unused slots of a new chunk are zero in the image too.
+                    .filter(|(i, word)| {
+                        a.get(i * 4..i * 4 + word.len())
+                            .map_or(word.iter().any(|&x| x != 0), |o| o != *word)
+                    })
+                    .count() as u64
+                    * 4
+            })
+            .sum();
+        let mut uploaded = 0;
+        let mut frames = 0;
+        loop {
+            let r = gpu.update(&ctx, &w).unwrap();
+            grew |= r.grew;
+            uploaded += r.uploaded_bytes;
+            frames += 1;
+            if r.deferred_bytes == 0 {
+                break;
+            }
+            deferred = true;
+            assert!(
+                r.uploaded_bytes == 1024,
+                "a deferring frame fills its slot: {r:?}"
+            );
+        }
+        for (b, image) in GpuBuffer::ALL.into_iter().zip(&now) {
+            let back = gpu.read_back(&ctx, b).unwrap();
+            assert!(
+                back == *image,
+                "batch {batch}: {b:?} differs on the GPU ({} vs {} bytes)",
+                back.len(),
+                image.len()
+            );
+        }
+        eprintln!("batch {batch}: {changed} bytes changed, {uploaded} uploaded in {frames} frames");
+        if rounds == 1 {
+            assert!(uploaded >= changed, "batch {batch}: {uploaded} < {changed}");
+            assert!(
+                uploaded <= 2 * changed,
+                "batch {batch}: {uploaded} > 2 × {changed}"
+            );
+            total_up += uploaded;
+            total_changed += changed;
+        }
+        prev = now;
+    }
+    assert!(
+        interleaved > 0,
+        "no batch edited while uploads were deferred"
+    );
+    assert!(grew, "the world never outgrew its regions");
+    assert!(deferred, "the ring never deferred an upload");
+    eprintln!("total: {total_changed} bytes changed, {total_up} uploaded");
+    gpu.destroy(&ctx);
+    assert_eq!(ctx.validation_errors(), 0);
+}

@@ -6,6 +6,17 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 
+/// A byte range of a buffer bound to one storage-buffer binding.
+#[derive(Clone, Copy, Debug)]
+pub struct Binding {
+    /// The buffer.
+    pub buffer: vk::Buffer,
+    /// Offset in bytes (a multiple of `minStorageBufferOffsetAlignment`).
+    pub offset: u64,
+    /// Length in bytes.
+    pub range: u64,
+}
+
 /// A storage buffer in host-visible memory.
 pub struct HostBuffer {
     /// The Vulkan buffer.
@@ -123,14 +134,28 @@ impl HostBuffer {
         }
     }
 
+    /// The whole buffer as a binding.
+    pub fn binding(&self) -> Binding {
+        Binding {
+            buffer: self.raw,
+            offset: 0,
+            range: self.size,
+        }
+    }
+
     /// Copies bytes into the start of the buffer.
     pub fn write(&mut self, bytes: &[u8]) {
+        self.write_at(0, bytes);
+    }
+
+    /// Copies bytes into the buffer at byte `offset`.
+    pub fn write_at(&mut self, offset: usize, bytes: &[u8]) {
         let slice = self
             .allocation
             .as_mut()
             .and_then(|a| a.mapped_slice_mut())
             .expect("host-visible buffers are mapped");
-        slice[..bytes.len()].copy_from_slice(bytes);
+        slice[offset..offset + bytes.len()].copy_from_slice(bytes);
     }
 
     /// The buffer's bytes (after the GPU finished writing them).

@@ -6,6 +6,7 @@
 pub mod buffer;
 pub mod pass;
 pub mod primary;
+pub mod staging;
 pub mod tonemap;
 pub mod trace;
 pub mod world;
@@ -87,6 +88,8 @@ pub struct GpuContext {
     pub name: String,
     /// Nanoseconds per timestamp tick (0 when the queue cannot time).
     pub timestamp_period: f32,
+    /// `minStorageBufferOffsetAlignment`: storage bindings start at multiples of it.
+    pub storage_alignment: u64,
 }
 
 unsafe extern "system" fn count_errors(
@@ -273,6 +276,7 @@ impl GpuContext {
             allocator: Mutex::new(Some(allocator)),
             name,
             timestamp_period,
+            storage_alignment: limits.min_storage_buffer_offset_alignment.max(4),
         })
     }
 

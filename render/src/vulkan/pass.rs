@@ -1,7 +1,7 @@
 //! A compute pass: one SPIR-V module, N storage buffers in set 0 (bindings 0..N), push
 //! constants, dispatched synchronously with the results made visible to the host.
 
-use super::buffer::HostBuffer;
+use super::buffer::Binding;
 use super::{GpuContext, GpuError, vk_call};
 use ash::vk;
 
@@ -100,7 +100,7 @@ impl ComputePass {
     pub fn run(
         &self,
         ctx: &GpuContext,
-        buffers: &[&HostBuffer],
+        buffers: &[Binding],
         push: &[u8],
         groups: [u32; 2],
     ) -> Result<(), GpuError> {
@@ -113,7 +113,7 @@ impl ComputePass {
     pub fn run_timed(
         &self,
         ctx: &GpuContext,
-        buffers: &[&HostBuffer],
+        buffers: &[Binding],
         push: &[u8],
         groups: [u32; 2],
         time: bool,
@@ -135,8 +135,9 @@ impl ComputePass {
                 .iter()
                 .map(|b| {
                     [vk::DescriptorBufferInfo::default()
-                        .buffer(b.raw)
-                        .range(vk::WHOLE_SIZE)]
+                        .buffer(b.buffer)
+                        .offset(b.offset)
+                        .range(b.range)]
                 })
                 .collect();
             let writes: Vec<vk::WriteDescriptorSet> = infos
@@ -185,13 +186,22 @@ impl ComputePass {
                 if let Some(q) = queries {
                     d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, q, 1);
                 }
+                // Results are visible to the host and to later passes and copies.
                 let barrier = [vk::MemoryBarrier::default()
                     .src_access_mask(vk::AccessFlags::SHADER_WRITE)
-                    .dst_access_mask(vk::AccessFlags::HOST_READ)];
+                    .dst_access_mask(
+                        vk::AccessFlags::HOST_READ
+                            | vk::AccessFlags::SHADER_READ
+                            | vk::AccessFlags::SHADER_WRITE
+                            | vk::AccessFlags::TRANSFER_READ
+                            | vk::AccessFlags::TRANSFER_WRITE,
+                    )];
                 d.cmd_pipeline_barrier(
                     cmd,
                     vk::PipelineStageFlags::COMPUTE_SHADER,
-                    vk::PipelineStageFlags::HOST,
+                    vk::PipelineStageFlags::HOST
+                        | vk::PipelineStageFlags::COMPUTE_SHADER
+                        | vk::PipelineStageFlags::TRANSFER,
                     vk::DependencyFlags::empty(),
                     &barrier,
                     &[],

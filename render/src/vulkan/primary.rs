@@ -81,8 +81,8 @@ impl PrimaryTracer {
             count: rays.len() as u32,
             words_per_column: world.words_per_column(),
         };
-        let mut bound: Vec<&HostBuffer> = world.buffers();
-        bound.extend([&input, &output]);
+        let mut bound = world.bindings();
+        bound.extend([input.binding(), output.binding()]);
         let result = self.0.run(
             ctx,
             &bound,

@@ -56,7 +56,7 @@ impl ToneMapper {
         };
         let result = self.0.run(
             ctx,
-            &[&hdr, &ldr],
+            &[hdr.binding(), ldr.binding()],
             bytemuck::bytes_of(&push),
             [pixels.div_ceil(GROUP), 1],
         );

@@ -148,8 +148,8 @@ impl PathTracer {
             p.image[2] = batch;
             p.seed[2] = done;
             uniforms.write(bytemuck::bytes_of(&p));
-            let mut bound = world.buffers();
-            bound.extend([&uniforms, &accum]);
+            let mut bound = world.bindings();
+            bound.extend([uniforms.binding(), accum.binding()]);
             result = self
                 .0
                 .run_timed(

@@ -1,59 +1,445 @@
-//! The world on the GPU: the brickmap's five buffers (brick index, bricks, coarse grid,
-//! material bytes, material tables) uploaded as they are, bound at 0..4 by every shader
-//! (`shaders/brickmap.glsl`), in device-local memory through a staging copy. Incremental
-//! updates (a staging ring fed by `World::take_dirty` + `WorldView::copy_gpu_range`) come next.
+//! The world on the GPU: one device-local buffer sub-allocated into five regions (brick
+//! index, bricks, coarse grid, material bytes, material tables), bound at 0..4 by every
+//! shader (`shaders/brickmap.glsl`), and kept equal to the CPU world by incremental uploads.
+//!
+//! Each frame [`GpuWorld::update`] drains the world's dirty ranges, reads their current bytes
+//! under one read lock, and compares them word by word with a host copy of what the GPU
+//! holds (the *shadow*), so only words that really changed are queued: dirty ranges that
+//! were coarsened (a whole 68-byte brick for one voxel, merged ranges) cost no upload
+//! beyond the words that differ. Queued uploads own their bytes and go through the
+//! [`StagingRing`]: one flush per frame, the rest deferred to the next frame. When the world
+//! outgrows a region, the buffer is replaced by a larger one and the old contents are copied
+//! on the GPU, so nothing is re-read or lost.
 
-use super::buffer::HostBuffer;
+use super::buffer::{Binding, HostBuffer};
+use super::staging::{StagingRing, Upload, barrier};
 use super::{GpuContext, GpuError};
-use brickmap::{GpuBuffer, WorldView};
+use ash::vk;
+use brickmap::{GpuBuffer, World, WorldView};
+use gpu_allocator::MemoryLocation;
+use std::collections::VecDeque;
+use std::ops::Range;
 
-/// The world's five buffers on the GPU, bound at 0..4 by every shader.
+/// Staging buffers in the ring.
+pub const RING_SLOTS: usize = 3;
+/// Bytes per staging buffer: what one frame uploads at most.
+pub const RING_SLOT_BYTES: u64 = 4 << 20;
+/// Changed runs at most this many bytes apart are uploaded as one copy region (so uploads
+/// stay within 1.5× of the changed words).
+const MERGE_GAP: usize = 4;
+
+#[derive(Clone, Copy, Debug, Default)]
+struct Region {
+    offset: u64,
+    capacity: u64,
+}
+
+/// What one update did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct UploadReport {
+    /// Bytes the world reported dirty.
+    pub dirty_bytes: u64,
+    /// Bytes queued: the words that differ from what the GPU holds (plus merged gaps).
+    pub queued_bytes: u64,
+    /// Bytes copied to the GPU.
+    pub uploaded_bytes: u64,
+    /// Copy regions recorded.
+    pub copy_regions: u32,
+    /// Flushes submitted.
+    pub flushes: u32,
+    /// Bytes still queued for later frames.
+    pub deferred_bytes: u64,
+    /// Whether the buffer was replaced by a larger one.
+    pub grew: bool,
+}
+
+impl UploadReport {
+    fn add(&mut self, o: &UploadReport) {
+        self.dirty_bytes += o.dirty_bytes;
+        self.queued_bytes += o.queued_bytes;
+        self.uploaded_bytes += o.uploaded_bytes;
+        self.copy_regions += o.copy_regions;
+        self.flushes += o.flushes;
+        self.deferred_bytes = o.deferred_bytes;
+        self.grew |= o.grew;
+    }
+
+    /// Whether the GPU's world changed (a render must restart its accumulation).
+    pub fn changed(&self) -> bool {
+        self.uploaded_bytes > 0 || self.grew
+    }
+}
+
+/// The world's buffers on the GPU.
 pub struct GpuWorld {
-    buffers: Vec<HostBuffer>,
+    buffer: HostBuffer,
+    regions: [Region; 5],
+    shadow: [Vec<u8>; 5],
+    ring: StagingRing,
+    queue: VecDeque<Upload>,
     dims: [u32; 3],
     words_per_column: u32,
+    alignment: u64,
+}
+
+fn align(x: u64, a: u64) -> u64 {
+    x.div_ceil(a) * a
+}
+
+/// Lays out regions of the given capacities; returns them and the total size.
+fn layout(capacities: [u64; 5], alignment: u64) -> ([Region; 5], u64) {
+    let mut at = 0;
+    let regions = capacities.map(|c| {
+        let r = Region {
+            offset: at,
+            capacity: align(c.max(4), 4),
+        };
+        at = align(at + r.capacity, alignment);
+        r
+    });
+    (regions, at.max(4))
+}
+
+/// Initial capacity: buffers that grow with the content get 25% headroom.
+fn initial_capacity(b: GpuBuffer, size: u64) -> u64 {
+    match b {
+        GpuBuffer::Bricks | GpuBuffer::MaterialBytes => size + size / 4,
+        _ => size,
+    }
+}
+
+/// A device-local buffer of `size` bytes, zero-filled.
+fn zeroed_buffer(ctx: &GpuContext, size: u64) -> Result<HostBuffer, GpuError> {
+    let buffer = HostBuffer::new(ctx, "world", size, MemoryLocation::GpuOnly)?;
+    let filled = ctx.submit_and_wait(|cmd| {
+        // SAFETY: the buffer lives until after the wait; the barrier orders the fill before
+        // every later copy and shader read.
+        unsafe {
+            ctx.device
+                .cmd_fill_buffer(cmd, buffer.raw, 0, vk::WHOLE_SIZE, 0);
+            barrier(
+                ctx,
+                cmd,
+                vk::PipelineStageFlags::TRANSFER,
+                vk::AccessFlags::TRANSFER_WRITE,
+                vk::PipelineStageFlags::TRANSFER | vk::PipelineStageFlags::COMPUTE_SHADER,
+                vk::AccessFlags::TRANSFER_READ
+                    | vk::AccessFlags::TRANSFER_WRITE
+                    | vk::AccessFlags::SHADER_READ,
+            );
+        }
+    });
+    match filled {
+        Ok(()) => Ok(buffer),
+        Err(e) => {
+            buffer.destroy(ctx);
+            Err(e)
+        }
+    }
+}
+
+/// Runs of words of `new` that differ from `old` (equal lengths), as byte ranges relative to
+/// both; runs at most [`MERGE_GAP`] bytes apart are merged.
+fn changed_runs(old: &[u8], new: &[u8]) -> Vec<Range<usize>> {
+    let mut runs: Vec<Range<usize>> = Vec::new();
+    let mut at = 0;
+    while at < new.len() {
+        let end = (at + 64).min(new.len());
+        if old[at..end] == new[at..end] {
+            at = end;
+            continue;
+        }
+        for w in (at..end).step_by(4) {
+            let we = (w + 4).min(end);
+            if old[w..we] == new[w..we] {
+                continue;
+            }
+            match runs.last_mut() {
+                Some(last) if w <= last.end + MERGE_GAP => last.end = we,
+                _ => runs.push(w..we),
+            }
+        }
+        at = end;
+    }
+    runs
 }
 
 impl GpuWorld {
-    /// Uploads a world's current buffers.
+    /// Uploads a world's current buffers (waits until they are on the GPU), with the default
+    /// ring ([`RING_SLOTS`] × [`RING_SLOT_BYTES`]).
     pub fn upload(ctx: &GpuContext, view: &WorldView<'_>) -> Result<Self, GpuError> {
-        let mut buffers = Vec::new();
-        for (name, which) in [
-            ("brick index", GpuBuffer::BrickIndex),
-            ("bricks", GpuBuffer::Bricks),
-            ("coarse", GpuBuffer::Coarse),
-            ("material bytes", GpuBuffer::MaterialBytes),
-            ("material tables", GpuBuffer::MaterialTables),
-        ] {
-            let bytes = view.gpu_image(which);
-            match HostBuffer::upload(ctx, name, &bytes) {
-                Ok(b) => {
-                    buffers.push(b);
-                }
-                Err(e) => {
-                    buffers.into_iter().for_each(|b| b.destroy(ctx));
-                    return Err(e);
-                }
+        Self::with_ring(ctx, view, RING_SLOTS, RING_SLOT_BYTES)
+    }
+
+    /// [`GpuWorld::upload`] with a ring of `slots` staging buffers of `slot_bytes` each.
+    pub fn with_ring(
+        ctx: &GpuContext,
+        view: &WorldView<'_>,
+        slots: usize,
+        slot_bytes: u64,
+    ) -> Result<Self, GpuError> {
+        let sizes = GpuBuffer::ALL.map(|b| view.gpu_buffer_size(b));
+        let alignment = ctx.storage_alignment.max(16);
+        let (regions, total) = layout(
+            std::array::from_fn(|i| initial_capacity(GpuBuffer::ALL[i], sizes[i])),
+            alignment,
+        );
+        let buffer = zeroed_buffer(ctx, total)?;
+        let ring = match StagingRing::new(ctx, slots, slot_bytes.max(4)) {
+            Ok(r) => r,
+            Err(e) => {
+                buffer.destroy(ctx);
+                return Err(e);
             }
-        }
+        };
         let dims = view.dims();
-        Ok(Self {
-            buffers,
+        let mut world = Self {
+            buffer,
+            regions,
+            shadow: Default::default(),
+            ring,
+            queue: VecDeque::new(),
             dims: dims.bricks().to_array(),
             words_per_column: dims.coarse_words_per_column() as u32,
+            alignment,
+        };
+        let whole = sizes.map(|s| std::iter::once(0..s).collect());
+        let staged = world
+            .stage(ctx, view, &whole)
+            .and_then(|_| world.drain(ctx));
+        match staged {
+            Ok(_) => Ok(world),
+            Err(e) => {
+                world.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    /// One frame's upload: drains the world's changes, queues the words that differ from
+    /// the GPU's copy, and submits one flush of at most one ring slot; the rest waits
+    /// for the next frames. A GPU error leaves every byte queued or in the shadow, so the
+    /// next call resumes without losing anything.
+    pub fn update(&mut self, ctx: &GpuContext, world: &World) -> Result<UploadReport, GpuError> {
+        let dirty = world.take_dirty();
+        let view = world.read();
+        let mut report = self.stage(ctx, &view, &dirty.ranges)?;
+        drop(view);
+        report.add(&self.flush(ctx)?);
+        Ok(report)
+    }
+
+    /// [`GpuWorld::update`], then flushes until nothing is deferred and waits for the copies.
+    pub fn sync(&mut self, ctx: &GpuContext, world: &World) -> Result<UploadReport, GpuError> {
+        let mut report = self.update(ctx, world)?;
+        report.add(&self.drain(ctx)?);
+        Ok(report)
+    }
+
+    fn drain(&mut self, ctx: &GpuContext) -> Result<UploadReport, GpuError> {
+        let mut report = UploadReport::default();
+        while !self.queue.is_empty() {
+            report.add(&self.flush(ctx)?);
+        }
+        self.ring.wait_idle(ctx)?;
+        Ok(report)
+    }
+
+    fn flush(&mut self, ctx: &GpuContext) -> Result<UploadReport, GpuError> {
+        let (buffer, regions) = (self.buffer.raw, self.regions);
+        let flushed = self
+            .ring
+            .flush(ctx, &mut self.queue, |r| (buffer, regions[r].offset))?;
+        Ok(UploadReport {
+            uploaded_bytes: flushed.bytes,
+            copy_regions: flushed.regions,
+            flushes: u32::from(flushed.bytes > 0),
+            deferred_bytes: self
+                .queue
+                .iter()
+                .map(|u| (u.bytes.len() - u.done) as u64)
+                .sum(),
+            ..Default::default()
         })
     }
 
-    /// Frees the buffers.
+    /// Grows regions that the world outgrew, then queues the changed words of `ranges`.
+    fn stage(
+        &mut self,
+        ctx: &GpuContext,
+        view: &WorldView<'_>,
+        ranges: &[Vec<Range<u64>>; 5],
+    ) -> Result<UploadReport, GpuError> {
+        let mut report = UploadReport::default();
+        let sizes = GpuBuffer::ALL.map(|b| view.gpu_buffer_size(b));
+        if sizes
+            .iter()
+            .zip(&self.regions)
+            .any(|(s, r)| *s > r.capacity)
+        {
+            self.grow(ctx, sizes)?;
+            report.grew = true;
+        }
+        let mut bytes = Vec::new();
+        for (i, which) in GpuBuffer::ALL.into_iter().enumerate() {
+            let size = sizes[i];
+            if (self.shadow[i].len() as u64) < size {
+                // The GPU's region beyond the old size holds zeros (zeroed_buffer).
+                self.shadow[i].resize(size as usize, 0);
+            }
+            for r in &ranges[i] {
+                let (start, end) = (r.start & !3, align(r.end, 4).min(size));
+                if start >= end {
+                    continue;
+                }
+                report.dirty_bytes += r.end.min(size).saturating_sub(r.start);
+                bytes.clear();
+                view.copy_gpu_range(which, start..end, &mut bytes);
+                let old = &mut self.shadow[i][start as usize..end as usize];
+                for run in changed_runs(old, &bytes) {
+                    old[run.clone()].copy_from_slice(&bytes[run.clone()]);
+                    report.queued_bytes += run.len() as u64;
+                    self.queue.push_back(Upload {
+                        region: i,
+                        offset: start + run.start as u64,
+                        bytes: bytes[run].to_vec(),
+                        done: 0,
+                    });
+                }
+            }
+        }
+        Ok(report)
+    }
+
+    /// Replaces the buffer by one whose regions fit `sizes` (growing ones get 50% headroom),
+    /// copying the old contents on the GPU.
+    fn grow(&mut self, ctx: &GpuContext, sizes: [u64; 5]) -> Result<(), GpuError> {
+        let capacities = std::array::from_fn(|i| {
+            let cap = self.regions[i].capacity;
+            if sizes[i] > cap {
+                sizes[i].max(cap + cap / 2)
+            } else {
+                cap
+            }
+        });
+        let (regions, total) = layout(capacities, self.alignment);
+        self.ring.wait_idle(ctx)?;
+        let buffer = zeroed_buffer(ctx, total)?;
+        let copies: Vec<(vk::BufferCopy, usize)> = (0..5)
+            .filter(|&i| !self.shadow[i].is_empty())
+            .map(|i| {
+                (
+                    vk::BufferCopy {
+                        src_offset: self.regions[i].offset,
+                        dst_offset: regions[i].offset,
+                        size: self.shadow[i].len() as u64,
+                    },
+                    i,
+                )
+            })
+            .collect();
+        let copy: Vec<vk::BufferCopy> = copies.iter().map(|(c, _)| *c).collect();
+        let (old, new) = (self.buffer.raw, buffer.raw);
+        let copied = ctx.submit_and_wait(|cmd| {
+            // SAFETY: both buffers live until after the wait; barriers order the copy after
+            // earlier shader reads and copies and before later ones.
+            unsafe {
+                barrier(
+                    ctx,
+                    cmd,
+                    vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
+                    vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::AccessFlags::TRANSFER_READ | vk::AccessFlags::TRANSFER_WRITE,
+                );
+                if !copy.is_empty() {
+                    ctx.device.cmd_copy_buffer(cmd, old, new, &copy);
+                }
+                barrier(
+                    ctx,
+                    cmd,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                    vk::PipelineStageFlags::TRANSFER | vk::PipelineStageFlags::COMPUTE_SHADER,
+                    vk::AccessFlags::TRANSFER_READ
+                        | vk::AccessFlags::TRANSFER_WRITE
+                        | vk::AccessFlags::SHADER_READ,
+                );
+            }
+        });
+        if let Err(e) = copied {
+            buffer.destroy(ctx);
+            return Err(e);
+        }
+        let old = std::mem::replace(&mut self.buffer, buffer);
+        old.destroy(ctx);
+        self.regions = regions;
+        Ok(())
+    }
+
+    /// Reads a region back from the GPU (its bytes in use): tests compare it with
+    /// [`WorldView::gpu_image`]. Call after [`GpuWorld::sync`].
+    pub fn read_back(&self, ctx: &GpuContext, which: GpuBuffer) -> Result<Vec<u8>, GpuError> {
+        let i = which as usize;
+        let len = self.shadow[i].len() as u64;
+        let out = HostBuffer::new(ctx, "read back", len, MemoryLocation::GpuToCpu)?;
+        let (src, offset) = (self.buffer.raw, self.regions[i].offset);
+        let copied = ctx.submit_and_wait(|cmd| {
+            // SAFETY: both buffers live until after the wait.
+            unsafe {
+                barrier(
+                    ctx,
+                    cmd,
+                    vk::PipelineStageFlags::TRANSFER | vk::PipelineStageFlags::COMPUTE_SHADER,
+                    vk::AccessFlags::TRANSFER_WRITE | vk::AccessFlags::SHADER_WRITE,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::AccessFlags::TRANSFER_READ,
+                );
+                if len > 0 {
+                    ctx.device.cmd_copy_buffer(
+                        cmd,
+                        src,
+                        out.raw,
+                        &[vk::BufferCopy {
+                            src_offset: offset,
+                            dst_offset: 0,
+                            size: len,
+                        }],
+                    );
+                }
+                barrier(
+                    ctx,
+                    cmd,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                    vk::PipelineStageFlags::HOST,
+                    vk::AccessFlags::HOST_READ,
+                );
+            }
+        });
+        let bytes = copied.map(|_| out.read()[..len as usize].to_vec());
+        out.destroy(ctx);
+        bytes
+    }
+
+    /// Frees the buffer and the ring (waits for pending copies).
     pub fn destroy(self, ctx: &GpuContext) {
-        self.buffers.into_iter().for_each(|b| b.destroy(ctx));
+        self.ring.destroy(ctx);
+        self.buffer.destroy(ctx);
     }
 }
 
 impl GpuWorld {
-    /// The buffers in binding order.
-    pub fn buffers(&self) -> Vec<&HostBuffer> {
-        self.buffers.iter().collect()
+    /// The five regions as bindings 0..4.
+    pub fn bindings(&self) -> Vec<Binding> {
+        self.regions
+            .iter()
+            .map(|r| Binding {
+                buffer: self.buffer.raw,
+                offset: r.offset,
+                range: r.capacity,
+            })
+            .collect()
     }
     /// Grid size in bricks.
     pub fn dims(&self) -> [u32; 3] {
@@ -62,5 +448,53 @@ impl GpuWorld {
     /// Coarse words per coarse x-column.
     pub fn words_per_column(&self) -> u32 {
         self.words_per_column
+    }
+    /// Device bytes reserved (all regions with their headroom).
+    pub fn device_bytes(&self) -> u64 {
+        self.buffer.size
+    }
+    /// Host bytes kept as the GPU's shadow copy.
+    pub fn shadow_bytes(&self) -> u64 {
+        self.shadow.iter().map(|s| s.len() as u64).sum()
+    }
+    /// Bytes queued and not yet copied.
+    pub fn deferred_bytes(&self) -> u64 {
+        self.queue
+            .iter()
+            .map(|u| (u.bytes.len() - u.done) as u64)
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn changed_runs_are_the_differing_words_merged_across_small_gaps() {
+        let old = vec![0u8; 200];
+        let mut new = old.clone();
+        new[5] = 1; // word 4..8
+        new[13] = 1; // word 12..16: gap of 4 bytes → merged with 4..8
+        new[100] = 1; // far away: own run
+        new[199] = 1; // last word
+        assert_eq!(changed_runs(&old, &new), vec![4..16, 100..104, 196..200]);
+        assert!(changed_runs(&old, &old).is_empty());
+        // A 2-word gap is not merged.
+        let mut n2 = old.clone();
+        n2[0] = 1;
+        n2[12] = 1;
+        assert_eq!(changed_runs(&old, &n2), vec![0..4, 12..16]);
+    }
+
+    #[test]
+    fn regions_are_aligned_and_disjoint() {
+        let (r, total) = layout([10, 68 * 3, 4, 0, 2304], 256);
+        for w in r.windows(2) {
+            assert!(w[0].offset + w[0].capacity <= w[1].offset);
+            assert_eq!(w[1].offset % 256, 0);
+        }
+        assert!(r[4].offset + r[4].capacity <= total);
+        assert_eq!(r[0].capacity, 12);
     }
 }
