@@ -18,6 +18,11 @@ layout(std430, set = 0, binding = 4) readonly buffer MaterialTables {
     float strength[64];
 } tables;
 
+// A shader that never traces inside a dielectric defines MEDIUM_POSSIBLE false.
+#ifndef MEDIUM_POSSIBLE
+#define MEDIUM_POSSIBLE true
+#endif
+
 const uint EMPTY = 0xFFFFFFFFu;
 const uint FULL_BASE = 0xFFFFFE00u;
 const uint UNIFORM_FLAG = 0x80000000u;
@@ -109,7 +114,7 @@ bool dda(ivec3 cell, float t, int axis, int medium, float t_max, out ivec3 voxel
         int block = 1;
         if (inside) {
             bool hit;
-            if (medium == AIR) {
+            if (!MEDIUM_POSSIBLE || medium == AIR) {
                 if (!coarse_occupied(cell >> 5)) block = 32;
                 else if (cell_word(cell >> 3) == EMPTY) block = 8;
                 hit = block == 1 && solid_at(cell);

@@ -1,11 +1,13 @@
-// Display stage: linear HDR accumulation → exposure → ACES fitted → sRGB 8-bit.
-// Keep in sync with render/src/image.rs (aces_fitted, encode_srgb) and render/src/vulkan/tonemap.rs.
+// Display stage: HDR accumulation (sum, count) at the internal resolution → mean →
+// bilinear upscale to the output resolution (in linear HDR) → exposure → ACES fitted →
+// sRGB 8-bit. Keep in sync with render/src/image.rs (resized_bilinear, aces_fitted,
+// encode_srgb) and render/src/vulkan/tonemap.rs.
 #version 450
-layout(local_size_x = 64) in;
+layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std430, set = 0, binding = 0) readonly buffer Hdr { float hdr[]; };   // RGB triples
+layout(std430, set = 0, binding = 0) readonly buffer Hdr { vec4 hdr[]; };    // rgb sum, count
 layout(std430, set = 0, binding = 1) writeonly buffer Ldr { uint ldr[]; };   // RGBA8 packed
-layout(push_constant) uniform Push { uint pixels; float scale; } pc;
+layout(push_constant) uniform Push { uvec2 src; uvec2 dst; float scale; } pc;
 
 vec3 aces_fitted(vec3 c) {
     const mat3 INPUT = mat3(0.59719, 0.07600, 0.02840,
@@ -25,10 +27,22 @@ uint encode_srgb(float x) {
     return uint(s * 255.0 + 0.5);
 }
 
+vec3 texel(int x, int y) {
+    x = clamp(x, 0, int(pc.src.x) - 1);
+    y = clamp(y, 0, int(pc.src.y) - 1);
+    vec4 v = hdr[uint(y) * pc.src.x + uint(x)];
+    return v.a > 0.0 ? v.rgb / v.a : vec3(0.0);
+}
+
 void main() {
-    uint i = gl_GlobalInvocationID.x;
-    if (i >= pc.pixels) return;
-    vec3 c = vec3(hdr[3 * i], hdr[3 * i + 1], hdr[3 * i + 2]) * pc.scale;
+    uvec2 px = gl_GlobalInvocationID.xy;
+    if (px.x >= pc.dst.x || px.y >= pc.dst.y) return;
+    vec2 s = (vec2(px) + 0.5) * (vec2(pc.src) / vec2(pc.dst)) - 0.5;
+    vec2 f0 = floor(s);
+    vec2 f = s - f0;
+    ivec2 i = ivec2(f0);
+    vec3 c = mix(mix(texel(i.x, i.y), texel(i.x + 1, i.y), f.x),
+                 mix(texel(i.x, i.y + 1), texel(i.x + 1, i.y + 1), f.x), f.y) * pc.scale;
     vec3 t = aces_fitted(c);
-    ldr[i] = encode_srgb(t.r) | (encode_srgb(t.g) << 8) | (encode_srgb(t.b) << 16) | (255u << 24);
+    ldr[px.y * pc.dst.x + px.x] = encode_srgb(t.r) | (encode_srgb(t.g) << 8) | (encode_srgb(t.b) << 16) | (255u << 24);
 }

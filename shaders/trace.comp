@@ -4,6 +4,21 @@
 #version 450
 layout(local_size_x = 8, local_size_y = 8) in;
 
+// Pipeline variants (render/src/vulkan/trace.rs `Variant`): what the scene needs. Code for
+// a material kind, the sun or the gradient sky that a scene lacks is compiled out; the path
+// length is a constant so short paths unroll. Sun and sky are also checked at run time, so
+// the everything variant (the defaults) renders any scene.
+layout(constant_id = 0) const bool HAS_LAMBERTIAN = true;
+layout(constant_id = 1) const bool HAS_METAL = true;
+layout(constant_id = 2) const bool HAS_DIELECTRIC = true;
+layout(constant_id = 3) const bool HAS_EMISSIVE = true;
+layout(constant_id = 4) const bool SUN = true;
+layout(constant_id = 5) const bool GRADIENT_SKY = true;
+layout(constant_id = 6) const uint MAX_BOUNCES = 4u;
+layout(constant_id = 7) const bool COUNT_RAYS = false;
+
+// Without dielectrics every ray travels in air: the traversal drops its medium branch.
+#define MEDIUM_POSSIBLE HAS_DIELECTRIC
 #include "brickmap.glsl"
 
 struct Params {
@@ -19,12 +34,17 @@ struct Params {
     vec4 sky_horizon;   // rgb
     vec4 sky_zenith;    // rgb, w: 1 for a gradient, 0 for uniform (horizon colour)
     uvec4 grid;         // bricks xyz, coarse words per column
-    uvec4 image;        // width, height, samples per pixel, max bounces B
-    uvec4 seed;         // seed, camera medium (material + 1, 0 for air), first sample index, unused
+    uvec4 image;        // width, height, samples per pixel in this dispatch, max bounces B
+    uvec4 seed;         // seed, camera medium (material + 1, 0 for air), first sample index,
+                        // 1 to add to the accumulation (0 to start it)
 };
 
 layout(std430, set = 0, binding = 5) readonly buffer ParamBuffer { Params p; };
-layout(std430, set = 0, binding = 6) writeonly buffer Accum { vec4 accum[]; };
+// Per pixel: the sum of its samples' radiance (rgb) and their count (a).
+layout(std430, set = 0, binding = 6) buffer Accum { vec4 accum[]; };
+// Rays traced (COUNT_RAYS variants only): camera rays, continuation rays, shadow rays.
+layout(std430, set = 0, binding = 7) buffer Counters { uint counters[4]; };
+uint g_rays[3];
 
 const float PI = 3.14159265358979;
 const int LAMBERTIAN = 0;
@@ -57,12 +77,14 @@ Shading material(int index) {
     uint param = (v >> 2) & 63u;
     uint colour = tables.colours[v >> 8];
     s.albedo = vec3(srgb_to_linear(colour & 0xFFu), srgb_to_linear((colour >> 8) & 0xFFu), srgb_to_linear((colour >> 16) & 0xFFu));
-    s.param = s.kind == METAL ? tables.roughness[param] : (s.kind == DIELECTRIC ? tables.ior[param] : (s.kind == EMISSIVE ? tables.strength[param] : 0.0));
+    s.param = HAS_METAL && s.kind == METAL ? tables.roughness[param]
+            : (HAS_DIELECTRIC && s.kind == DIELECTRIC ? tables.ior[param]
+            : (HAS_EMISSIVE && s.kind == EMISSIVE ? tables.strength[param] : 0.0));
     return s;
 }
 
 vec3 sky(vec3 d) {
-    if (p.sky_zenith.w == 0.0) return p.sky_horizon.rgb;
+    if (!GRADIENT_SKY || p.sky_zenith.w == 0.0) return p.sky_horizon.rgb;
     float t = clamp(d.y, 0.0, 1.0);
     return p.sky_horizon.rgb * (1.0 - t) + p.sky_zenith.rgb * t;
 }
@@ -72,7 +94,7 @@ float sun_area() { return PI * p.sun_centre.w * p.sun_centre.w; }
 // Distance to the sun disc's front face along a unit ray, or -1; also its cosine.
 float sun_hit(vec3 o, vec3 d, out float cos_l) {
     cos_l = 0.0;
-    if (p.sun_normal.w == 0.0) return -1.0;
+    if (!SUN || p.sun_normal.w == 0.0) return -1.0;
     float denom = dot(d, p.sun_normal.xyz);
     if (denom >= 0.0) return -1.0;
     float t = dot(p.sun_centre.xyz - o, p.sun_normal.xyz) / denom;
@@ -122,11 +144,11 @@ void frame(vec3 n, out vec3 t, out vec3 b) {
 vec3 eval_bsdf(Shading s, vec3 wo, vec3 wi, out float pdf) {
     pdf = 0.0;
     if (wo.z <= 0.0 || wi.z <= 0.0) return vec3(0.0);
-    if (s.kind == LAMBERTIAN) {
+    if (HAS_LAMBERTIAN && s.kind == LAMBERTIAN) {
         pdf = wi.z / PI;
         return s.albedo / PI;
     }
-    if (s.kind == METAL && s.param > 0.0) {
+    if (HAS_METAL && s.kind == METAL && s.param > 0.0) {
         float alpha = s.param * s.param;
         vec3 h = normalize(wo + wi);
         float d = ggx_d(h, alpha);
@@ -143,7 +165,7 @@ bool sample_bsdf(Shading s, vec3 wo, out vec3 wi, out vec3 weight, out float pdf
     weight = vec3(0.0);
     pdf = -1.0;
     wi = vec3(0.0, 0.0, 1.0);
-    if (s.kind == LAMBERTIAN) {
+    if (HAS_LAMBERTIAN && s.kind == LAMBERTIAN) {
         float u1 = rand();
         float r = sqrt(u1);
         float phi = 2.0 * PI * rand();
@@ -152,12 +174,12 @@ bool sample_bsdf(Shading s, vec3 wo, out vec3 wi, out vec3 weight, out float pdf
         pdf = wi.z / PI;
         return wi.z > 0.0;
     }
-    if (s.kind == METAL && s.param <= 0.0) {
+    if (HAS_METAL && s.kind == METAL && s.param <= 0.0) {
         wi = vec3(-wo.x, -wo.y, wo.z);
         weight = s.albedo;
         return true;
     }
-    if (s.kind == METAL) {
+    if (HAS_METAL && s.kind == METAL) {
         float alpha = s.param * s.param;
         if (wo.z <= 0.0) return false;
         vec3 h = ggx_sample_visible(wo, alpha, rand(), rand());
@@ -178,13 +200,14 @@ vec3 radiance(vec3 origin, vec3 dir) {
     vec3 d = dir;
     bool from_camera = true;
     ivec3 start = ivec3(0);
-    int medium = int(p.seed.y) - 1;
+    int medium = HAS_DIELECTRIC ? int(p.seed.y) - 1 : AIR;
     float bsdf_pdf = -1.0; // < 0: delta or camera
-    uint bounces = p.image.w;
+    const uint bounces = MAX_BOUNCES;
     for (uint vertex = 1u; vertex <= bounces + 1u; vertex++) {
         ivec3 voxel;
         ivec3 normal;
         float t_voxel;
+        if (COUNT_RAYS) g_rays[from_camera ? 0 : 1]++;
         bool hit = from_camera ? trace_from_origin(o, d, medium, 1.0 / 0.0, voxel, normal, t_voxel)
                                : trace_from_cell(o, d, start, medium, 1.0 / 0.0, voxel, normal, t_voxel);
         if (!hit) t_voxel = 1.0 / 0.0;
@@ -204,8 +227,8 @@ vec3 radiance(vec3 origin, vec3 dir) {
         int here = material_at(voxel);
         Shading s;
         if (here >= 0) s = material(here);
-        bool crossing = (here >= 0 && s.kind == DIELECTRIC) || (here < 0 && medium >= 0);
-        if (here >= 0 && s.kind == EMISSIVE) {
+        bool crossing = HAS_DIELECTRIC && ((here >= 0 && s.kind == DIELECTRIC) || (here < 0 && medium >= 0));
+        if (HAS_EMISSIVE && here >= 0 && s.kind == EMISSIVE) {
             l += beta * s.albedo * s.param;
             break;
         }
@@ -241,8 +264,8 @@ vec3 radiance(vec3 origin, vec3 dir) {
             vec3 fb;
             frame(n, ft, fb);
             vec3 wo = vec3(dot(-d, ft), dot(-d, fb), dot(-d, n));
-            bool delta = s.kind == METAL && s.param <= 0.0;
-            if (!delta && p.sun_normal.w != 0.0) {
+            bool delta = HAS_METAL && s.kind == METAL && s.param <= 0.0;
+            if (SUN && !delta && p.sun_normal.w != 0.0) {
                 float r = p.sun_centre.w * sqrt(rand());
                 float phi = 2.0 * PI * rand();
                 vec3 y = p.sun_centre.xyz + (p.sun_e1.xyz * cos(phi) + p.sun_e2.xyz * sin(phi)) * r;
@@ -257,6 +280,7 @@ vec3 radiance(vec3 origin, vec3 dir) {
                     ivec3 sv;
                     ivec3 sn;
                     float st;
+                    if (COUNT_RAYS && fv != vec3(0.0)) g_rays[2]++;
                     if (fv != vec3(0.0) && !trace_from_cell(pt, w, front, AIR, dist, sv, sn, st)) {
                         float pdf_light = dist * dist / (cl * sun_area());
                         l += beta * fv * wi.z * p.sun_radiance.rgb * power_heuristic(pdf_light, pdf_bsdf) / pdf_light;
@@ -290,6 +314,9 @@ void main() {
     g_words_per_column = p.grid.w;
     uint index = px.y * p.image.x + px.x;
     vec3 sum = vec3(0.0);
+    g_rays[0] = 0u;
+    g_rays[1] = 0u;
+    g_rays[2] = 0u;
     for (uint s = 0u; s < p.image.z; s++) {
         rng = hash(p.seed.x ^ hash(index * 9781u + (p.seed.z + s) * 6271u + 1u));
         float u = (2.0 * (float(px.x) + rand()) / float(p.image.x) - 1.0);
@@ -297,5 +324,9 @@ void main() {
         vec3 dir = normalize(p.cam_forward.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v);
         sum += radiance(p.cam_pos.xyz, dir);
     }
-    accum[index] = vec4(sum / float(max(p.image.z, 1u)), 1.0);
+    vec4 mine = vec4(sum, float(p.image.z));
+    accum[index] = p.seed.w != 0u ? accum[index] + mine : mine;
+    if (COUNT_RAYS) {
+        for (int k = 0; k < 3; k++) atomicAdd(counters[k], g_rays[k]);
+    }
 }

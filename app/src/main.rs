@@ -116,6 +116,10 @@ enum Command {
         /// Random seed.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Internal resolution as a fraction of the output (0 < F <= 1): paths are traced at
+        /// ceil(W·F)×ceil(H·F) and upscaled bilinearly.
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
     },
     /// Replay an edit script headlessly, reporting each step; exits non-zero at the first
     /// failed step.
@@ -341,6 +345,7 @@ fn run(cli: Cli) -> Result<()> {
             camera,
             device,
             seed,
+            scale,
         } => render_command(RenderArgs {
             scene,
             out,
@@ -352,6 +357,7 @@ fn run(cli: Cli) -> Result<()> {
             camera,
             device,
             seed,
+            scale,
             workers,
         }),
         Command::Replay {
@@ -532,12 +538,16 @@ struct RenderArgs {
     camera: Option<String>,
     device: String,
     seed: u64,
+    scale: f64,
     workers: usize,
 }
 
 fn render_command(a: RenderArgs) -> Result<()> {
     if a.spp == 0 || a.width == 0 || a.height == 0 || a.width > 16384 || a.height > 16384 {
         bail!("--spp, --width and --height must be positive (sizes at most 16384)");
+    }
+    if !(a.scale > 0.0 && a.scale <= 1.0) {
+        bail!("--scale {} is outside (0, 1]", a.scale);
     }
     let scene = with_progress(format!("reading {}", a.scene.display()), || {
         Ok(Scene::load(&a.scene, a.workers)?)
@@ -559,13 +569,22 @@ fn render_command(a: RenderArgs) -> Result<()> {
         params.settings.max_bounces = b;
     }
     let view = scene.world.read();
+    let internal = (
+        ((a.width as f64 * a.scale).ceil() as u32).max(1),
+        ((a.height as f64 * a.scale).ceil() as u32).max(1),
+    );
     let job = render::cpu::RenderJob {
-        width: a.width,
-        height: a.height,
+        width: internal.0,
+        height: internal.1,
         spp: a.spp,
         seed: a.seed,
     };
     let (image, backend, timing) = render_on(&a.device, &view, &params, &job)?;
+    let image = if internal == (a.width, a.height) {
+        image
+    } else {
+        image.resized_bilinear(a.width, a.height)
+    };
     let write = |path: &PathBuf, f: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
         app::atomic::write_atomic(path, f).with_context(|| format!("writing {}", path.display()))
     };
@@ -573,13 +592,15 @@ fn render_command(a: RenderArgs) -> Result<()> {
     if let Some(hdr) = &a.hdr {
         write(hdr, &|w| image.write_pfm(w))?;
     }
-    let samples = a.width as u64 * a.height as u64 * a.spp as u64;
+    let samples = internal.0 as u64 * internal.1 as u64 * a.spp as u64;
     emit(&format!(
-        "rendered     {samples} samples ({}x{} at {} spp, {} bounces) on {backend}\n{timing}wrote        {}\n",
-        a.width,
-        a.height,
+        "rendered     {samples} samples ({}x{} at {} spp, {} bounces) on {backend}, shown at {}x{}\n{timing}wrote        {}\n",
+        internal.0,
+        internal.1,
         a.spp,
         params.settings.max_bounces,
+        a.width,
+        a.height,
         a.out.display()
     ))
 }
@@ -604,7 +625,9 @@ fn bench_gpu(
     workers: usize,
 ) -> Result<()> {
     use render::vulkan::{
-        ContextOptions, DeviceChoice, GpuContext, trace::PathTracer, world::GpuWorld,
+        ContextOptions, DeviceChoice, GpuContext,
+        trace::{PathTracer, Variant},
+        world::GpuWorld,
     };
     let scene = thesis_scene(workers)?;
     let choice = device.map_or(DeviceChoice::Best, DeviceChoice::Name);
@@ -614,13 +637,13 @@ fn bench_gpu(
     })?;
     let view = scene.world.read();
     let world = GpuWorld::upload(&ctx, &view)?;
-    let tracer = PathTracer::new(&ctx)?;
     let mut text = format!(
         "device       {}\nscene        thesis (512x256x512, {} solid voxels), {width}x{height}\n",
         ctx.name,
         view.solid_count()
     );
     let mut failure = None;
+    let mut tracer = PathTracer::new(&ctx)?;
     for (label, bounces, spp, sun) in [
         ("complexity 1 (1 bounce, 1 spp, no sun)", 1, 1, false),
         ("complexity 2 (1 bounce, 1 spp, sun)", 1, 1, true),
@@ -629,42 +652,63 @@ fn bench_gpu(
         let mut params = scene.params.clone();
         params.settings.max_bounces = bounces;
         params.sun.enabled = sun;
-        let mut times = Vec::with_capacity(frames);
-        for frame in 0..frames + 5 {
-            let job = render::cpu::RenderJob {
-                width,
-                height,
-                spp,
-                seed: frame as u64,
-            };
-            match tracer
-                .render(&ctx, &world, &view, &params, &job)
-                .map(|(_, gpu)| gpu)
-            {
-                Ok(Some(t)) if frame >= 5 => times.push(t),
-                Ok(_) => {}
-                Err(e) => {
-                    failure = Some(e);
-                    break;
+        let job = |seed: u64| render::cpu::RenderJob {
+            width,
+            height,
+            spp,
+            seed,
+        };
+        // The scene's variant and the everything variant, alternated frame by frame so both
+        // see the same machine state; the first 5 frames of each are warm-up.
+        let scene_variant = Variant::for_scene(view.materials(), &params);
+        let variants = [scene_variant, Variant::everything(bounces)];
+        let mut times = [Vec::with_capacity(frames), Vec::with_capacity(frames)];
+        'frames: for frame in 0..frames + 5 {
+            for (k, v) in variants.iter().enumerate() {
+                match tracer.render_variant(&ctx, &world, &view, &params, &job(frame as u64), *v) {
+                    Ok((_, Some(t))) if frame >= 5 => times[k].push(t),
+                    Ok(_) => {}
+                    Err(e) => {
+                        failure = Some(e);
+                        break 'frames;
+                    }
                 }
             }
         }
         if failure.is_some() {
             break;
         }
-        if times.is_empty() {
+        if times[0].is_empty() {
             text += &format!("{label}: this queue cannot take timestamps\n");
             continue;
         }
-        times.sort_by(|a, b| a.total_cmp(b));
-        let median = times[times.len() / 2];
-        let primary = width as f64 * height as f64 * spp as f64 / median / 1e6;
+        let rays = match tracer.render_counted(&ctx, &world, &view, &params, &job(0)) {
+            Ok((_, _, rays)) => rays,
+            Err(e) => {
+                failure = Some(e);
+                break;
+            }
+        };
+        let n = times[0].len();
+        let [(median, p10, p90), (full, _, _)] = times.map(|mut t| {
+            t.sort_by(|a, b| a.total_cmp(b));
+            (t[t.len() / 2], t[t.len() / 10], t[t.len() * 9 / 10])
+        });
         text += &format!(
-            "{label}: median {:.3} ms (p10 {:.3}, p90 {:.3}, {} frames), {primary:.1} M primary rays/s\n",
+            "{label}: median {:.3} ms (p10 {:.3}, p90 {:.3}, {} frames); everything variant {:.3} ms ({:+.1}%)\n  \
+             rays: {:.1} M primary, {:.1} M secondary, {:.1} M shadow; {:.0} Mrays/s primary, {:.0} Mrays/s secondary+shadow, {:.0} Mrays/s all\n",
             median * 1e3,
-            times[times.len() / 10] * 1e3,
-            times[times.len() * 9 / 10] * 1e3,
-            times.len()
+            p10 * 1e3,
+            p90 * 1e3,
+            n,
+            full * 1e3,
+            (full / median - 1.0) * 100.0,
+            rays.primary as f64 / 1e6,
+            rays.secondary as f64 / 1e6,
+            rays.shadow as f64 / 1e6,
+            rays.primary as f64 / median / 1e6,
+            (rays.secondary + rays.shadow) as f64 / median / 1e6,
+            rays.total() as f64 / median / 1e6,
         );
     }
     tracer.destroy(&ctx);
@@ -720,23 +764,26 @@ fn render_on(
             || "no usable Vulkan device (the CPU reference renderer runs with --device cpu)",
         )?;
         let world = GpuWorld::upload(&ctx, view)?;
-        let tracer = PathTracer::new(&ctx)?;
+        let mut tracer = PathTracer::new(&ctx)?;
         let rendered = with_progress(
             format!(
                 "rendering {}x{} at {} spp on {}",
                 job.width, job.height, job.spp, ctx.name
             ),
-            || Ok(tracer.render(&ctx, &world, view, params, job)?),
+            || Ok(tracer.render_counted(&ctx, &world, view, params, job)?),
         );
         tracer.destroy(&ctx);
         world.destroy(&ctx);
-        let (image, gpu) = rendered?;
-        let primary = job.width as f64 * job.height as f64 * job.spp as f64;
+        let (image, gpu, rays) = rendered?;
         let timing = match gpu {
             Some(t) => format!(
-                "gpu time     {:.3} ms (timestamp queries)\nprimary rays {:.1} M/s\n",
+                "gpu time     {:.3} ms (timestamp queries)\nrays         {} ({:.1} Mrays/s: {} primary, {} secondary, {} shadow)\n",
                 t * 1e3,
-                primary / t / 1e6
+                rays.total(),
+                rays.total() as f64 / t / 1e6,
+                rays.primary,
+                rays.secondary,
+                rays.shadow
             ),
             None => format!(
                 "time         {:.2} s (this queue cannot take timestamps)\n",

@@ -53,6 +53,43 @@ impl Image {
         m
     }
 
+    /// The image resampled to `width`×`height` by bilinear interpolation between pixel
+    /// centres (edges clamped), as the display pass upscales the internal resolution.
+    pub fn resized_bilinear(&self, width: u32, height: u32) -> Image {
+        let (sw, sh) = (self.width as i64, self.height as i64);
+        let texel = |x: i64, y: i64| {
+            let p = self.pixels[(y.clamp(0, sh - 1) * sw + x.clamp(0, sw - 1)) as usize];
+            [p[0] as f64, p[1] as f64, p[2] as f64]
+        };
+        let (rx, ry) = (sw as f64 / width as f64, sh as f64 / height as f64);
+        let mut pixels = Vec::with_capacity(width as usize * height as usize);
+        for y in 0..height {
+            let sy = (y as f64 + 0.5) * ry - 0.5;
+            let (y0, fy) = (sy.floor(), sy - sy.floor());
+            for x in 0..width {
+                let sx = (x as f64 + 0.5) * rx - 0.5;
+                let (x0, fx) = (sx.floor(), sx - sx.floor());
+                let (a, b) = (texel(x0 as i64, y0 as i64), texel(x0 as i64 + 1, y0 as i64));
+                let (c, d) = (
+                    texel(x0 as i64, y0 as i64 + 1),
+                    texel(x0 as i64 + 1, y0 as i64 + 1),
+                );
+                let mut out = [0f32; 3];
+                for k in 0..3 {
+                    let top = a[k] + (b[k] - a[k]) * fx;
+                    let bottom = c[k] + (d[k] - c[k]) * fx;
+                    out[k] = (top + (bottom - top) * fy) as f32;
+                }
+                pixels.push(out);
+            }
+        }
+        Image {
+            width,
+            height,
+            pixels,
+        }
+    }
+
     /// Whether every value is finite (no NaN, no infinity).
     pub fn all_finite(&self) -> bool {
         self.pixels.iter().all(|p| p.iter().all(|c| c.is_finite()))

@@ -408,7 +408,7 @@ fn render_step(
         let ctx = GpuContext::new(&ContextOptions { device: choice, validation: false })
             .context("no usable Vulkan device for render steps (replay with --device cpu for the CPU reference)")?;
         let world = GpuWorld::upload(&ctx, &view)?;
-        let tracer = PathTracer::new(&ctx)?;
+        let mut tracer = PathTracer::new(&ctx)?;
         let rendered = tracer.render(&ctx, &world, &view, &params, &job(r.seed));
         tracer.destroy(&ctx);
         world.destroy(&ctx);

@@ -1,6 +1,7 @@
 //! Storage buffers: host-visible ones the CPU writes and reads back, and device-local ones
 //! filled by a copy from a host-visible staging buffer.
 
+use super::staging::barrier;
 use super::{GpuContext, GpuError, vk_call};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -179,4 +180,47 @@ impl HostBuffer {
         // SAFETY: the caller guarantees the GPU no longer uses the buffer.
         unsafe { ctx.device.destroy_buffer(self.raw, None) };
     }
+}
+
+/// Copies a (device-local) buffer range into host memory and returns its bytes; earlier
+/// shader writes and copies are made visible first.
+pub fn read_device(ctx: &GpuContext, src: Binding) -> Result<Vec<u8>, GpuError> {
+    let out = HostBuffer::new(ctx, "read back", src.range, MemoryLocation::GpuToCpu)?;
+    let dst = out.raw;
+    let copied = ctx.submit_and_wait(|cmd| {
+        // SAFETY: both buffers live until after the wait inside submit_and_wait.
+        unsafe {
+            barrier(
+                ctx,
+                cmd,
+                vk::PipelineStageFlags::TRANSFER | vk::PipelineStageFlags::COMPUTE_SHADER,
+                vk::AccessFlags::TRANSFER_WRITE | vk::AccessFlags::SHADER_WRITE,
+                vk::PipelineStageFlags::TRANSFER,
+                vk::AccessFlags::TRANSFER_READ,
+            );
+            if src.range > 0 {
+                ctx.device.cmd_copy_buffer(
+                    cmd,
+                    src.buffer,
+                    dst,
+                    &[vk::BufferCopy {
+                        src_offset: src.offset,
+                        dst_offset: 0,
+                        size: src.range,
+                    }],
+                );
+            }
+            barrier(
+                ctx,
+                cmd,
+                vk::PipelineStageFlags::TRANSFER,
+                vk::AccessFlags::TRANSFER_WRITE,
+                vk::PipelineStageFlags::HOST,
+                vk::AccessFlags::HOST_READ,
+            );
+        }
+    });
+    let bytes = copied.map(|_| out.read()[..src.range as usize].to_vec());
+    out.destroy(ctx);
+    bytes
 }

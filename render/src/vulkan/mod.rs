@@ -6,6 +6,7 @@
 pub mod buffer;
 pub mod pass;
 pub mod primary;
+pub mod progressive;
 pub mod staging;
 pub mod tonemap;
 pub mod trace;

@@ -19,7 +19,30 @@ impl ComputePass {
     /// Builds the pipeline for SPIR-V bytes with `buffers` storage buffers and `push` bytes
     /// of push constants.
     pub fn new(ctx: &GpuContext, spirv: &[u8], buffers: u32, push: u32) -> Result<Self, GpuError> {
+        Self::specialized(ctx, spirv, buffers, push, &[])
+    }
+
+    /// [`ComputePass::new`] with specialization constants: `constants[i]` is the 32-bit
+    /// value of `constant_id = i` (booleans as 0 or 1).
+    pub fn specialized(
+        ctx: &GpuContext,
+        spirv: &[u8],
+        buffers: u32,
+        push: u32,
+        constants: &[u32],
+    ) -> Result<Self, GpuError> {
         let d = &ctx.device;
+        let entries: Vec<vk::SpecializationMapEntry> = (0..constants.len() as u32)
+            .map(|i| vk::SpecializationMapEntry {
+                constant_id: i,
+                offset: 4 * i,
+                size: 4,
+            })
+            .collect();
+        let spec_data: &[u8] = bytemuck::cast_slice(constants);
+        let spec = vk::SpecializationInfo::default()
+            .map_entries(&entries)
+            .data(spec_data);
         let words: Vec<u32> = spirv
             .chunks_exact(4)
             .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
@@ -67,6 +90,11 @@ impl ComputePass {
                 .stage(vk::ShaderStageFlags::COMPUTE)
                 .module(module)
                 .name(c"main");
+            let stage = if constants.is_empty() {
+                stage
+            } else {
+                stage.specialization_info(&spec)
+            };
             let info = [vk::ComputePipelineCreateInfo::default()
                 .stage(stage)
                 .layout(layout)];

@@ -1,25 +1,27 @@
-//! The display pass on the GPU: linear HDR → exposure → ACES fitted → sRGB 8-bit
-//! (`shaders/tonemap.comp`), the same curve as `Image::to_srgb8` on the CPU.
+//! The display pass on the GPU (`shaders/tonemap.comp`): accumulated HDR (radiance sum and
+//! sample count per pixel) → mean → bilinear upscale from the internal to the output
+//! resolution → exposure → ACES fitted → sRGB 8-bit; the same arithmetic as
+//! `Image::resized_bilinear` and `Image::to_srgb8` on the CPU.
 
-use super::buffer::HostBuffer;
+use super::buffer::{Binding, HostBuffer};
 use super::pass::ComputePass;
 use super::{GpuContext, GpuError};
 use crate::image::Image;
 use gpu_allocator::MemoryLocation;
 
 const SPIRV: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/tonemap.comp.spv"));
-const GROUP: u32 = 64;
 
 /// Push constants. Keep in sync with `Push` in shaders/tonemap.comp.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct Push {
-    pixels: u32,
+    src: [u32; 2],
+    dst: [u32; 2],
     scale: f32,
 }
-const _: () = assert!(std::mem::size_of::<Push>() == 8);
+const _: () = assert!(std::mem::size_of::<Push>() == 20);
 
-/// The tone-map pipeline.
+/// The display pipeline.
 pub struct ToneMapper(ComputePass);
 
 impl ToneMapper {
@@ -33,32 +35,28 @@ impl ToneMapper {
         )?))
     }
 
-    /// Tone-maps an image on the GPU; returns sRGB 8-bit pixels.
-    pub fn run(
+    /// Displays `hdr` (vec4 per pixel: radiance sum, sample count) of size `src` at size
+    /// `dst`; returns sRGB 8-bit pixels, rows top to bottom.
+    pub fn display(
         &self,
         ctx: &GpuContext,
-        image: &Image,
+        hdr: Binding,
+        src: (u32, u32),
+        dst: (u32, u32),
         exposure: f32,
     ) -> Result<Vec<[u8; 3]>, GpuError> {
-        let pixels = image.pixels.len() as u32;
-        let mut hdr = HostBuffer::new(ctx, "hdr", pixels as u64 * 12, MemoryLocation::CpuToGpu)?;
-        let ldr = match HostBuffer::new(ctx, "ldr", pixels as u64 * 4, MemoryLocation::GpuToCpu) {
-            Ok(b) => b,
-            Err(e) => {
-                hdr.destroy(ctx);
-                return Err(e);
-            }
-        };
-        hdr.write(bytemuck::cast_slice(&image.pixels));
+        let pixels = dst.0 as u64 * dst.1 as u64;
+        let ldr = HostBuffer::new(ctx, "ldr", pixels * 4, MemoryLocation::GpuToCpu)?;
         let push = Push {
-            pixels,
+            src: [src.0, src.1],
+            dst: [dst.0, dst.1],
             scale: 2f32.powf(exposure),
         };
         let result = self.0.run(
             ctx,
-            &[hdr.binding(), ldr.binding()],
+            &[hdr, ldr.binding()],
             bytemuck::bytes_of(&push),
-            [pixels.div_ceil(GROUP), 1],
+            [dst.0.div_ceil(8), dst.1.div_ceil(8)],
         );
         let out = result.map(|_| {
             ldr.read()[..pixels as usize * 4]
@@ -66,8 +64,49 @@ impl ToneMapper {
                 .map(|p| [p[0], p[1], p[2]])
                 .collect()
         });
-        hdr.destroy(ctx);
         ldr.destroy(ctx);
+        out
+    }
+
+    /// Tone-maps a linear image on the GPU at its own size; returns sRGB 8-bit pixels.
+    pub fn run(
+        &self,
+        ctx: &GpuContext,
+        image: &Image,
+        exposure: f32,
+    ) -> Result<Vec<[u8; 3]>, GpuError> {
+        let size = (image.width, image.height);
+        self.upscale(ctx, image, size, exposure)
+    }
+
+    /// Displays a linear image at size `dst` (bilinear upscale, then the curve).
+    pub fn upscale(
+        &self,
+        ctx: &GpuContext,
+        image: &Image,
+        dst: (u32, u32),
+        exposure: f32,
+    ) -> Result<Vec<[u8; 3]>, GpuError> {
+        let packed: Vec<[f32; 4]> = image
+            .pixels
+            .iter()
+            .map(|p| [p[0], p[1], p[2], 1.0])
+            .collect();
+        let mut hdr = HostBuffer::new(
+            ctx,
+            "hdr",
+            packed.len() as u64 * 16,
+            MemoryLocation::CpuToGpu,
+        )?;
+        hdr.write(bytemuck::cast_slice(&packed));
+        let out = self.display(
+            ctx,
+            hdr.binding(),
+            (image.width, image.height),
+            dst,
+            exposure,
+        );
+        hdr.destroy(ctx);
         out
     }
 

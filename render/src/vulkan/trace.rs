@@ -1,16 +1,19 @@
 //! The path tracer on the GPU (`shaders/trace.comp`): the CPU reference integrator ported
-//! to a compute shader, one invocation per pixel.
+//! to a compute shader, one invocation per pixel, in pipeline variants specialised to what a
+//! scene needs ([`Variant`], built on first use and cached).
 
-use super::buffer::HostBuffer;
+use super::buffer::{Binding, HostBuffer};
 use super::pass::ComputePass;
+use super::progressive::Progressive;
 use super::world::GpuWorld;
 use super::{GpuContext, GpuError};
 use crate::cpu::RenderJob;
 use crate::image::Image;
 use crate::params::{SceneParams, Sky};
-use brickmap::{MaterialKind, WorldView};
+use brickmap::{MaterialKind, MaterialTable, WorldView};
 use glam::DVec3;
 use gpu_allocator::MemoryLocation;
+use std::collections::HashMap;
 
 const SPIRV: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/trace.comp.spv"));
 
@@ -94,103 +97,248 @@ impl TraceParams {
         ];
         p
     }
+
+    /// The same parameters with `samples` samples per pixel starting at sample `first`,
+    /// added to the accumulation when `add`.
+    pub fn batch(mut self, samples: u32, first: u32, add: bool) -> Self {
+        self.image[2] = samples;
+        self.seed[2] = first;
+        self.seed[3] = u32::from(add);
+        self
+    }
+
+    /// Everything that changes the converged image (not the seed, the batch or the sample
+    /// index), as bytes: two renders with equal keys converge to the same image.
+    pub fn image_key(&self) -> Vec<u8> {
+        let mut k = *self;
+        k.seed = [0, self.seed[1], 0, 0];
+        k.image[2] = 0;
+        bytemuck::bytes_of(&k).to_vec()
+    }
 }
 
-/// The parameter buffer and the accumulation buffer of a frame of `pixels` pixels.
-fn frame_buffers(ctx: &GpuContext, pixels: u64) -> Result<(HostBuffer, HostBuffer), GpuError> {
-    let uniforms = HostBuffer::new(
-        ctx,
-        "trace params",
-        std::mem::size_of::<TraceParams>() as u64,
-        MemoryLocation::CpuToGpu,
-    )?;
-    match HostBuffer::new(ctx, "accumulation", pixels * 16, MemoryLocation::GpuToCpu) {
-        Ok(accum) => Ok((uniforms, accum)),
-        Err(e) => {
-            uniforms.destroy(ctx);
-            Err(e)
+/// What a pipeline variant contains (`constant_id` 0..7 of shaders/trace.comp).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Variant {
+    /// Code for lambertian materials.
+    pub lambertian: bool,
+    /// Code for metals (mirror and GGX).
+    pub metal: bool,
+    /// Code for dielectrics (and media: without them every ray is in air).
+    pub dielectric: bool,
+    /// Code for emissive voxels.
+    pub emissive: bool,
+    /// The sun disc (next-event estimation, MIS, hits).
+    pub sun: bool,
+    /// A gradient sky (else uniform).
+    pub gradient_sky: bool,
+    /// Scattering vertices per path (DESIGN.md's B).
+    pub max_bounces: u32,
+    /// Count rays into the counters buffer (for Mrays/s; not for timing).
+    pub count_rays: bool,
+}
+
+impl Variant {
+    /// The variant a scene needs: the kinds present in its material table (every entry, used
+    /// or not, so any voxel is shaded by its kind), its sun, sky and path length.
+    pub fn for_scene(materials: &MaterialTable, params: &SceneParams) -> Self {
+        let mut v = Self {
+            lambertian: false,
+            metal: false,
+            dielectric: false,
+            emissive: false,
+            sun: params.sun.enabled,
+            gradient_sky: matches!(params.sky, Sky::Gradient { .. }),
+            max_bounces: params.settings.max_bounces.max(1),
+            count_rays: false,
+        };
+        for i in 0..materials.len() {
+            if let Ok(m) = materials.get(i as u8) {
+                match m.kind {
+                    MaterialKind::Lambertian => v.lambertian = true,
+                    MaterialKind::Metal => v.metal = true,
+                    MaterialKind::Dielectric => v.dielectric = true,
+                    MaterialKind::Emissive => v.emissive = true,
+                }
+            }
+        }
+        v
+    }
+
+    /// The variant with every feature (what an unspecialised shader would run).
+    pub fn everything(max_bounces: u32) -> Self {
+        Self {
+            lambertian: true,
+            metal: true,
+            dielectric: true,
+            emissive: true,
+            sun: true,
+            gradient_sky: true,
+            max_bounces: max_bounces.max(1),
+            count_rays: false,
         }
     }
+
+    fn constants(&self) -> [u32; 8] {
+        [
+            self.lambertian as u32,
+            self.metal as u32,
+            self.dielectric as u32,
+            self.emissive as u32,
+            self.sun as u32,
+            self.gradient_sky as u32,
+            self.max_bounces,
+            self.count_rays as u32,
+        ]
+    }
 }
 
-/// The path-tracing pipeline.
-pub struct PathTracer(ComputePass);
+/// Rays a render traced, by kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayCounts {
+    /// Camera rays.
+    pub primary: u64,
+    /// Continuation rays after a scattering vertex.
+    pub secondary: u64,
+    /// Shadow rays towards the sun.
+    pub shadow: u64,
+}
+
+impl RayCounts {
+    /// All rays.
+    pub fn total(&self) -> u64 {
+        self.primary + self.secondary + self.shadow
+    }
+}
+
+/// The path-tracing pipelines, one per variant in use.
+pub struct PathTracer {
+    passes: HashMap<Variant, ComputePass>,
+    counters: HostBuffer,
+}
 
 impl PathTracer {
-    /// Builds the pipeline.
+    /// Creates the tracer; pipelines are built when a variant is first used.
     pub fn new(ctx: &GpuContext) -> Result<Self, GpuError> {
-        Ok(Self(ComputePass::new(ctx, SPIRV, 7, 0)?))
+        Ok(Self {
+            passes: HashMap::new(),
+            counters: HostBuffer::new(ctx, "ray counters", 16, MemoryLocation::GpuToCpu)?,
+        })
     }
 
-    /// Renders `job.spp` samples per pixel; returns the linear image and the GPU time spent
-    /// (timestamp queries summed over the dispatches; None when the queue cannot time). Samples go in batches
-    /// of at most [`SAMPLES_PER_DISPATCH`] per dispatch (averaged on the host): long-running
-    /// invocations lose samples on lavapipe (measured: 256 samples per invocation came out 9%
-    /// dark there, exact on the H100), and short dispatches are what a viewport does anyway.
+    /// Builds a variant's pipeline now (it is cached).
+    pub fn prepare(&mut self, ctx: &GpuContext, variant: Variant) -> Result<(), GpuError> {
+        if let std::collections::hash_map::Entry::Vacant(slot) = self.passes.entry(variant) {
+            slot.insert(ComputePass::specialized(
+                ctx,
+                SPIRV,
+                8,
+                0,
+                &variant.constants(),
+            )?);
+        }
+        Ok(())
+    }
+
+    /// Variants built so far.
+    pub fn variants(&self) -> usize {
+        self.passes.len()
+    }
+
+    /// One dispatch of `p` (its batch of samples) into `accum` (one vec4 per pixel: radiance
+    /// sum and sample count); returns its GPU time when `time` is set and the queue can time.
+    #[allow(clippy::too_many_arguments)]
+    pub fn dispatch(
+        &mut self,
+        ctx: &GpuContext,
+        world: &GpuWorld,
+        variant: Variant,
+        p: &TraceParams,
+        uniforms: &mut HostBuffer,
+        accum: Binding,
+        time: bool,
+    ) -> Result<Option<f64>, GpuError> {
+        self.prepare(ctx, variant)?;
+        uniforms.write(bytemuck::bytes_of(p));
+        let mut bound = world.bindings();
+        bound.extend([uniforms.binding(), accum, self.counters.binding()]);
+        self.passes[&variant].run_timed(
+            ctx,
+            &bound,
+            &[],
+            [p.image[0].div_ceil(8), p.image[1].div_ceil(8)],
+            time,
+        )
+    }
+
+    /// Renders `job.spp` samples per pixel with the scene's variant; returns the linear image
+    /// and the GPU time spent (timestamp queries summed over the dispatches; None when the
+    /// queue cannot time). Samples accumulate on the GPU in batches of at most
+    /// [`SAMPLES_PER_DISPATCH`] per dispatch: long-running invocations lose samples on
+    /// lavapipe (measured: 256 samples per invocation came out 9% dark there, exact on the
+    /// H100), and short dispatches are what a viewport does anyway.
     pub fn render(
-        &self,
+        &mut self,
         ctx: &GpuContext,
         world: &GpuWorld,
         view: &WorldView<'_>,
         params: &SceneParams,
         job: &RenderJob,
     ) -> Result<(Image, Option<f64>), GpuError> {
-        let pixels = job.width as u64 * job.height as u64;
-        let (mut uniforms, accum) = frame_buffers(ctx, pixels)?;
-        let base = TraceParams::new(view, params, job);
-        let mut sum = vec![[0f64; 3]; pixels as usize];
-        let mut result = Ok(());
-        let mut done = 0;
-        let mut gpu_seconds = Some(0.0);
-        while done < job.spp && result.is_ok() {
-            let batch = (job.spp - done).min(SAMPLES_PER_DISPATCH);
-            let mut p = base;
-            p.image[2] = batch;
-            p.seed[2] = done;
-            uniforms.write(bytemuck::bytes_of(&p));
-            let mut bound = world.bindings();
-            bound.extend([uniforms.binding(), accum.binding()]);
-            result = self
-                .0
-                .run_timed(
-                    ctx,
-                    &bound,
-                    &[],
-                    [job.width.div_ceil(8), job.height.div_ceil(8)],
-                    true,
-                )
-                .map(|t| gpu_seconds = gpu_seconds.zip(t).map(|(a, b)| a + b));
-            if result.is_ok() {
-                let raw: &[[f32; 4]] = bytemuck::cast_slice(&accum.read()[..pixels as usize * 16]);
-                for (s, px) in sum.iter_mut().zip(raw) {
-                    for k in 0..3 {
-                        s[k] += px[k] as f64 * batch as f64;
-                    }
-                }
-            }
-            done += batch;
-        }
-        let n = job.spp.max(1) as f64;
-        let image = result.map(|_| {
-            (
-                Image {
-                    width: job.width,
-                    height: job.height,
-                    pixels: sum
-                        .iter()
-                        .map(|s| [(s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32])
-                        .collect(),
-                },
-                gpu_seconds,
-            )
-        });
-        uniforms.destroy(ctx);
-        accum.destroy(ctx);
-        image
+        let variant = Variant::for_scene(view.materials(), params);
+        self.render_variant(ctx, world, view, params, job, variant)
     }
 
-    /// Destroys the pipeline.
+    /// [`PathTracer::render`] with a chosen variant (benchmarks compare variants; a variant
+    /// lacking something the scene has renders it wrongly).
+    pub fn render_variant(
+        &mut self,
+        ctx: &GpuContext,
+        world: &GpuWorld,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        job: &RenderJob,
+        variant: Variant,
+    ) -> Result<(Image, Option<f64>), GpuError> {
+        let size = (job.width, job.height);
+        let mut acc = Progressive::new(ctx, size, size, job.seed)?;
+        let result = acc
+            .accumulate(ctx, self, world, view, params, variant, job.spp)
+            .and_then(|(gpu, _)| acc.hdr(ctx).map(|img| (img, gpu)));
+        acc.destroy(ctx);
+        result
+    }
+
+    /// [`PathTracer::render`] with a counting variant of the scene's (the same image, plus
+    /// one atomic add per pixel and dispatch): also returns the rays traced, by kind.
+    pub fn render_counted(
+        &mut self,
+        ctx: &GpuContext,
+        world: &GpuWorld,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        job: &RenderJob,
+    ) -> Result<(Image, Option<f64>, RayCounts), GpuError> {
+        let variant = Variant {
+            count_rays: true,
+            ..Variant::for_scene(view.materials(), params)
+        };
+        self.counters.write(&[0; 16]);
+        let (image, gpu) = self.render_variant(ctx, world, view, params, job, variant)?;
+        let c: [u32; 4] = bytemuck::pod_read_unaligned(&self.counters.read()[..16]);
+        let counts = RayCounts {
+            primary: c[0] as u64,
+            secondary: c[1] as u64,
+            shadow: c[2] as u64,
+        };
+        Ok((image, gpu, counts))
+    }
+
+    /// Destroys the pipelines.
     pub fn destroy(self, ctx: &GpuContext) {
-        self.0.destroy(ctx);
+        for (_, pass) in self.passes {
+            pass.destroy(ctx);
+        }
+        self.counters.destroy(ctx);
     }
 }

@@ -11,7 +11,7 @@
 //! outgrows a region, the buffer is replaced by a larger one and the old contents are copied
 //! on the GPU, so nothing is re-read or lost.
 
-use super::buffer::{Binding, HostBuffer};
+use super::buffer::{Binding, HostBuffer, read_device};
 use super::staging::{StagingRing, Upload, barrier};
 use super::{GpuContext, GpuError};
 use ash::vk;
@@ -381,45 +381,14 @@ impl GpuWorld {
     /// [`WorldView::gpu_image`]. Call after [`GpuWorld::sync`].
     pub fn read_back(&self, ctx: &GpuContext, which: GpuBuffer) -> Result<Vec<u8>, GpuError> {
         let i = which as usize;
-        let len = self.shadow[i].len() as u64;
-        let out = HostBuffer::new(ctx, "read back", len, MemoryLocation::GpuToCpu)?;
-        let (src, offset) = (self.buffer.raw, self.regions[i].offset);
-        let copied = ctx.submit_and_wait(|cmd| {
-            // SAFETY: both buffers live until after the wait.
-            unsafe {
-                barrier(
-                    ctx,
-                    cmd,
-                    vk::PipelineStageFlags::TRANSFER | vk::PipelineStageFlags::COMPUTE_SHADER,
-                    vk::AccessFlags::TRANSFER_WRITE | vk::AccessFlags::SHADER_WRITE,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::AccessFlags::TRANSFER_READ,
-                );
-                if len > 0 {
-                    ctx.device.cmd_copy_buffer(
-                        cmd,
-                        src,
-                        out.raw,
-                        &[vk::BufferCopy {
-                            src_offset: offset,
-                            dst_offset: 0,
-                            size: len,
-                        }],
-                    );
-                }
-                barrier(
-                    ctx,
-                    cmd,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::AccessFlags::TRANSFER_WRITE,
-                    vk::PipelineStageFlags::HOST,
-                    vk::AccessFlags::HOST_READ,
-                );
-            }
-        });
-        let bytes = copied.map(|_| out.read()[..len as usize].to_vec());
-        out.destroy(ctx);
-        bytes
+        read_device(
+            ctx,
+            Binding {
+                buffer: self.buffer.raw,
+                offset: self.regions[i].offset,
+                range: self.shadow[i].len() as u64,
+            },
+        )
     }
 
     /// Frees the buffer and the ring (waits for pending copies).

@@ -1,0 +1,220 @@
+//! Progressive accumulation: samples add up in a device-local HDR buffer at the internal
+//! resolution while nothing that changes the image changes (camera, world, materials, sun,
+//! sky, settings); any change restarts it. The display pass divides by the sample count,
+//! applies exposure, the ACES fitted curve and sRGB, and upscales bilinearly to the output
+//! resolution (exposure is display-only: changing it keeps the samples).
+
+use super::buffer::{HostBuffer, read_device};
+use super::tonemap::ToneMapper;
+use super::trace::{PathTracer, SAMPLES_PER_DISPATCH, TraceParams, Variant};
+use super::world::GpuWorld;
+use super::{GpuContext, GpuError};
+use crate::cpu::RenderJob;
+use crate::image::Image;
+use crate::params::SceneParams;
+use brickmap::WorldView;
+use gpu_allocator::MemoryLocation;
+use std::hash::{DefaultHasher, Hash, Hasher};
+
+/// What one frame did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameReport {
+    /// Samples per pixel accumulated so far (after this frame).
+    pub samples: u32,
+    /// Whether this frame restarted the accumulation.
+    pub restarted: bool,
+    /// GPU time of this frame's dispatches (None when the queue cannot time).
+    pub gpu_seconds: Option<f64>,
+}
+
+/// An accumulating frame at an internal resolution, displayed at an output resolution.
+pub struct Progressive {
+    accum: HostBuffer,
+    uniforms: HostBuffer,
+    internal: (u32, u32),
+    output: (u32, u32),
+    key: Option<u64>,
+    samples: u32,
+    seed: u64,
+}
+
+impl Progressive {
+    /// Buffers for an `internal` image displayed at `output`; `seed` picks the random
+    /// sequence (each restart continues it with fresh samples).
+    pub fn new(
+        ctx: &GpuContext,
+        internal: (u32, u32),
+        output: (u32, u32),
+        seed: u64,
+    ) -> Result<Self, GpuError> {
+        let internal = (internal.0.max(1), internal.1.max(1));
+        let pixels = internal.0 as u64 * internal.1 as u64;
+        let accum = HostBuffer::new(ctx, "accumulation", pixels * 16, MemoryLocation::GpuOnly)?;
+        let uniforms = match HostBuffer::new(
+            ctx,
+            "trace params",
+            std::mem::size_of::<TraceParams>() as u64,
+            MemoryLocation::CpuToGpu,
+        ) {
+            Ok(u) => u,
+            Err(e) => {
+                accum.destroy(ctx);
+                return Err(e);
+            }
+        };
+        Ok(Self {
+            accum,
+            uniforms,
+            internal,
+            output: (output.0.max(1), output.1.max(1)),
+            key: None,
+            samples: 0,
+            seed,
+        })
+    }
+
+    /// Samples per pixel accumulated so far.
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// Internal (traced) resolution.
+    pub fn internal(&self) -> (u32, u32) {
+        self.internal
+    }
+
+    /// Output (displayed) resolution.
+    pub fn output(&self) -> (u32, u32) {
+        self.output
+    }
+
+    /// Drops the accumulated samples; the next frame starts over.
+    pub fn restart(&mut self) {
+        self.key = None;
+        self.samples = 0;
+    }
+
+    /// One frame of `spp` more samples per pixel with the scene's variant. `world_changed`
+    /// (from [`GpuWorld::update`]) or any change of the parameters restarts the accumulation.
+    #[allow(clippy::too_many_arguments)]
+    pub fn frame(
+        &mut self,
+        ctx: &GpuContext,
+        tracer: &mut PathTracer,
+        world: &GpuWorld,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        world_changed: bool,
+        spp: u32,
+    ) -> Result<FrameReport, GpuError> {
+        if world_changed {
+            self.restart();
+        }
+        let variant = Variant::for_scene(view.materials(), params);
+        let (gpu_seconds, restarted) =
+            self.accumulate(ctx, tracer, world, view, params, variant, spp)?;
+        Ok(FrameReport {
+            samples: self.samples,
+            restarted,
+            gpu_seconds,
+        })
+    }
+
+    /// Adds `spp` samples per pixel with `variant`, restarting first if the image key
+    /// changed; returns the GPU time of the dispatches and whether it started over.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn accumulate(
+        &mut self,
+        ctx: &GpuContext,
+        tracer: &mut PathTracer,
+        world: &GpuWorld,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        variant: Variant,
+        spp: u32,
+    ) -> Result<(Option<f64>, bool), GpuError> {
+        let job = RenderJob {
+            width: self.internal.0,
+            height: self.internal.1,
+            spp,
+            seed: self.seed,
+        };
+        let base = TraceParams::new(view, params, &job);
+        let mut hasher = DefaultHasher::new();
+        base.image_key().hash(&mut hasher);
+        variant.hash(&mut hasher);
+        let key = hasher.finish();
+        if self.key != Some(key) {
+            self.samples = 0;
+            self.key = Some(key);
+        }
+        let restarted = self.samples == 0;
+        let mut gpu = Some(0.0);
+        let mut done = 0;
+        while done < spp {
+            let batch = (spp - done).min(SAMPLES_PER_DISPATCH);
+            let p = base.batch(batch, self.samples, self.samples > 0);
+            let t = tracer.dispatch(
+                ctx,
+                world,
+                variant,
+                &p,
+                &mut self.uniforms,
+                self.accum.binding(),
+                true,
+            );
+            let t = match t {
+                Ok(t) => t,
+                Err(e) => {
+                    // The buffer may hold a partial batch: start over next frame.
+                    self.restart();
+                    return Err(e);
+                }
+            };
+            gpu = gpu.zip(t).map(|(a, b)| a + b);
+            self.samples += batch;
+            done += batch;
+        }
+        Ok((gpu, restarted))
+    }
+
+    /// The mean radiance so far, at the internal resolution.
+    pub fn hdr(&self, ctx: &GpuContext) -> Result<Image, GpuError> {
+        let raw = read_device(ctx, self.accum.binding())?;
+        let px: &[[f32; 4]] = bytemuck::cast_slice(&raw);
+        Ok(Image {
+            width: self.internal.0,
+            height: self.internal.1,
+            pixels: px
+                .iter()
+                .map(|p| {
+                    let n = if p[3] > 0.0 { p[3] } else { 1.0 };
+                    [p[0] / n, p[1] / n, p[2] / n]
+                })
+                .collect(),
+        })
+    }
+
+    /// The displayed frame: mean → exposure → ACES fitted → sRGB, upscaled bilinearly (in
+    /// linear HDR, before the curve) to the output resolution; rows top to bottom.
+    pub fn display(
+        &self,
+        ctx: &GpuContext,
+        tone: &ToneMapper,
+        exposure: f32,
+    ) -> Result<Vec<[u8; 3]>, GpuError> {
+        tone.display(
+            ctx,
+            self.accum.binding(),
+            self.internal,
+            self.output,
+            exposure,
+        )
+    }
+
+    /// Frees the buffers.
+    pub fn destroy(self, ctx: &GpuContext) {
+        self.accum.destroy(ctx);
+        self.uniforms.destroy(ctx);
+    }
+}
