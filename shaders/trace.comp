@@ -16,9 +16,13 @@ layout(constant_id = 4) const bool SUN = true;
 layout(constant_id = 5) const bool GRADIENT_SKY = true;
 layout(constant_id = 6) const uint MAX_BOUNCES = 4u;
 layout(constant_id = 7) const bool COUNT_RAYS = false;
+// Benchmark experiments (bench-gpu --experiment), 0 in every real render: bit 0 ends paths
+// at the first hit (primary rays only), bit 1 decodes colours without pow.
+layout(constant_id = 8) const uint EXPERIMENT = 0u;
 
 // Without dielectrics every ray travels in air: the traversal drops its medium branch.
 #define MEDIUM_POSSIBLE HAS_DIELECTRIC
+#define COUNT_STEPS COUNT_RAYS
 #include "brickmap.glsl"
 
 struct Params {
@@ -42,9 +46,10 @@ struct Params {
 layout(std430, set = 0, binding = 5) readonly buffer ParamBuffer { Params p; };
 // Per pixel: the sum of its samples' radiance (rgb) and their count (a).
 layout(std430, set = 0, binding = 6) buffer Accum { vec4 accum[]; };
-// Rays traced (COUNT_RAYS variants only): camera rays, continuation rays, shadow rays.
-layout(std430, set = 0, binding = 7) buffer Counters { uint counters[4]; };
-uint g_rays[3];
+// COUNT_RAYS variants only: camera rays, continuation rays, shadow rays, then the traversal
+// steps each kind took.
+layout(std430, set = 0, binding = 7) buffer Counters { uint counters[8]; };
+uint g_rays[6];
 
 const float PI = 3.14159265358979;
 const int LAMBERTIAN = 0;
@@ -67,6 +72,7 @@ struct Shading { int kind; vec3 albedo; float param; };
 
 float srgb_to_linear(uint c) {
     float x = float(c) / 255.0;
+    if ((EXPERIMENT & 2u) != 0u) return x * x;
     return x <= 0.04045 ? x / 12.92 : pow((x + 0.055) / 1.055, 2.4);
 }
 
@@ -208,8 +214,10 @@ vec3 radiance(vec3 origin, vec3 dir) {
         ivec3 normal;
         float t_voxel;
         if (COUNT_RAYS) g_rays[from_camera ? 0 : 1]++;
+        g_steps = 0u;
         bool hit = from_camera ? trace_from_origin(o, d, medium, 1.0 / 0.0, voxel, normal, t_voxel)
                                : trace_from_cell(o, d, start, medium, 1.0 / 0.0, voxel, normal, t_voxel);
+        if (COUNT_RAYS) g_rays[from_camera ? 3 : 4] += g_steps;
         if (!hit) t_voxel = 1.0 / 0.0;
         float cos_l;
         float t_sun = sun_hit(o, d, cos_l);
@@ -228,6 +236,10 @@ vec3 radiance(vec3 origin, vec3 dir) {
         Shading s;
         if (here >= 0) s = material(here);
         bool crossing = HAS_DIELECTRIC && ((here >= 0 && s.kind == DIELECTRIC) || (here < 0 && medium >= 0));
+        if ((EXPERIMENT & 1u) != 0u) {
+            l += beta * (here >= 0 ? s.albedo : vec3(0.0));
+            break;
+        }
         if (HAS_EMISSIVE && here >= 0 && s.kind == EMISSIVE) {
             l += beta * s.albedo * s.param;
             break;
@@ -281,7 +293,10 @@ vec3 radiance(vec3 origin, vec3 dir) {
                     ivec3 sn;
                     float st;
                     if (COUNT_RAYS && fv != vec3(0.0)) g_rays[2]++;
-                    if (fv != vec3(0.0) && !trace_from_cell(pt, w, front, AIR, dist, sv, sn, st)) {
+                    g_steps = 0u;
+                    bool blocked = fv != vec3(0.0) && trace_from_cell(pt, w, front, AIR, dist, sv, sn, st);
+                    if (COUNT_RAYS) g_rays[5] += g_steps;
+                    if (fv != vec3(0.0) && !blocked) {
                         float pdf_light = dist * dist / (cl * sun_area());
                         l += beta * fv * wi.z * p.sun_radiance.rgb * power_heuristic(pdf_light, pdf_bsdf) / pdf_light;
                     }
@@ -314,9 +329,7 @@ void main() {
     g_words_per_column = p.grid.w;
     uint index = px.y * p.image.x + px.x;
     vec3 sum = vec3(0.0);
-    g_rays[0] = 0u;
-    g_rays[1] = 0u;
-    g_rays[2] = 0u;
+    for (int k = 0; k < 6; k++) g_rays[k] = 0u;
     for (uint s = 0u; s < p.image.z; s++) {
         rng = hash(p.seed.x ^ hash(index * 9781u + (p.seed.z + s) * 6271u + 1u));
         float u = (2.0 * (float(px.x) + rand()) / float(p.image.x) - 1.0);
@@ -327,6 +340,6 @@ void main() {
     vec4 mine = vec4(sum, float(p.image.z));
     accum[index] = p.seed.w != 0u ? accum[index] + mine : mine;
     if (COUNT_RAYS) {
-        for (int k = 0; k < 3; k++) atomicAdd(counters[k], g_rays[k]);
+        for (int k = 0; k < 6; k++) atomicAdd(counters[k], g_rays[k]);
     }
 }

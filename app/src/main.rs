@@ -148,12 +148,15 @@ enum Command {
         /// Internal resolution height.
         #[arg(long, default_value_t = 576)]
         height: u32,
-        /// Timed frames per complexity (after 5 warm-up frames).
+        /// Timed frames per complexity (after 20 warm-up frames).
         #[arg(long, default_value_t = 50)]
         frames: usize,
         /// Device name filter (default: a discrete GPU if any).
         #[arg(long)]
         device: Option<String>,
+        /// Shader experiment bits (trace.comp `EXPERIMENT`; 0 = the real renderer).
+        #[arg(long, default_value_t = 0)]
+        experiment: u32,
     },
     /// Print a scene file's dimensions, voxel count, materials and memory.
     Info {
@@ -409,7 +412,8 @@ fn run(cli: Cli) -> Result<()> {
             height,
             frames,
             device,
-        } => bench_gpu(width, height, frames.max(1), device, workers),
+            experiment,
+        } => bench_gpu(width, height, frames.max(1), device, experiment, workers),
         Command::Info { file } => {
             let started = Instant::now();
             let scene = with_progress(format!("reading {}", file.display()), || {
@@ -622,6 +626,7 @@ fn bench_gpu(
     height: u32,
     frames: usize,
     device: Option<String>,
+    experiment: u32,
     workers: usize,
 ) -> Result<()> {
     use render::vulkan::{
@@ -659,14 +664,17 @@ fn bench_gpu(
             seed,
         };
         // The scene's variant and the everything variant, alternated frame by frame so both
-        // see the same machine state; the first 5 frames of each are warm-up.
-        let scene_variant = Variant::for_scene(view.materials(), &params);
+        // see the same machine state; the first 20 frames of each are warm-up (clocks ramp up).
+        let scene_variant = Variant {
+            experiment,
+            ..Variant::for_scene(view.materials(), &params)
+        };
         let variants = [scene_variant, Variant::everything(bounces)];
         let mut times = [Vec::with_capacity(frames), Vec::with_capacity(frames)];
-        'frames: for frame in 0..frames + 5 {
+        'frames: for frame in 0..frames + 20 {
             for (k, v) in variants.iter().enumerate() {
                 match tracer.render_variant(&ctx, &world, &view, &params, &job(frame as u64), *v) {
-                    Ok((_, Some(t))) if frame >= 5 => times[k].push(t),
+                    Ok((_, Some(t))) if frame >= 20 => times[k].push(t),
                     Ok(_) => {}
                     Err(e) => {
                         failure = Some(e);
@@ -682,7 +690,14 @@ fn bench_gpu(
             text += &format!("{label}: this queue cannot take timestamps\n");
             continue;
         }
-        let rays = match tracer.render_counted(&ctx, &world, &view, &params, &job(0)) {
+        let rays = match tracer.render_counted_variant(
+            &ctx,
+            &world,
+            &view,
+            &params,
+            &job(0),
+            scene_variant,
+        ) {
             Ok((_, _, rays)) => rays,
             Err(e) => {
                 failure = Some(e);
@@ -690,13 +705,24 @@ fn bench_gpu(
             }
         };
         let n = times[0].len();
+        let stats = tracer
+            .statistics(&ctx, scene_variant)
+            .unwrap_or_default()
+            .into_iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        if !stats.is_empty() {
+            text += &format!("{label}: pipeline statistics: {stats}\n");
+        }
         let [(median, p10, p90), (full, _, _)] = times.map(|mut t| {
             t.sort_by(|a, b| a.total_cmp(b));
             (t[t.len() / 2], t[t.len() / 10], t[t.len() * 9 / 10])
         });
         text += &format!(
             "{label}: median {:.3} ms (p10 {:.3}, p90 {:.3}, {} frames); everything variant {:.3} ms ({:+.1}%)\n  \
-             rays: {:.1} M primary, {:.1} M secondary, {:.1} M shadow; {:.0} Mrays/s primary, {:.0} Mrays/s secondary+shadow, {:.0} Mrays/s all\n",
+             rays: {:.1} M primary, {:.1} M secondary, {:.1} M shadow; {:.0} Mrays/s primary, {:.0} Mrays/s secondary+shadow, {:.0} Mrays/s all\n  \
+             traversal steps per ray: {:.1} primary, {:.1} secondary, {:.1} shadow\n",
             median * 1e3,
             p10 * 1e3,
             p90 * 1e3,
@@ -709,6 +735,9 @@ fn bench_gpu(
             rays.primary as f64 / median / 1e6,
             (rays.secondary + rays.shadow) as f64 / median / 1e6,
             rays.total() as f64 / median / 1e6,
+            rays.steps[0] as f64 / rays.primary.max(1) as f64,
+            rays.steps[1] as f64 / rays.secondary.max(1) as f64,
+            rays.steps[2] as f64 / rays.shadow.max(1) as f64,
         );
     }
     tracer.destroy(&ctx);

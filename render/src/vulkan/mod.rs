@@ -91,6 +91,8 @@ pub struct GpuContext {
     pub timestamp_period: f32,
     /// `minStorageBufferOffsetAlignment`: storage bindings start at multiples of it.
     pub storage_alignment: u64,
+    /// VK_KHR_pipeline_executable_properties, when the driver has it.
+    pub pipeline_stats: Option<ash::khr::pipeline_executable_properties::Device>,
 }
 
 unsafe extern "system" fn count_errors(
@@ -233,11 +235,30 @@ impl GpuContext {
         let queues = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)
             .queue_priorities(&priorities)];
-        let info = vk::DeviceCreateInfo::default().queue_create_infos(&queues);
+        // Pipeline statistics (registers, spills, instructions per shader) when the driver
+        // offers them: benchmarks print them next to the timings.
+        // SAFETY: plain query.
+        let has_stats = unsafe { instance.enumerate_device_extension_properties(physical) }
+            .unwrap_or_default()
+            .iter()
+            .any(|e| {
+                e.extension_name_as_c_str() == Ok(ash::khr::pipeline_executable_properties::NAME)
+            });
+        let extensions = [ash::khr::pipeline_executable_properties::NAME.as_ptr()];
+        let mut stats_feature = vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default()
+            .pipeline_executable_info(true);
+        let mut info = vk::DeviceCreateInfo::default().queue_create_infos(&queues);
+        if has_stats {
+            info = info
+                .enabled_extension_names(&extensions)
+                .push_next(&mut stats_feature);
+        }
         // SAFETY: the create info outlives the call.
         let device = vk_call("vkCreateDevice", unsafe {
             instance.create_device(physical, &info, None)
         })?;
+        let pipeline_stats = has_stats
+            .then(|| ash::khr::pipeline_executable_properties::Device::new(&instance, &device));
         // SAFETY: family and index exist (we asked for one queue of this family).
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let allocator =
@@ -278,6 +299,7 @@ impl GpuContext {
             name,
             timestamp_period,
             storage_alignment: limits.min_storage_buffer_offset_alignment.max(4),
+            pipeline_stats,
         })
     }
 

@@ -95,7 +95,13 @@ impl ComputePass {
             } else {
                 stage.specialization_info(&spec)
             };
+            let flags = if ctx.pipeline_stats.is_some() {
+                vk::PipelineCreateFlags::CAPTURE_STATISTICS_KHR
+            } else {
+                vk::PipelineCreateFlags::empty()
+            };
             let info = [vk::ComputePipelineCreateInfo::default()
+                .flags(flags)
                 .stage(stage)
                 .layout(layout)];
             let pipeline = d
@@ -257,6 +263,50 @@ impl ComputePass {
             }
             result.map(|_| elapsed)
         }
+    }
+
+    /// The driver's statistics of the compiled pipeline (name, value), e.g. register count
+    /// and spills on NVIDIA; empty without VK_KHR_pipeline_executable_properties.
+    pub fn statistics(&self, ctx: &GpuContext) -> Vec<(String, String)> {
+        let Some(ext) = &ctx.pipeline_stats else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        // SAFETY: queries on a live pipeline created with CAPTURE_STATISTICS_KHR.
+        unsafe {
+            let info = vk::PipelineInfoKHR::default().pipeline(self.pipeline);
+            let count = ext
+                .get_pipeline_executable_properties(&info)
+                .map_or(0, |p| p.len());
+            for index in 0..count as u32 {
+                let exec = vk::PipelineExecutableInfoKHR::default()
+                    .pipeline(self.pipeline)
+                    .executable_index(index);
+                for st in ext
+                    .get_pipeline_executable_statistics(&exec)
+                    .unwrap_or_default()
+                {
+                    let name = st
+                        .name_as_c_str()
+                        .map(|n| n.to_string_lossy().into_owned())
+                        .unwrap_or_default();
+                    let value = match st.format {
+                        vk::PipelineExecutableStatisticFormatKHR::BOOL32 => {
+                            (st.value.b32 != 0).to_string()
+                        }
+                        vk::PipelineExecutableStatisticFormatKHR::INT64 => {
+                            st.value.i64.to_string()
+                        }
+                        vk::PipelineExecutableStatisticFormatKHR::UINT64 => {
+                            st.value.u64.to_string()
+                        }
+                        _ => format!("{:.3}", st.value.f64),
+                    };
+                    out.push((name, value));
+                }
+            }
+        }
+        out
     }
 
     /// Destroys the pipeline's objects.

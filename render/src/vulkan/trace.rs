@@ -136,6 +136,8 @@ pub struct Variant {
     pub max_bounces: u32,
     /// Count rays into the counters buffer (for Mrays/s; not for timing).
     pub count_rays: bool,
+    /// Benchmark experiments (`EXPERIMENT` in trace.comp); 0 for real renders.
+    pub experiment: u32,
 }
 
 impl Variant {
@@ -151,6 +153,7 @@ impl Variant {
             gradient_sky: matches!(params.sky, Sky::Gradient { .. }),
             max_bounces: params.settings.max_bounces.max(1),
             count_rays: false,
+            experiment: 0,
         };
         for i in 0..materials.len() {
             if let Ok(m) = materials.get(i as u8) {
@@ -176,10 +179,11 @@ impl Variant {
             gradient_sky: true,
             max_bounces: max_bounces.max(1),
             count_rays: false,
+            experiment: 0,
         }
     }
 
-    fn constants(&self) -> [u32; 8] {
+    fn constants(&self) -> [u32; 9] {
         [
             self.lambertian as u32,
             self.metal as u32,
@@ -189,6 +193,7 @@ impl Variant {
             self.gradient_sky as u32,
             self.max_bounces,
             self.count_rays as u32,
+            self.experiment,
         ]
     }
 }
@@ -202,6 +207,8 @@ pub struct RayCounts {
     pub secondary: u64,
     /// Shadow rays towards the sun.
     pub shadow: u64,
+    /// Traversal steps of camera, continuation and shadow rays.
+    pub steps: [u64; 3],
 }
 
 impl RayCounts {
@@ -222,7 +229,7 @@ impl PathTracer {
     pub fn new(ctx: &GpuContext) -> Result<Self, GpuError> {
         Ok(Self {
             passes: HashMap::new(),
-            counters: HostBuffer::new(ctx, "ray counters", 16, MemoryLocation::GpuToCpu)?,
+            counters: HostBuffer::new(ctx, "ray counters", 32, MemoryLocation::GpuToCpu)?,
         })
     }
 
@@ -238,6 +245,16 @@ impl PathTracer {
             )?);
         }
         Ok(())
+    }
+
+    /// The driver's statistics of a variant's pipeline (built if needed).
+    pub fn statistics(
+        &mut self,
+        ctx: &GpuContext,
+        variant: Variant,
+    ) -> Result<Vec<(String, String)>, GpuError> {
+        self.prepare(ctx, variant)?;
+        Ok(self.passes[&variant].statistics(ctx))
     }
 
     /// Variants built so far.
@@ -319,17 +336,32 @@ impl PathTracer {
         params: &SceneParams,
         job: &RenderJob,
     ) -> Result<(Image, Option<f64>, RayCounts), GpuError> {
+        let variant = Variant::for_scene(view.materials(), params);
+        self.render_counted_variant(ctx, world, view, params, job, variant)
+    }
+
+    /// [`PathTracer::render_counted`] with a chosen variant.
+    pub fn render_counted_variant(
+        &mut self,
+        ctx: &GpuContext,
+        world: &GpuWorld,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        job: &RenderJob,
+        variant: Variant,
+    ) -> Result<(Image, Option<f64>, RayCounts), GpuError> {
         let variant = Variant {
             count_rays: true,
-            ..Variant::for_scene(view.materials(), params)
+            ..variant
         };
-        self.counters.write(&[0; 16]);
+        self.counters.write(&[0; 32]);
         let (image, gpu) = self.render_variant(ctx, world, view, params, job, variant)?;
-        let c: [u32; 4] = bytemuck::pod_read_unaligned(&self.counters.read()[..16]);
+        let c: [u32; 8] = bytemuck::pod_read_unaligned(&self.counters.read()[..32]);
         let counts = RayCounts {
             primary: c[0] as u64,
             secondary: c[1] as u64,
             shadow: c[2] as u64,
+            steps: [c[3] as u64, c[4] as u64, c[5] as u64],
         };
         Ok((image, gpu, counts))
     }
