@@ -176,6 +176,15 @@ fn same_seed_same_image_and_no_nan_in_hard_places() {
             "camera {i}"
         );
     }
+    let (w, views) = common::far_places();
+    for (i, p) in views.iter().enumerate() {
+        let img = render(&w, p, 8, 2, i as u64);
+        assert!(img.all_finite(), "far camera {i}");
+        assert!(
+            img.pixels.iter().all(|px| px.iter().all(|c| *c >= 0.0)),
+            "far camera {i}"
+        );
+    }
 }
 
 #[test]

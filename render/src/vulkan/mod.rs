@@ -245,8 +245,9 @@ impl GpuContext {
                 e.extension_name_as_c_str() == Ok(ash::khr::pipeline_executable_properties::NAME)
             });
         let extensions = [ash::khr::pipeline_executable_properties::NAME.as_ptr()];
-        let mut stats_feature = vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default()
-            .pipeline_executable_info(true);
+        let mut stats_feature =
+            vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default()
+                .pipeline_executable_info(true);
         let mut info = vk::DeviceCreateInfo::default().queue_create_infos(&queues);
         if has_stats {
             info = info

@@ -294,9 +294,7 @@ impl ComputePass {
                         vk::PipelineExecutableStatisticFormatKHR::BOOL32 => {
                             (st.value.b32 != 0).to_string()
                         }
-                        vk::PipelineExecutableStatisticFormatKHR::INT64 => {
-                            st.value.i64.to_string()
-                        }
+                        vk::PipelineExecutableStatisticFormatKHR::INT64 => st.value.i64.to_string(),
                         vk::PipelineExecutableStatisticFormatKHR::UINT64 => {
                             st.value.u64.to_string()
                         }

@@ -219,3 +219,79 @@ pub fn assert_error_halves(mut render: impl FnMut(u32) -> render::Image, expecte
         );
     }
 }
+
+/// The largest grid (4096 × 1024 × 4096 voxels) with glass, metal, an emitter and a floor at
+/// its far corner, and cameras where f32 coordinates are coarsest: near and on the far
+/// corner, on a voxel face, inside glass, along the grid's far edge, and far outside. The
+/// first two cameras' centre rays pass no voxel edge (an exactly diagonal ray would, and f32
+/// and f64 may then legitimately order the crossings differently).
+pub fn far_places() -> (World, Vec<SceneParams>) {
+    let w = world((512, 128, 512));
+    let floor = add_material(&w, MaterialKind::Lambertian, 0, [150, 150, 150]);
+    let glass = add_material(&w, MaterialKind::Dielectric, 0, [240, 250, 255]);
+    let metal = add_material(&w, MaterialKind::Metal, 20, [230, 200, 120]);
+    let lamp = add_material(&w, MaterialKind::Emissive, 0, [255, 255, 255]);
+    for (shape, m) in [
+        (
+            Shape::Box {
+                min: IVec3::new(4000, 990, 4000),
+                max: IVec3::new(4095, 1000, 4095),
+            },
+            floor,
+        ),
+        (
+            Shape::Box {
+                min: IVec3::new(4080, 1001, 4080),
+                max: IVec3::new(4095, 1010, 4095),
+            },
+            glass,
+        ),
+        (
+            Shape::Sphere {
+                centre: DVec3::new(4060.0, 1010.0, 4060.0),
+                radius: 6.0,
+            },
+            metal,
+        ),
+    ] {
+        w.apply(EditOp::Shape {
+            shape,
+            mode: Mode::Add(m),
+        })
+        .unwrap();
+    }
+    w.apply(EditOp::Voxels(vec![VoxelEdit {
+        pos: IVec3::new(4090, 1020, 4090),
+        op: VoxelOp::Set(lamp),
+    }]))
+    .unwrap();
+    let sun = Sun {
+        enabled: true,
+        position: DVec3::new(4300.0, 1400.0, 4200.0),
+        radius: 20.0,
+        colour: [1.0, 0.9, 0.8],
+        intensity: 20.0,
+        animate: false,
+        speed_deg_per_s: 0.0,
+    };
+    let sky = Sky::Gradient {
+        horizon: [0.9, 0.9, 1.0],
+        zenith: [0.2, 0.4, 0.9],
+    };
+    let cams = [
+        ((4050.0, 1020.0, 4050.0), (4095.0, 1000.0, 4093.3)), // looking at the far corner
+        ((5000.0, 1500.0, 5000.0), (4050.0, 995.0, 4047.7)),  // far outside, looking in
+        ((4090.0, 1001.0, 4070.5), (4095.0, 990.0, 4095.0)),  // on the floor's top face
+        ((4088.5, 1005.5, 4088.5), (5000.0, 1005.5, 4088.5)), // inside glass, out through x
+        ((4095.999, 1023.999, 0.5), (4095.999, 1023.999, 4096.0)), // along the far edge
+        ((4096.0, 1024.0, 4096.0), (4000.0, 990.0, 4000.0)),  // on the far corner itself
+    ];
+    let views = cams
+        .into_iter()
+        .map(|(eye, target)| {
+            let cam = Camera::looking_at(DVec3::from(eye), DVec3::from(target), 70.0);
+            params(cam, sky.clone(), Some(sun.clone()), 6)
+        })
+        .collect();
+    (w, views)
+}
