@@ -259,7 +259,7 @@ impl GpuContext {
             instance.create_device(physical, &info, None)
         })?;
         let pipeline_stats = has_stats
-            .then(|| ash::khr::pipeline_executable_properties::Device::new(&instance, &device));
+            .then(|| ash::khr::pipeline_executable_properties::Device::new(instance, &device));
         // SAFETY: family and index exist (we asked for one queue of this family).
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let allocator =
