@@ -1,7 +1,7 @@
-//! Storage buffers: host-visible ones the CPU writes and reads back, and device-local ones
-//! filled by a copy from a host-visible staging buffer.
+//! Storage buffers (host-visible ones the CPU writes and reads back, device-local ones that
+//! copies fill), bindings of buffer ranges, and reading a device-local range back.
 
-use super::staging::barrier;
+use super::staging::{barrier, before_transfer};
 use super::{GpuContext, GpuError, vk_call};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -29,7 +29,7 @@ pub struct HostBuffer {
 
 impl HostBuffer {
     /// A buffer of `size` bytes (at least 4) at `location` (CpuToGpu, GpuToCpu, or GpuOnly for
-    /// device-local memory, which only [`HostBuffer::upload`] fills).
+    /// device-local memory, which copies fill).
     pub fn new(
         ctx: &GpuContext,
         name: &str,
@@ -88,53 +88,6 @@ impl HostBuffer {
         })
     }
 
-    /// A device-local buffer holding `bytes`, copied there through a staging buffer; the
-    /// copy is made visible to compute shaders.
-    pub fn upload(ctx: &GpuContext, name: &str, bytes: &[u8]) -> Result<Self, GpuError> {
-        let mut staging =
-            HostBuffer::new(ctx, "staging", bytes.len() as u64, MemoryLocation::CpuToGpu)?;
-        staging.write(bytes);
-        let target = match HostBuffer::new(ctx, name, bytes.len() as u64, MemoryLocation::GpuOnly) {
-            Ok(b) => b,
-            Err(e) => {
-                staging.destroy(ctx);
-                return Err(e);
-            }
-        };
-        let size = staging.size.min(target.size);
-        let copied = ctx.submit_and_wait(|cmd| {
-            // SAFETY: both buffers live until after the fence wait inside submit_and_wait.
-            unsafe {
-                ctx.device.cmd_copy_buffer(
-                    cmd,
-                    staging.raw,
-                    target.raw,
-                    &[vk::BufferCopy::default().size(size)],
-                );
-                let barrier = [vk::MemoryBarrier::default()
-                    .src_access_mask(vk::AccessFlags::TRANSFER_WRITE)
-                    .dst_access_mask(vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE)];
-                ctx.device.cmd_pipeline_barrier(
-                    cmd,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::PipelineStageFlags::COMPUTE_SHADER,
-                    vk::DependencyFlags::empty(),
-                    &barrier,
-                    &[],
-                    &[],
-                );
-            }
-        });
-        staging.destroy(ctx);
-        match copied {
-            Ok(()) => Ok(target),
-            Err(e) => {
-                target.destroy(ctx);
-                Err(e)
-            }
-        }
-    }
-
     /// The whole buffer as a binding.
     pub fn binding(&self) -> Binding {
         Binding {
@@ -190,14 +143,7 @@ pub fn read_device(ctx: &GpuContext, src: Binding) -> Result<Vec<u8>, GpuError> 
     let copied = ctx.submit_and_wait(|cmd| {
         // SAFETY: both buffers live until after the wait inside submit_and_wait.
         unsafe {
-            barrier(
-                ctx,
-                cmd,
-                vk::PipelineStageFlags::TRANSFER | vk::PipelineStageFlags::COMPUTE_SHADER,
-                vk::AccessFlags::TRANSFER_WRITE | vk::AccessFlags::SHADER_WRITE,
-                vk::PipelineStageFlags::TRANSFER,
-                vk::AccessFlags::TRANSFER_READ,
-            );
+            before_transfer(ctx, cmd);
             if src.range > 0 {
                 ctx.device.cmd_copy_buffer(
                     cmd,

@@ -184,14 +184,7 @@ impl StagingRing {
                         .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
                 ),
             )?;
-            barrier(
-                ctx,
-                slot.cmd,
-                vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
-                vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
-                vk::PipelineStageFlags::TRANSFER,
-                vk::AccessFlags::TRANSFER_WRITE,
-            );
+            before_transfer(ctx, slot.cmd);
             for (i, (dst, copies)) in commands.iter().enumerate() {
                 if i > 0 {
                     barrier(
@@ -205,16 +198,7 @@ impl StagingRing {
                 }
                 d.cmd_copy_buffer(slot.cmd, src, *dst, copies);
             }
-            barrier(
-                ctx,
-                slot.cmd,
-                vk::PipelineStageFlags::TRANSFER,
-                vk::AccessFlags::TRANSFER_WRITE,
-                vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
-                vk::AccessFlags::SHADER_READ
-                    | vk::AccessFlags::TRANSFER_READ
-                    | vk::AccessFlags::TRANSFER_WRITE,
-            );
+            after_transfer(ctx, slot.cmd);
             vk_call("vkEndCommandBuffer", d.end_command_buffer(slot.cmd))?;
             let cmds = [slot.cmd];
             let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
@@ -292,6 +276,44 @@ fn push_copy(
         }
     }
     commands.push((dst, vec![c]));
+}
+
+/// Orders transfers after earlier shader and transfer writes and reads (WAR and WAW).
+///
+/// # Safety
+/// `cmd` must be recording.
+pub(crate) unsafe fn before_transfer(ctx: &GpuContext, cmd: vk::CommandBuffer) {
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        barrier(
+            ctx,
+            cmd,
+            vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
+            vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
+            vk::PipelineStageFlags::TRANSFER,
+            vk::AccessFlags::TRANSFER_READ | vk::AccessFlags::TRANSFER_WRITE,
+        )
+    }
+}
+
+/// Makes transfer writes visible to later compute shaders and transfers.
+///
+/// # Safety
+/// `cmd` must be recording.
+pub(crate) unsafe fn after_transfer(ctx: &GpuContext, cmd: vk::CommandBuffer) {
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        barrier(
+            ctx,
+            cmd,
+            vk::PipelineStageFlags::TRANSFER,
+            vk::AccessFlags::TRANSFER_WRITE,
+            vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
+            vk::AccessFlags::SHADER_READ
+                | vk::AccessFlags::TRANSFER_READ
+                | vk::AccessFlags::TRANSFER_WRITE,
+        )
+    }
 }
 
 /// A global memory barrier.

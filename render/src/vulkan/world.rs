@@ -12,7 +12,7 @@
 //! on the GPU, so nothing is re-read or lost.
 
 use super::buffer::{Binding, HostBuffer, read_device};
-use super::staging::{StagingRing, Upload, barrier};
+use super::staging::{StagingRing, Upload, after_transfer, before_transfer};
 use super::{GpuContext, GpuError};
 use ash::vk;
 use brickmap::{GpuBuffer, World, WorldView};
@@ -117,16 +117,7 @@ fn zeroed_buffer(ctx: &GpuContext, size: u64) -> Result<HostBuffer, GpuError> {
         unsafe {
             ctx.device
                 .cmd_fill_buffer(cmd, buffer.raw, 0, vk::WHOLE_SIZE, 0);
-            barrier(
-                ctx,
-                cmd,
-                vk::PipelineStageFlags::TRANSFER,
-                vk::AccessFlags::TRANSFER_WRITE,
-                vk::PipelineStageFlags::TRANSFER | vk::PipelineStageFlags::COMPUTE_SHADER,
-                vk::AccessFlags::TRANSFER_READ
-                    | vk::AccessFlags::TRANSFER_WRITE
-                    | vk::AccessFlags::SHADER_READ,
-            );
+            after_transfer(ctx, cmd);
         }
     });
     match filled {
@@ -344,27 +335,11 @@ impl GpuWorld {
             // SAFETY: both buffers live until after the wait; barriers order the copy after
             // earlier shader reads and copies and before later ones.
             unsafe {
-                barrier(
-                    ctx,
-                    cmd,
-                    vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
-                    vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::AccessFlags::TRANSFER_READ | vk::AccessFlags::TRANSFER_WRITE,
-                );
+                before_transfer(ctx, cmd);
                 if !copy.is_empty() {
                     ctx.device.cmd_copy_buffer(cmd, old, new, &copy);
                 }
-                barrier(
-                    ctx,
-                    cmd,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::AccessFlags::TRANSFER_WRITE,
-                    vk::PipelineStageFlags::TRANSFER | vk::PipelineStageFlags::COMPUTE_SHADER,
-                    vk::AccessFlags::TRANSFER_READ
-                        | vk::AccessFlags::TRANSFER_WRITE
-                        | vk::AccessFlags::SHADER_READ,
-                );
+                after_transfer(ctx, cmd);
             }
         });
         if let Err(e) = copied {
