@@ -38,7 +38,8 @@ struct Params {
     vec4 sky_horizon;   // rgb
     vec4 sky_zenith;    // rgb, w: 1 for a gradient, 0 for uniform (horizon colour)
     uvec4 grid;         // bricks xyz, coarse words per column
-    uvec4 image;        // width, height, samples per pixel in this dispatch, max bounces B
+    uvec4 image;        // width, height, samples per pixel in this dispatch, B (the shader
+                        // uses the variant's MAX_BOUNCES; B is kept for the image key)
     uvec4 seed;         // seed, camera medium (material + 1, 0 for air), first sample index,
                         // 1 to add to the accumulation (0 to start it)
 };

@@ -8,7 +8,10 @@ use brickmap::{EditOp, MaterialKind, Mode, Shape, World};
 use glam::{DVec3, IVec3};
 mod common;
 
-use common::{add_material, params, sun_floor, world};
+use common::{
+    SKY, add_material, assert_finite_and_nonnegative, block_scene, mean_and_error, params,
+    sun_floor, world,
+};
 use render::cpu::{CpuScene, RenderJob};
 use render::{Camera, Image, SceneParams, Sky};
 
@@ -22,35 +25,8 @@ fn render(w: &World, p: &SceneParams, size: u32, spp: u32, seed: u64) -> Image {
     })
 }
 
-/// Mean of channel 0 over the image and its standard error.
-fn mean_and_error(img: &Image) -> (f64, f64) {
-    let v: Vec<f64> = img.pixels.iter().map(|p| p[0] as f64).collect();
-    let n = v.len() as f64;
-    let mean = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
-    (mean, (var / n).sqrt())
-}
-
 fn looking_at(eye: DVec3, target: DVec3, fov: f64) -> Camera {
     Camera::looking_at(eye, target, fov)
-}
-
-const SKY: [f32; 3] = [0.7, 0.5, 0.3];
-
-/// A 12³ block in the middle of a 32³ grid, seen from a corner.
-fn block_scene(kind: MaterialKind, param: u8) -> (World, SceneParams) {
-    let w = world((4, 4, 4));
-    let m = add_material(&w, kind, param, [255, 255, 255]);
-    w.apply(EditOp::Shape {
-        shape: Shape::Box {
-            min: IVec3::splat(10),
-            max: IVec3::splat(21),
-        },
-        mode: Mode::Add(m),
-    })
-    .unwrap();
-    let cam = looking_at(DVec3::new(-6.0, 40.0, -8.0), DVec3::splat(16.0), 40.0);
-    (w, params(cam, Sky::Uniform { colour: SKY }, None, 4))
 }
 
 #[test]
@@ -169,21 +145,12 @@ fn same_seed_same_image_and_no_nan_in_hard_places() {
 
     let (w, views) = common::hard_places();
     for (i, p) in views.iter().enumerate() {
-        let img = render(&w, p, 20, 4, i as u64);
-        assert!(img.all_finite(), "camera {i}");
-        assert!(
-            img.pixels.iter().all(|px| px.iter().all(|c| *c >= 0.0)),
-            "camera {i}"
-        );
+        assert_finite_and_nonnegative(&render(&w, p, 20, 4, i as u64), &format!("camera {i}"));
     }
     let (w, views) = common::far_places();
     for (i, p) in views.iter().enumerate() {
-        let img = render(&w, p, 8, 2, i as u64);
-        assert!(img.all_finite(), "far camera {i}");
-        assert!(
-            img.pixels.iter().all(|px| px.iter().all(|c| *c >= 0.0)),
-            "far camera {i}"
-        );
+        let what = format!("far camera {i}");
+        assert_finite_and_nonnegative(&render(&w, p, 8, 2, i as u64), &what);
     }
 }
 

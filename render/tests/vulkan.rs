@@ -282,33 +282,11 @@ mod trace {
             return;
         };
         for kind in [MaterialKind::Lambertian, MaterialKind::Metal] {
-            let w = World::new(
-                GridDims::new(4, 4, 4).unwrap(),
-                WorldConfig::with_workers(2),
-            )
-            .unwrap();
-            let m = add(&w, kind, 0, [255, 255, 255]);
-            w.apply(EditOp::Shape {
-                shape: Shape::Box {
-                    min: IVec3::splat(10),
-                    max: IVec3::splat(21),
-                },
-                mode: Mode::Add(m),
-            })
-            .unwrap();
-            let cam = Camera::looking_at(DVec3::new(-6.0, 40.0, -8.0), DVec3::splat(16.0), 40.0);
-            let sky = [0.7, 0.5, 0.3];
-            let img = gpu_render(
-                &ctx,
-                &w,
-                &params(cam, Sky::Uniform { colour: sky }, None, 4),
-                24,
-                4,
-                1,
-            );
+            let (w, p) = common::block_scene(kind, 0);
+            let img = gpu_render(&ctx, &w, &p, 24, 4, 1);
             for px in &img.pixels {
                 for c in 0..3 {
-                    assert!((px[c] - sky[c]).abs() < 1e-4, "{kind:?}: {px:?}");
+                    assert!((px[c] - common::SKY[c]).abs() < 1e-4, "{kind:?}: {px:?}");
                 }
             }
         }
@@ -322,12 +300,7 @@ mod trace {
         };
         let (w, p, expected) = sun_floor();
         let img = gpu_render(&ctx, &w, &p, 16, 256, 5);
-        let v: Vec<f64> = img.pixels.iter().map(|p| p[0] as f64).collect();
-        let mean = v.iter().sum::<f64>() / v.len() as f64;
-        let se = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>()
-            / (v.len() as f64 - 1.0)
-            / v.len() as f64)
-            .sqrt();
+        let (mean, se) = common::mean_and_error(&img);
         assert!(
             (mean - expected).abs() < 4.0 * se + 1e-3 * expected,
             "{mean} ± {se}, expected {expected}"
@@ -343,11 +316,7 @@ mod trace {
         let (w, views) = common::hard_places();
         for (i, p) in views.iter().enumerate() {
             let img = gpu_render(&ctx, &w, p, 20, 4, i as u64);
-            assert!(img.all_finite(), "camera {i}");
-            assert!(
-                img.pixels.iter().all(|px| px.iter().all(|c| *c >= 0.0)),
-                "camera {i}"
-            );
+            common::assert_finite_and_nonnegative(&img, &format!("camera {i}"));
         }
         assert_eq!(ctx.validation_errors(), 0);
     }
@@ -373,11 +342,7 @@ mod trace {
                 seed: i as u64,
             };
             let (img, _) = tracer.render(&ctx, &world, &view, p, &job).unwrap();
-            assert!(img.all_finite(), "camera {i}: {:?}", img.pixels);
-            assert!(
-                img.pixels.iter().all(|px| px.iter().all(|c| *c >= 0.0)),
-                "camera {i}"
-            );
+            common::assert_finite_and_nonnegative(&img, &format!("camera {i}"));
         }
         // The centre rays of the cameras looking at geometry hit what the exact f64 cast of
         // the same (f32) ray hits, up to f32's resolution of crossing times: two crossings

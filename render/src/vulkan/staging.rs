@@ -250,8 +250,8 @@ impl StagingRing {
 }
 
 /// Appends a copy, merging it into the previous region when both source and destination
-/// continue it; starts a new copy command when it overlaps an earlier destination range of
-/// the current command (regions of one command must not overlap).
+/// continue it; starts a new copy command when its destination does not lie after the
+/// previous region's (regions of one command must not overlap).
 fn push_copy(
     commands: &mut Vec<(vk::Buffer, Vec<vk::BufferCopy>)>,
     dst: vk::Buffer,
@@ -267,10 +267,13 @@ fn push_copy(
             last.size += c.size;
             return;
         }
-        let overlaps = copies
-            .iter()
-            .any(|r| r.dst_offset < c.dst_offset + c.size && c.dst_offset < r.dst_offset + r.size);
-        if !overlaps {
+        // Destinations ascending within a command cannot overlap; checking the last region
+        // keeps this O(1) per upload (a frame's uploads are queued in ascending order, so
+        // only deferred leftovers followed by newer bytes start a new command).
+        if copies
+            .last()
+            .is_none_or(|last| c.dst_offset >= last.dst_offset + last.size)
+        {
             copies.push(c);
             return;
         }

@@ -245,11 +245,7 @@ impl GpuWorld {
             uploaded_bytes: flushed.bytes,
             copy_regions: flushed.regions,
             flushes: u32::from(flushed.bytes > 0),
-            deferred_bytes: self
-                .queue
-                .iter()
-                .map(|u| (u.bytes.len() - u.done) as u64)
-                .sum(),
+            deferred_bytes: self.deferred_bytes(),
             ..Default::default()
         })
     }
@@ -392,14 +388,6 @@ impl GpuWorld {
     /// Coarse words per coarse x-column.
     pub fn words_per_column(&self) -> u32 {
         self.words_per_column
-    }
-    /// Device bytes reserved (all regions with their headroom).
-    pub fn device_bytes(&self) -> u64 {
-        self.buffer.size
-    }
-    /// Host bytes kept as the GPU's shadow copy.
-    pub fn shadow_bytes(&self) -> u64 {
-        self.shadow.iter().map(|s| s.len() as u64).sum()
     }
     /// Bytes queued and not yet copied.
     pub fn deferred_bytes(&self) -> u64 {

@@ -6,7 +6,7 @@ use brickmap::{
     EditOp, GridDims, Material, MaterialKind, Mode, Shape, VoxelEdit, VoxelOp, World, WorldConfig,
 };
 use glam::{DVec3, IVec3};
-use render::{Camera, RenderSettings, SceneParams, Sky, Sun};
+use render::{Camera, Image, RenderSettings, SceneParams, Sky, Sun};
 
 pub fn params(camera: Camera, sky: Sky, sun: Option<Sun>, bounces: u32) -> SceneParams {
     SceneParams {
@@ -28,6 +28,44 @@ pub fn params(camera: Camera, sky: Sky, sun: Option<Sun>, bounces: u32) -> Scene
             exposure: 0.0,
         },
     }
+}
+
+/// The furnace sky radiance of [`block_scene`].
+pub const SKY: [f32; 3] = [0.7, 0.5, 0.3];
+
+/// A 12³ block of one material (white) in the middle of a 32³ grid under the uniform
+/// [`SKY`], seen from a corner, 4 bounces.
+pub fn block_scene(kind: MaterialKind, param: u8) -> (World, SceneParams) {
+    let w = world((4, 4, 4));
+    let m = add_material(&w, kind, param, [255, 255, 255]);
+    w.apply(EditOp::Shape {
+        shape: Shape::Box {
+            min: IVec3::splat(10),
+            max: IVec3::splat(21),
+        },
+        mode: Mode::Add(m),
+    })
+    .unwrap();
+    let cam = Camera::looking_at(DVec3::new(-6.0, 40.0, -8.0), DVec3::splat(16.0), 40.0);
+    (w, params(cam, Sky::Uniform { colour: SKY }, None, 4))
+}
+
+/// Mean of channel 0 over the image and its standard error.
+pub fn mean_and_error(img: &Image) -> (f64, f64) {
+    let v: Vec<f64> = img.pixels.iter().map(|p| p[0] as f64).collect();
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+/// Every pixel finite (no NaN, no infinity) and non-negative.
+pub fn assert_finite_and_nonnegative(img: &Image, what: &str) {
+    assert!(img.all_finite(), "{what}: {:?}", img.pixels);
+    assert!(
+        img.pixels.iter().all(|px| px.iter().all(|c| *c >= 0.0)),
+        "{what}"
+    );
 }
 
 pub fn world(bricks: (u32, u32, u32)) -> World {
