@@ -183,27 +183,29 @@ int entry_axis(ivec3 cell) {
     return axis;
 }
 
-// A ray from anywhere (the camera): finds its first cell in the grid, then walks.
-bool trace_from_origin(vec3 o, vec3 d, int medium, float t_max, out ivec3 voxel, out ivec3 normal, out float t_hit) {
+// One entry for every ray, so a shader that calls only this has a single copy of the
+// traversal: from anywhere (the camera; finds its first cell in the grid) when `from_origin`,
+// else leaving a surface from the known `cell` at t = 0 (no epsilon offsets).
+bool trace(vec3 o, vec3 d, bool from_origin, ivec3 cell, int medium, float t_max, out ivec3 voxel, out ivec3 normal, out float t_hit) {
     set_ray(o, d);
     float t = 0.0;
-    for (int a = 0; a < 3; a++) {
-        int s = comp(g_sgn, a);
-        float oa = comp(o, a);
-        float n = float(comp(g_size, a));
-        if (s == 0) {
-            if (!(oa >= 0.0 && oa < n)) return false;
-        } else {
-            t = max(t, plane_time(a, s > 0 ? 0.0 : n));
+    if (from_origin) {
+        for (int a = 0; a < 3; a++) {
+            int s = comp(g_sgn, a);
+            float oa = comp(o, a);
+            float n = float(comp(g_size, a));
+            if (s == 0) {
+                if (!(oa >= 0.0 && oa < n)) return false;
+            } else {
+                t = max(t, plane_time(a, s > 0 ? 0.0 : n));
+            }
         }
+        if (isinf(t) || isnan(t)) return false;
+        cell = ivec3(cell_at(0, t, false), cell_at(1, t, false), cell_at(2, t, false));
     }
-    if (isinf(t) || isnan(t)) return false;
-    ivec3 cell = ivec3(cell_at(0, t, false), cell_at(1, t, false), cell_at(2, t, false));
     return dda(cell, t, entry_axis(cell), medium, t_max, voxel, normal, t_hit);
 }
 
-// A ray leaving a surface from a known cell (no epsilon offsets).
-bool trace_from_cell(vec3 o, vec3 d, ivec3 cell, int medium, float t_max, out ivec3 voxel, out ivec3 normal, out float t_hit) {
-    set_ray(o, d);
-    return dda(cell, 0.0, entry_axis(cell), medium, t_max, voxel, normal, t_hit);
+bool trace_from_origin(vec3 o, vec3 d, int medium, float t_max, out ivec3 voxel, out ivec3 normal, out float t_hit) {
+    return trace(o, d, true, ivec3(0), medium, t_max, voxel, normal, t_hit);
 }

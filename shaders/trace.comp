@@ -2,6 +2,7 @@
 // render/src/cpu/mod.rs (CpuScene::radiance) in f32. Keep in sync with it and with
 // render/src/vulkan/trace.rs (TraceParams).
 #version 450
+#extension GL_KHR_shader_subgroup_ballot : require
 layout(local_size_x = 8, local_size_y = 8) in;
 
 // Pipeline variants (render/src/vulkan/trace.rs `Variant`): what the scene needs. Code for
@@ -17,8 +18,15 @@ layout(constant_id = 5) const bool GRADIENT_SKY = true;
 layout(constant_id = 6) const uint MAX_BOUNCES = 4u;
 layout(constant_id = 7) const bool COUNT_RAYS = false;
 // Benchmark experiments (bench-gpu --experiment), 0 in every real render: bit 0 ends paths
-// at the first hit (primary rays only), bit 1 decodes colours without pow.
+// at the first hit (primary rays only), bit 1 decodes colours without pow, bit 2 counts
+// every shadow ray as unblocked without tracing it, bit 3 skips sun sampling (NEE), bit 4
+// makes shaders/shadow.comp skip its work.
 layout(constant_id = 8) const uint EXPERIMENT = 0u;
+// Shadow rays go to a queue that shaders/shadow.comp traces next, one per invocation, instead
+// of being traced here: in a warp only some lanes have a shadow ray at a vertex, and tracing
+// them here costs the whole warp a traversal (measured on the H100: shadow rays cost 4× what
+// a camera ray costs when traced in place). When the queue is full they are traced here.
+layout(constant_id = 9) const bool SHADOW_QUEUE = false;
 
 // Without dielectrics every ray travels in air: the traversal drops its medium branch.
 #define MEDIUM_POSSIBLE HAS_DIELECTRIC
@@ -47,9 +55,11 @@ struct Params {
 layout(std430, set = 0, binding = 5) readonly buffer ParamBuffer { Params p; };
 // Per pixel: the sum of its samples' radiance (rgb) and their count (a).
 layout(std430, set = 0, binding = 6) buffer Accum { vec4 accum[]; };
-// COUNT_RAYS variants only: camera rays, continuation rays, shadow rays, then the traversal
-// steps each kind took.
+// COUNT_RAYS variants only: camera rays, continuation rays, shadow rays, the traversal
+// steps each kind took, then the most steps one camera or continuation ray took and one
+// shadow ray took.
 layout(std430, set = 0, binding = 7) buffer Counters { uint counters[8]; };
+#include "shadow_queue.glsl"
 uint g_rays[6];
 
 const float PI = 3.14159265358979;
@@ -200,127 +210,149 @@ bool sample_bsdf(Shading s, vec3 wo, out vec3 wi, out vec3 weight, out float pdf
     return false;
 }
 
-vec3 radiance(vec3 origin, vec3 dir) {
-    vec3 l = vec3(0.0);
-    vec3 beta = vec3(1.0);
-    vec3 o = origin;
-    vec3 d = dir;
-    bool from_camera = true;
-    ivec3 start = ivec3(0);
-    int medium = HAS_DIELECTRIC ? int(p.seed.y) - 1 : AIR;
-    float bsdf_pdf = -1.0; // < 0: delta or camera
+// The path of this invocation's current sample. Paths are traced by one loop with a single
+// traversal call (main): a vertex's shadow ray towards the sun is the loop's next ray, the
+// path's continuation the one after, and a finished path starts the pixel's next sample in
+// the same loop. So the traversal is compiled once (fewer registers than three inlined
+// copies), and lanes of a warp tracing shadow rays, continuations and new camera rays run
+// the traversal together instead of in turn.
+vec3 pixel_sum;     // radiance of the pixel's samples so far (paths add to it directly)
+vec3 path_beta;     // throughput
+vec3 path_o;        // the next ray: origin, direction, first cell (not from the camera)
+vec3 path_d;
+ivec3 path_start;
+int path_medium;    // material the path is inside (AIR outside dielectrics)
+float path_pdf;     // pdf the BSDF chose path_d with; < 0: delta or camera
+bool path_camera;   // the next ray is the camera ray
+uint path_vertex;   // index of the vertex the next ray finds (1: the camera ray's hit)
+// A pending shadow ray from path_o, starting in path_start: when nothing blocks it before
+// shadow_t, shadow_l counts.
+bool shadow_pending;
+vec3 shadow_d;
+float shadow_t;
+vec3 shadow_l;
+
+void begin_path(uvec2 px, uint index, uint s) {
+    rng = hash(p.seed.x ^ hash(index * 9781u + (p.seed.z + s) * 6271u + 1u));
+    float u = (2.0 * (float(px.x) + rand()) / float(p.image.x) - 1.0);
+    float v = (1.0 - 2.0 * (float(px.y) + rand()) / float(p.image.y));
+    path_d = normalize(p.cam_forward.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v);
+    path_o = p.cam_pos.xyz;
+    path_beta = vec3(1.0);
+    path_start = ivec3(0);
+    path_medium = HAS_DIELECTRIC ? int(p.seed.y) - 1 : AIR;
+    path_pdf = -1.0;
+    path_camera = true;
+    path_vertex = 1u;
+    shadow_pending = false;
+}
+
+// What the path's ray found (a voxel at t_voxel, or nothing): adds what it sees, prepares
+// the vertex's shadow ray (shadow_pending) and the next ray. Returns whether the path goes on.
+bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
     const uint bounces = MAX_BOUNCES;
-    for (uint vertex = 1u; vertex <= bounces + 1u; vertex++) {
-        ivec3 voxel;
-        ivec3 normal;
-        float t_voxel;
-        if (COUNT_RAYS) g_rays[from_camera ? 0 : 1]++;
-        g_steps = 0u;
-        bool hit = from_camera ? trace_from_origin(o, d, medium, 1.0 / 0.0, voxel, normal, t_voxel)
-                               : trace_from_cell(o, d, start, medium, 1.0 / 0.0, voxel, normal, t_voxel);
-        if (COUNT_RAYS) g_rays[from_camera ? 3 : 4] += g_steps;
-        if (!hit) t_voxel = 1.0 / 0.0;
-        float cos_l;
-        float t_sun = sun_hit(o, d, cos_l);
-        if (t_sun > 0.0 && t_sun < t_voxel) {
-            float w = bsdf_pdf < 0.0 ? 1.0 : power_heuristic(bsdf_pdf, t_sun * t_sun / (cos_l * sun_area()));
-            l += beta * p.sun_radiance.rgb * w;
-            break;
+    vec3 o = path_o;
+    vec3 d = path_d;
+    if (!hit) t_voxel = 1.0 / 0.0;
+    float cos_l;
+    float t_sun = sun_hit(o, d, cos_l);
+    if (t_sun > 0.0 && t_sun < t_voxel) {
+        float w = path_pdf < 0.0 ? 1.0 : power_heuristic(path_pdf, t_sun * t_sun / (cos_l * sun_area()));
+        pixel_sum += path_beta * p.sun_radiance.rgb * w;
+        return false;
+    }
+    if (!hit) {
+        pixel_sum += path_beta * sky(d);
+        return false;
+    }
+    vec3 pt = o + d * t_voxel;
+    vec3 n = vec3(normal);
+    int here = material_at(voxel);
+    Shading s;
+    if (here >= 0) s = material(here);
+    bool crossing = HAS_DIELECTRIC && ((here >= 0 && s.kind == DIELECTRIC) || (here < 0 && path_medium >= 0));
+    if ((EXPERIMENT & 1u) != 0u) {
+        pixel_sum += path_beta * (here >= 0 ? s.albedo : vec3(0.0));
+        return false;
+    }
+    if (HAS_EMISSIVE && here >= 0 && s.kind == EMISSIVE) {
+        pixel_sum += path_beta * s.albedo * s.param;
+        return false;
+    }
+    if (path_vertex == bounces + 1u) return false;
+    ivec3 front = voxel + normal;
+    path_o = pt;
+    if (crossing) {
+        int medium = path_medium;
+        float eta_i = medium >= 0 ? material(medium).param : 1.0;
+        float eta_t = here >= 0 ? s.param : 1.0;
+        vec3 tint = here >= 0 ? s.albedo : material(medium).albedo;
+        float cos_i = -dot(d, n);
+        float eta = eta_i / eta_t;
+        float sin2_t = eta * eta * max(0.0, 1.0 - cos_i * cos_i);
+        float f = 1.0;
+        float cos_t = 0.0;
+        if (sin2_t < 1.0) {
+            cos_t = sqrt(1.0 - sin2_t);
+            float rs = (eta_i * cos_i - eta_t * cos_t) / (eta_i * cos_i + eta_t * cos_t);
+            float rp = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
+            f = 0.5 * (rs * rs + rp * rp);
         }
-        if (!hit) {
-            l += beta * sky(d);
-            break;
-        }
-        vec3 pt = o + d * t_voxel;
-        vec3 n = vec3(normal);
-        int here = material_at(voxel);
-        Shading s;
-        if (here >= 0) s = material(here);
-        bool crossing = HAS_DIELECTRIC && ((here >= 0 && s.kind == DIELECTRIC) || (here < 0 && medium >= 0));
-        if ((EXPERIMENT & 1u) != 0u) {
-            l += beta * (here >= 0 ? s.albedo : vec3(0.0));
-            break;
-        }
-        if (HAS_EMISSIVE && here >= 0 && s.kind == EMISSIVE) {
-            l += beta * s.albedo * s.param;
-            break;
-        }
-        if (vertex == bounces + 1u) break;
-        ivec3 front = voxel + normal;
-        if (crossing) {
-            float eta_i = medium >= 0 ? material(medium).param : 1.0;
-            float eta_t = here >= 0 ? s.param : 1.0;
-            vec3 tint = here >= 0 ? s.albedo : material(medium).albedo;
-            float cos_i = -dot(d, n);
-            float eta = eta_i / eta_t;
-            float sin2_t = eta * eta * max(0.0, 1.0 - cos_i * cos_i);
-            float f = 1.0;
-            float cos_t = 0.0;
-            if (sin2_t < 1.0) {
-                cos_t = sqrt(1.0 - sin2_t);
-                float rs = (eta_i * cos_i - eta_t * cos_t) / (eta_i * cos_i + eta_t * cos_t);
-                float rp = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
-                f = 0.5 * (rs * rs + rp * rp);
-            }
-            if (rand() < f) {
-                d = normalize(d + n * (2.0 * cos_i));
-                start = front;
-            } else {
-                d = normalize(d * eta + n * (eta * cos_i - cos_t));
-                start = voxel;
-                beta *= tint * (eta * eta);
-                medium = here;
-            }
-            bsdf_pdf = -1.0;
+        if (rand() < f) {
+            path_d = normalize(d + n * (2.0 * cos_i));
+            path_start = front;
         } else {
-            vec3 ft;
-            vec3 fb;
-            frame(n, ft, fb);
-            vec3 wo = vec3(dot(-d, ft), dot(-d, fb), dot(-d, n));
-            bool delta = HAS_METAL && s.kind == METAL && s.param <= 0.0;
-            if (SUN && !delta && p.sun_normal.w != 0.0) {
-                float r = p.sun_centre.w * sqrt(rand());
-                float phi = 2.0 * PI * rand();
-                vec3 y = p.sun_centre.xyz + (p.sun_e1.xyz * cos(phi) + p.sun_e2.xyz * sin(phi)) * r;
-                vec3 to = y - pt;
-                float dist = length(to);
-                vec3 w = to / dist;
-                float cl = -dot(w, p.sun_normal.xyz);
-                vec3 wi = vec3(dot(w, ft), dot(w, fb), dot(w, n));
-                if (cl > 0.0 && wi.z > 0.0) {
-                    float pdf_bsdf;
-                    vec3 fv = eval_bsdf(s, wo, wi, pdf_bsdf);
-                    ivec3 sv;
-                    ivec3 sn;
-                    float st;
-                    if (COUNT_RAYS && fv != vec3(0.0)) g_rays[2]++;
-                    g_steps = 0u;
-                    bool blocked = fv != vec3(0.0) && trace_from_cell(pt, w, front, AIR, dist, sv, sn, st);
-                    if (COUNT_RAYS) g_rays[5] += g_steps;
-                    if (fv != vec3(0.0) && !blocked) {
-                        float pdf_light = dist * dist / (cl * sun_area());
-                        l += beta * fv * wi.z * p.sun_radiance.rgb * power_heuristic(pdf_light, pdf_bsdf) / pdf_light;
-                    }
+            path_d = normalize(d * eta + n * (eta * cos_i - cos_t));
+            path_start = voxel;
+            path_beta *= tint * (eta * eta);
+            path_medium = here;
+        }
+        path_pdf = -1.0;
+    } else {
+        vec3 ft;
+        vec3 fb;
+        frame(n, ft, fb);
+        vec3 wo = vec3(dot(-d, ft), dot(-d, fb), dot(-d, n));
+        path_start = front; // the shadow ray's first cell too
+        bool delta = HAS_METAL && s.kind == METAL && s.param <= 0.0;
+        if (SUN && !delta && p.sun_normal.w != 0.0 && (EXPERIMENT & 8u) == 0u) {
+            float r = p.sun_centre.w * sqrt(rand());
+            float phi = 2.0 * PI * rand();
+            vec3 y = p.sun_centre.xyz + (p.sun_e1.xyz * cos(phi) + p.sun_e2.xyz * sin(phi)) * r;
+            vec3 to = y - pt;
+            float dist = length(to);
+            vec3 w = to / dist;
+            float cl = -dot(w, p.sun_normal.xyz);
+            vec3 wi = vec3(dot(w, ft), dot(w, fb), dot(w, n));
+            if (cl > 0.0 && wi.z > 0.0) {
+                float pdf_bsdf;
+                vec3 fv = eval_bsdf(s, wo, wi, pdf_bsdf);
+                if (fv != vec3(0.0)) {
+                    float pdf_light = dist * dist / (cl * sun_area());
+                    shadow_pending = (EXPERIMENT & 4u) == 0u;
+                    if ((EXPERIMENT & 4u) != 0u) pixel_sum += path_beta * fv * wi.z * p.sun_radiance.rgb * power_heuristic(pdf_light, pdf_bsdf) / pdf_light;
+                    shadow_d = w;
+                    shadow_t = dist;
+                    shadow_l = path_beta * fv * wi.z * p.sun_radiance.rgb * power_heuristic(pdf_light, pdf_bsdf) / pdf_light;
                 }
             }
-            vec3 wi;
-            vec3 weight;
-            float pdf;
-            if (!sample_bsdf(s, wo, wi, weight, pdf)) break;
-            beta *= weight;
-            bsdf_pdf = pdf;
-            d = ft * wi.x + fb * wi.y + n * wi.z;
-            start = front;
         }
-        o = pt;
-        from_camera = false;
-        if (vertex >= 4u) {
-            float q = clamp(max(beta.r, max(beta.g, beta.b)), 0.05, 1.0);
-            if (rand() >= q) break;
-            beta /= q;
-        }
+        vec3 wi;
+        vec3 weight;
+        float pdf;
+        if (!sample_bsdf(s, wo, wi, weight, pdf)) return false;
+        path_beta *= weight;
+        path_pdf = pdf;
+        path_d = ft * wi.x + fb * wi.y + n * wi.z;
     }
-    return l;
+    path_camera = false;
+    if (path_vertex >= 4u) {
+        float q = clamp(max(path_beta.r, max(path_beta.g, path_beta.b)), 0.05, 1.0);
+        if (rand() >= q) return false;
+        path_beta /= q;
+    }
+    path_vertex++;
+    return true;
 }
 
 void main() {
@@ -329,16 +361,62 @@ void main() {
     g_dims = p.grid.xyz;
     g_words_per_column = p.grid.w;
     uint index = px.y * p.image.x + px.x;
-    vec3 sum = vec3(0.0);
     for (int k = 0; k < 6; k++) g_rays[k] = 0u;
-    for (uint s = 0u; s < p.image.z; s++) {
-        rng = hash(p.seed.x ^ hash(index * 9781u + (p.seed.z + s) * 6271u + 1u));
-        float u = (2.0 * (float(px.x) + rand()) / float(p.image.x) - 1.0);
-        float v = (1.0 - 2.0 * (float(px.y) + rand()) / float(p.image.y));
-        vec3 dir = normalize(p.cam_forward.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v);
-        sum += radiance(p.cam_pos.xyz, dir);
+    pixel_sum = vec3(0.0);
+    uint next_sample = 0u;
+    bool more = p.image.z > 0u; // samples left (the current path's included)
+    if (more) begin_path(px, index, next_sample++);
+    bool path_alive = true; // false: the path ended (its shadow ray may still be pending)
+    while (more) {
+        bool shadow = shadow_pending;
+        bool camera = path_camera && !shadow;
+        uint kind = shadow ? 2u : (camera ? 0u : 1u);
+        if (COUNT_RAYS) g_rays[kind]++;
+        g_steps = 0u;
+        ivec3 voxel;
+        ivec3 normal;
+        float t;
+        bool hit = trace(path_o, shadow ? shadow_d : path_d, camera, path_start,
+                         shadow ? AIR : path_medium, shadow ? shadow_t : 1.0 / 0.0, voxel, normal, t);
+        if (COUNT_RAYS) {
+            g_rays[kind + 3u] += g_steps;
+            atomicMax(counters[shadow ? 7 : 6], g_steps);
+        }
+        if (shadow) {
+            if (!hit) pixel_sum += shadow_l;
+            shadow_pending = false;
+        } else {
+            path_alive = scatter(hit, voxel, normal, t);
+        }
+        if (SHADOW_QUEUE) {
+            // A shadow ray made by this vertex goes to the queue; the subgroup reserves its
+            // slots with one atomic.
+            bool want = shadow_pending;
+            uvec4 ballot = subgroupBallot(want);
+            uint n = subgroupBallotBitCount(ballot);
+            if (n > 0u) {
+                uint base = 0u;
+                if (subgroupElect()) {
+                    base = atomicAdd(queue_count, n);
+                    atomicMax(queue_groups, (min(base + n, shadow_rays.length()) + 63u) / 64u);
+                }
+                base = subgroupBroadcastFirst(base);
+                uint slot = base + subgroupBallotExclusiveBitCount(ballot);
+                if (want && push_shadow_ray(slot, path_o, path_start, shadow_d, shadow_t, shadow_l, index)) {
+                    shadow_pending = false;
+                    if (COUNT_RAYS) g_rays[2]++;
+                }
+            }
+        }
+        if (!path_alive && !shadow_pending) {
+            more = next_sample < p.image.z;
+            if (more) {
+                begin_path(px, index, next_sample++);
+                path_alive = true;
+            }
+        }
     }
-    vec4 mine = vec4(sum, float(p.image.z));
+    vec4 mine = vec4(pixel_sum, float(p.image.z));
     accum[index] = p.seed.w != 0u ? accum[index] + mine : mine;
     if (COUNT_RAYS) {
         for (int k = 0; k < 6; k++) atomicAdd(counters[k], g_rays[k]);

@@ -148,7 +148,8 @@ enum Command {
         /// Internal resolution height.
         #[arg(long, default_value_t = 576)]
         height: u32,
-        /// Timed frames per complexity (after 20 warm-up frames).
+        /// Timed dispatches per complexity and variant, in rounds of 10 back to back (after
+        /// two warm-up rounds).
         #[arg(long, default_value_t = 50)]
         frames: usize,
         /// Device name filter (default: a discrete GPU if any).
@@ -157,6 +158,9 @@ enum Command {
         /// Shader experiment bits (trace.comp `EXPERIMENT`; 0 = the real renderer).
         #[arg(long, default_value_t = 0)]
         experiment: u32,
+        /// Trace shadow rays where they start instead of queueing them for the shadow pass.
+        #[arg(long)]
+        inline_shadows: bool,
     },
     /// Print a scene file's dimensions, voxel count, materials and memory.
     Info {
@@ -413,7 +417,16 @@ fn run(cli: Cli) -> Result<()> {
             frames,
             device,
             experiment,
-        } => bench_gpu(width, height, frames.max(1), device, experiment, workers),
+            inline_shadows,
+        } => bench_gpu(
+            width,
+            height,
+            frames.max(1),
+            device,
+            experiment,
+            inline_shadows,
+            workers,
+        ),
         Command::Info { file } => {
             let started = Instant::now();
             let scene = with_progress(format!("reading {}", file.display()), || {
@@ -627,10 +640,12 @@ fn bench_gpu(
     frames: usize,
     device: Option<String>,
     experiment: u32,
+    inline_shadows: bool,
     workers: usize,
 ) -> Result<()> {
     use render::vulkan::{
         ContextOptions, DeviceChoice, GpuContext,
+        progressive::Progressive,
         trace::{PathTracer, Variant},
         world::GpuWorld,
     };
@@ -649,6 +664,15 @@ fn bench_gpu(
     );
     let mut failure = None;
     let mut tracer = PathTracer::new(&ctx)?;
+    tracer.set_deferred_shadows(&ctx, !inline_shadows);
+    text += &format!(
+        "shadow rays  {}\n",
+        if tracer.deferred_shadows() {
+            "queued for the shadow pass"
+        } else {
+            "traced in place"
+        }
+    );
     for (label, bounces, spp, sun) in [
         ("complexity 1 (1 bounce, 1 spp, no sun)", 1, 1, false),
         ("complexity 2 (1 bounce, 1 spp, sun)", 1, 1, true),
@@ -663,26 +687,31 @@ fn bench_gpu(
             spp,
             seed,
         };
-        // The scene's variant and the everything variant, alternated frame by frame so both
-        // see the same machine state; the first 20 frames of each are warm-up (clocks ramp up).
+        // The scene's variant and the everything variant, alternated in rounds of
+        // back-to-back dispatches (one submission each, so the GPU stays busy and its clocks
+        // stay up) so both see the same machine state; the first two rounds of each are
+        // warm-up.
         let scene_variant = Variant {
             experiment,
             ..Variant::for_scene(view.materials(), &params)
         };
         let variants = [scene_variant, Variant::everything(bounces)];
         let mut times = [Vec::with_capacity(frames), Vec::with_capacity(frames)];
-        'frames: for frame in 0..frames + 20 {
+        const ROUND: u32 = 10;
+        let mut acc = Progressive::new(&ctx, (width, height), (width, height), 1)?;
+        'rounds: for round in 0..frames.div_ceil(ROUND as usize) + 2 {
             for (k, v) in variants.iter().enumerate() {
-                match tracer.render_variant(&ctx, &world, &view, &params, &job(frame as u64), *v) {
-                    Ok((_, Some(t))) if frame >= 20 => times[k].push(t),
+                match acc.time_repeated(&ctx, &mut tracer, &world, &view, &params, *v, spp, ROUND) {
+                    Ok(t) if round >= 2 => times[k].extend(t),
                     Ok(_) => {}
                     Err(e) => {
                         failure = Some(e);
-                        break 'frames;
+                        break 'rounds;
                     }
                 }
             }
         }
+        acc.destroy(&ctx);
         if failure.is_some() {
             break;
         }
@@ -722,7 +751,7 @@ fn bench_gpu(
         text += &format!(
             "{label}: median {:.3} ms (p10 {:.3}, p90 {:.3}, {} frames); everything variant {:.3} ms ({:+.1}%)\n  \
              rays: {:.1} M primary, {:.1} M secondary, {:.1} M shadow; {:.0} Mrays/s primary, {:.0} Mrays/s secondary+shadow, {:.0} Mrays/s all\n  \
-             traversal steps per ray: {:.1} primary, {:.1} secondary, {:.1} shadow\n",
+             traversal steps per ray: {:.1} primary, {:.1} secondary, {:.1} shadow; most in one ray: {} camera or continuation, {} shadow\n",
             median * 1e3,
             p10 * 1e3,
             p90 * 1e3,
@@ -738,6 +767,8 @@ fn bench_gpu(
             rays.steps[0] as f64 / rays.primary.max(1) as f64,
             rays.steps[1] as f64 / rays.secondary.max(1) as f64,
             rays.steps[2] as f64 / rays.shadow.max(1) as f64,
+            rays.max_steps[0],
+            rays.max_steps[1],
         );
     }
     tracer.destroy(&ctx);

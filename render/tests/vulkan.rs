@@ -110,6 +110,35 @@ fn the_messenger_counts_validation_errors() {
 }
 
 #[test]
+fn synchronization_validation_reports_a_missing_barrier() {
+    // Without this, "zero hazards" could pass because synchronization validation is off.
+    use ash::vk;
+    use gpu_allocator::MemoryLocation;
+    use render::vulkan::buffer::HostBuffer;
+    let Some(ctx) = context(DeviceChoice::Best) else {
+        return;
+    };
+    let buf = HostBuffer::new(&ctx, "hazard", 256, MemoryLocation::GpuOnly).unwrap();
+    let src = HostBuffer::new(&ctx, "hazard source", 256, MemoryLocation::CpuToGpu).unwrap();
+    assert_eq!(ctx.validation_errors(), 0);
+    // Two copies into the same bytes with no barrier between them: a write-after-write.
+    let region = [vk::BufferCopy::default().size(256)];
+    ctx.submit_and_wait(|cmd| unsafe {
+        ctx.device
+            .cmd_copy_buffer(cmd, src.binding().buffer, buf.binding().buffer, &region);
+        ctx.device
+            .cmd_copy_buffer(cmd, src.binding().buffer, buf.binding().buffer, &region);
+    })
+    .unwrap();
+    assert!(
+        ctx.validation_errors() >= 1,
+        "synchronization validation did not report the hazard"
+    );
+    buf.destroy(&ctx);
+    src.destroy(&ctx);
+}
+
+#[test]
 fn gpu_traversal_matches_the_cpu_ray_cast() {
     use brickmap::{
         EditOp, GridDims, Mode, Ray, Shape, VoxelEdit, VoxelOp, World, WorldConfig, terrain,
@@ -225,15 +254,12 @@ fn gpu_traversal_matches_the_cpu_ray_cast() {
 mod trace {
     //! The GPU path tracer against closed forms and against the CPU reference.
     use super::*;
-    use brickmap::{
-        EditOp, GridDims, MaterialKind, Mode, Shape, VoxelEdit, VoxelOp, World, WorldConfig,
-    };
-    use common::{add_material as add, params, sun_floor};
-    use glam::{DVec3, IVec3};
+    use brickmap::{MaterialKind, World};
+    use common::sun_floor;
+    use render::SceneParams;
     use render::cpu::{CpuScene, RenderJob};
     use render::vulkan::trace::PathTracer;
     use render::vulkan::world::GpuWorld;
-    use render::{Camera, SceneParams, Sky, Sun};
 
     fn gpu_render(
         ctx: &GpuContext,
@@ -403,95 +429,68 @@ mod trace {
     }
 
     #[test]
+    fn queued_shadow_rays_render_what_shadow_rays_traced_in_place_render() {
+        let Some(ctx) = context(DeviceChoice::Best) else {
+            return;
+        };
+        if !ctx.shadow_queue {
+            // Every driver we test on has float atomics; a device without them traces in place.
+            assert_ne!(
+                std::env::var("VOXBRICK_REQUIRE_GPU").as_deref(),
+                Ok("1"),
+                "{} cannot queue shadow rays",
+                ctx.name
+            );
+            eprintln!("SKIPPED: {} cannot queue shadow rays", ctx.name);
+            return;
+        }
+        let (w, p) = common::showcase();
+        let view = w.read();
+        let world = GpuWorld::upload(&ctx, &view).unwrap();
+        let job = RenderJob {
+            width: 24,
+            height: 16,
+            spp: 4,
+            seed: 5,
+        };
+        let mut tracer = PathTracer::new(&ctx).unwrap();
+        assert!(tracer.deferred_shadows());
+        let mut render = |deferred: bool, limit: u64| {
+            tracer.set_deferred_shadows(&ctx, deferred);
+            tracer.set_queue_limit(limit);
+            let (img, _, rays) = tracer
+                .render_counted(&ctx, &world, &view, &p, &job)
+                .unwrap();
+            (img, rays)
+        };
+        let (in_place, rays) = render(false, u64::MAX);
+        // The limit of 100 rays makes the queue overflow: the rest are traced in place.
+        assert!(rays.shadow > 300, "{rays:?}");
+        for limit in [u64::MAX, 100] {
+            let (queued, queued_rays) = render(true, limit);
+            assert_eq!(queued_rays, rays, "queue limit {limit}");
+            for (a, b) in queued.pixels.iter().zip(&in_place.pixels) {
+                for k in 0..3 {
+                    assert!(
+                        (a[k] - b[k]).abs() <= 1e-5 * b[k].abs().max(1.0),
+                        "queue limit {limit}: {a:?} vs {b:?}"
+                    );
+                }
+            }
+        }
+        tracer.destroy(&ctx);
+        world.destroy(&ctx);
+        assert_eq!(ctx.validation_errors(), 0);
+    }
+
+    #[test]
     fn gpu_and_cpu_agree_within_sampling_noise() {
         // If the GPU estimator is the CPU one, RMS(GPU − CPU₁) ≈ RMS(CPU₂ − CPU₁) for
         // independent renders; a bias shows as a larger ratio (and a shifted mean).
         let Some(ctx) = context(DeviceChoice::Best) else {
             return;
         };
-        let w = World::new(
-            GridDims::new(6, 4, 6).unwrap(),
-            WorldConfig::with_workers(2),
-        )
-        .unwrap();
-        let floor = add(&w, MaterialKind::Lambertian, 0, [150, 140, 120]);
-        let glass = add(&w, MaterialKind::Dielectric, 0, [240, 250, 255]);
-        let water = add(&w, MaterialKind::Dielectric, 1, [200, 230, 255]);
-        let rough = add(&w, MaterialKind::Metal, 30, [230, 200, 120]);
-        let mirror = add(&w, MaterialKind::Metal, 0, [250, 250, 250]);
-        w.set_param(MaterialKind::Emissive, 2, 6.0).unwrap();
-        let lamp = add(&w, MaterialKind::Emissive, 2, [255, 220, 180]);
-        for (shape, m) in [
-            (
-                Shape::Box {
-                    min: IVec3::ZERO,
-                    max: IVec3::new(47, 2, 47),
-                },
-                floor,
-            ),
-            (
-                Shape::Box {
-                    min: IVec3::new(0, 3, 28),
-                    max: IVec3::new(47, 5, 47),
-                },
-                water,
-            ),
-            (
-                Shape::Box {
-                    min: IVec3::new(8, 3, 8),
-                    max: IVec3::new(15, 10, 15),
-                },
-                glass,
-            ),
-            (
-                Shape::Sphere {
-                    centre: DVec3::new(30.0, 8.0, 14.0),
-                    radius: 5.0,
-                },
-                rough,
-            ),
-            (
-                Shape::Box {
-                    min: IVec3::new(40, 3, 4),
-                    max: IVec3::new(41, 14, 20),
-                },
-                mirror,
-            ),
-        ] {
-            w.apply(EditOp::Shape {
-                shape,
-                mode: Mode::Add(m),
-            })
-            .unwrap();
-        }
-        w.apply(EditOp::Voxels(vec![VoxelEdit {
-            pos: IVec3::new(22, 12, 30),
-            op: VoxelOp::Set(lamp),
-        }]))
-        .unwrap();
-        let sun = Sun {
-            enabled: true,
-            position: DVec3::new(80.0, 90.0, 60.0),
-            radius: 8.0,
-            colour: [1.0, 0.9, 0.8],
-            intensity: 15.0,
-            animate: false,
-            speed_deg_per_s: 0.0,
-        };
-        let cam = Camera::looking_at(
-            DVec3::new(-8.0, 26.0, -8.0),
-            DVec3::new(24.0, 6.0, 24.0),
-            55.0,
-        );
-        let p = params(
-            cam,
-            Sky::Gradient {
-                horizon: [0.8, 0.85, 1.0],
-                zenith: [0.2, 0.35, 0.8],
-            },
-            Some(sun),
-            4,
-        );
+        let (w, p) = common::showcase();
         let (size, spp) = (32, 64);
         let g = gpu_render(&ctx, &w, &p, size, spp, 11);
         let c1 = cpu_render(&w, &p, size, spp, 12);
@@ -887,6 +886,51 @@ mod progressive {
 
         tracer.destroy(&ctx);
         gpu.destroy(&ctx);
+        assert_eq!(ctx.validation_errors(), 0);
+    }
+
+    #[test]
+    fn back_to_back_benchmark_dispatches_are_each_timed_and_ordered() {
+        let Some(ctx) = context(DeviceChoice::Best) else {
+            return;
+        };
+        let (w, p, _) = sun_floor();
+        let gpu = GpuWorld::upload(&ctx, &w.read()).unwrap();
+        let mut tracer = PathTracer::new(&ctx).unwrap();
+        let size = (16, 12);
+        let mut acc = Progressive::new(&ctx, size, size, 3).unwrap();
+        let variant = Variant::for_scene(w.read().materials(), &p);
+        let times = acc
+            .time_repeated(&ctx, &mut tracer, &gpu, &w.read(), &p, variant, 2, 5)
+            .unwrap();
+        if ctx.timestamp_period > 0.0 {
+            assert_eq!(times.len(), 5);
+            assert!(times.iter().all(|t| t.is_finite() && *t > 0.0), "{times:?}");
+        } else {
+            assert!(times.is_empty());
+        }
+        // The buffer holds one batch (each dispatch starts it over), the same as a render.
+        let repeated = acc.hdr(&ctx).unwrap();
+        let job = RenderJob {
+            width: size.0,
+            height: size.1,
+            spp: 2,
+            seed: 3,
+        };
+        let (direct, _) = tracer.render(&ctx, &gpu, &w.read(), &p, &job).unwrap();
+        // Equal up to the order of the shadow pass's float atomic adds.
+        for (a, b) in repeated.pixels.iter().zip(&direct.pixels) {
+            for k in 0..3 {
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-5 * b[k].abs().max(1.0),
+                    "{a:?} vs {b:?}"
+                );
+            }
+        }
+        acc.destroy(&ctx);
+        tracer.destroy(&ctx);
+        gpu.destroy(&ctx);
+        // Sync validation reports a missing barrier between the dispatches.
         assert_eq!(ctx.validation_errors(), 0);
     }
 

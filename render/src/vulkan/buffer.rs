@@ -42,7 +42,8 @@ impl HostBuffer {
             .usage(
                 vk::BufferUsageFlags::STORAGE_BUFFER
                     | vk::BufferUsageFlags::TRANSFER_SRC
-                    | vk::BufferUsageFlags::TRANSFER_DST,
+                    | vk::BufferUsageFlags::TRANSFER_DST
+                    | vk::BufferUsageFlags::INDIRECT_BUFFER,
             )
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: the create info outlives the call; the buffer is destroyed in `destroy`.

@@ -93,6 +93,9 @@ pub struct GpuContext {
     pub storage_alignment: u64,
     /// VK_KHR_pipeline_executable_properties, when the driver has it.
     pub pipeline_stats: Option<ash::khr::pipeline_executable_properties::Device>,
+    /// Float atomic adds on storage buffers (VK_EXT_shader_atomic_float) and subgroup ballots
+    /// in compute shaders: what the path tracer's shadow-ray queue needs.
+    pub shadow_queue: bool,
 }
 
 unsafe extern "system" fn count_errors(
@@ -238,21 +241,52 @@ impl GpuContext {
         // Pipeline statistics (registers, spills, instructions per shader) when the driver
         // offers them: benchmarks print them next to the timings.
         // SAFETY: plain query.
-        let has_stats = unsafe { instance.enumerate_device_extension_properties(physical) }
-            .unwrap_or_default()
-            .iter()
-            .any(|e| {
-                e.extension_name_as_c_str() == Ok(ash::khr::pipeline_executable_properties::NAME)
-            });
-        let extensions = [ash::khr::pipeline_executable_properties::NAME.as_ptr()];
+        let available =
+            unsafe { instance.enumerate_device_extension_properties(physical) }.unwrap_or_default();
+        let has = |name: &CStr| {
+            available
+                .iter()
+                .any(|e| e.extension_name_as_c_str() == Ok(name))
+        };
+        let has_stats = has(ash::khr::pipeline_executable_properties::NAME);
+        // The shadow-ray queue: float atomic adds on buffers and subgroup ballots in compute.
+        let mut atomic_float = vk::PhysicalDeviceShaderAtomicFloatFeaturesEXT::default();
+        let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
+        // SAFETY: plain queries with valid output chains (Vulkan 1.1 core).
+        unsafe {
+            let mut features = vk::PhysicalDeviceFeatures2::default().push_next(&mut atomic_float);
+            instance.get_physical_device_features2(physical, &mut features);
+            let mut props = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
+            instance.get_physical_device_properties2(physical, &mut props);
+        }
+        let shadow_queue = has(ash::ext::shader_atomic_float::NAME)
+            && atomic_float.shader_buffer_float32_atomic_add == vk::TRUE
+            && subgroup
+                .supported_stages
+                .contains(vk::ShaderStageFlags::COMPUTE)
+            && subgroup
+                .supported_operations
+                .contains(vk::SubgroupFeatureFlags::BASIC | vk::SubgroupFeatureFlags::BALLOT);
+        let mut extensions = Vec::new();
+        if has_stats {
+            extensions.push(ash::khr::pipeline_executable_properties::NAME.as_ptr());
+        }
+        if shadow_queue {
+            extensions.push(ash::ext::shader_atomic_float::NAME.as_ptr());
+        }
         let mut stats_feature =
             vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default()
                 .pipeline_executable_info(true);
-        let mut info = vk::DeviceCreateInfo::default().queue_create_infos(&queues);
+        let mut float_feature = vk::PhysicalDeviceShaderAtomicFloatFeaturesEXT::default()
+            .shader_buffer_float32_atomic_add(true);
+        let mut info = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queues)
+            .enabled_extension_names(&extensions);
         if has_stats {
-            info = info
-                .enabled_extension_names(&extensions)
-                .push_next(&mut stats_feature);
+            info = info.push_next(&mut stats_feature);
+        }
+        if shadow_queue {
+            info = info.push_next(&mut float_feature);
         }
         // SAFETY: the create info outlives the call.
         let device = vk_call("vkCreateDevice", unsafe {
@@ -298,6 +332,7 @@ impl GpuContext {
             queue_family,
             allocator: Mutex::new(Some(allocator)),
             name,
+            shadow_queue,
             timestamp_period,
             storage_alignment: limits.min_storage_buffer_offset_alignment.max(4),
             pipeline_stats,

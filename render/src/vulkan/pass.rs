@@ -2,8 +2,123 @@
 //! constants, dispatched synchronously with the results made visible to the host.
 
 use super::buffer::Binding;
+use super::staging::barrier;
 use super::{GpuContext, GpuError, vk_call};
 use ash::vk;
+
+/// How many workgroups a recorded dispatch runs.
+#[derive(Clone, Copy, Debug)]
+pub enum Dispatch {
+    /// x × y × 1 groups.
+    Groups(u32, u32),
+    /// Read by the device from a buffer (three u32 at the offset).
+    Indirect(vk::Buffer, u64),
+}
+
+/// Records `record` `count` times back to back in one submission (each repetition after the
+/// previous one's shader and transfer writes), then waits; afterwards shader writes are
+/// visible to the host, later passes and copies. With `time`, the GPU time of each
+/// repetition from timestamp queries (empty when the queue cannot time). Benchmarks use
+/// repetitions: a GPU kept busy keeps its clocks up, while one dispatch per submission with
+/// host work in between lets the driver lower them (seen on the H100: 1980 → 405 MHz in the
+/// middle of a benchmark).
+pub fn run_batch(
+    ctx: &GpuContext,
+    count: u32,
+    time: bool,
+    record: impl Fn(vk::CommandBuffer),
+) -> Result<Vec<f64>, GpuError> {
+    let d = &ctx.device;
+    // SAFETY: the query pool is destroyed after the fence wait; commands are recorded into a
+    // buffer that is recording.
+    unsafe {
+        let queries = if time && ctx.timestamp_period > 0.0 {
+            let info = vk::QueryPoolCreateInfo::default()
+                .query_type(vk::QueryType::TIMESTAMP)
+                .query_count(2 * count);
+            Some(vk_call(
+                "vkCreateQueryPool",
+                d.create_query_pool(&info, None),
+            )?)
+        } else {
+            None
+        };
+        let result = ctx.submit_and_wait(|cmd| {
+            // Host writes before the submit are visible to the device (submission order).
+            if let Some(q) = queries {
+                d.cmd_reset_query_pool(cmd, q, 0, 2 * count);
+            }
+            for k in 0..count {
+                if k > 0 {
+                    // The previous repetition's writes come first (same buffers).
+                    barrier(
+                        ctx,
+                        cmd,
+                        vk::PipelineStageFlags::COMPUTE_SHADER
+                            | vk::PipelineStageFlags::TRANSFER
+                            | vk::PipelineStageFlags::DRAW_INDIRECT,
+                        vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
+                        vk::PipelineStageFlags::COMPUTE_SHADER
+                            | vk::PipelineStageFlags::TRANSFER
+                            | vk::PipelineStageFlags::DRAW_INDIRECT,
+                        vk::AccessFlags::SHADER_READ
+                            | vk::AccessFlags::SHADER_WRITE
+                            | vk::AccessFlags::TRANSFER_WRITE
+                            | vk::AccessFlags::INDIRECT_COMMAND_READ,
+                    );
+                }
+                // Start: once everything before has completed; end: once this has.
+                if let Some(q) = queries {
+                    d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, q, 2 * k);
+                }
+                record(cmd);
+                if let Some(q) = queries {
+                    d.cmd_write_timestamp(
+                        cmd,
+                        vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+                        q,
+                        2 * k + 1,
+                    );
+                }
+            }
+            // Results are visible to the host and to later passes and copies.
+            barrier(
+                ctx,
+                cmd,
+                vk::PipelineStageFlags::COMPUTE_SHADER,
+                vk::AccessFlags::SHADER_WRITE,
+                vk::PipelineStageFlags::HOST
+                    | vk::PipelineStageFlags::COMPUTE_SHADER
+                    | vk::PipelineStageFlags::TRANSFER,
+                vk::AccessFlags::HOST_READ
+                    | vk::AccessFlags::SHADER_READ
+                    | vk::AccessFlags::SHADER_WRITE
+                    | vk::AccessFlags::TRANSFER_READ
+                    | vk::AccessFlags::TRANSFER_WRITE,
+            );
+        });
+        let mut elapsed = Vec::new();
+        if let Some(q) = queries {
+            let mut ticks = vec![0u64; 2 * count as usize];
+            if result.is_ok()
+                && d.get_query_pool_results(
+                    q,
+                    0,
+                    &mut ticks,
+                    vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                )
+                .is_ok()
+            {
+                elapsed = ticks
+                    .chunks_exact(2)
+                    .map(|t| t[1].wrapping_sub(t[0]) as f64 * ctx.timestamp_period as f64 * 1e-9)
+                    .collect();
+            }
+            d.destroy_query_pool(q, None);
+        }
+        result.map(|_| elapsed)
+    }
+}
 
 /// A compute pipeline and what it needs to be bound.
 pub struct ComputePass {
@@ -152,10 +267,40 @@ impl ComputePass {
         groups: [u32; 2],
         time: bool,
     ) -> Result<Option<f64>, GpuError> {
+        self.run_repeated(ctx, buffers, push, groups, 1, time)
+            .map(|t| t.first().copied())
+    }
+
+    /// `count` identical dispatches back to back in one submission (each after the previous
+    /// one's writes), then waits; with `time`, the GPU time of each (empty when the queue
+    /// cannot time).
+    pub fn run_repeated(
+        &self,
+        ctx: &GpuContext,
+        buffers: &[Binding],
+        push: &[u8],
+        groups: [u32; 2],
+        count: u32,
+        time: bool,
+    ) -> Result<Vec<f64>, GpuError> {
+        let set = self.allocate_set(ctx, buffers)?;
+        let result = run_batch(ctx, count, time, |cmd| {
+            self.record(ctx, cmd, set, push, Dispatch::Groups(groups[0], groups[1]))
+        });
+        self.free_set(ctx, set);
+        result
+    }
+
+    /// A descriptor set binding `buffers` to bindings 0.. (one set per pass may be live).
+    pub fn allocate_set(
+        &self,
+        ctx: &GpuContext,
+        buffers: &[Binding],
+    ) -> Result<vk::DescriptorSet, GpuError> {
         assert_eq!(buffers.len() as u32, self.buffers, "one buffer per binding");
         let d = &ctx.device;
         let layouts = [self.set_layout];
-        // SAFETY: the set is written before use and freed after the fence wait.
+        // SAFETY: the pool and layout are alive; the writes' infos outlive the update.
         unsafe {
             let set = vk_call(
                 "vkAllocateDescriptorSets",
@@ -186,82 +331,44 @@ impl ComputePass {
                 })
                 .collect();
             d.update_descriptor_sets(&writes, &[]);
-            let timed = time && ctx.timestamp_period > 0.0;
-            let queries = if timed {
-                let info = vk::QueryPoolCreateInfo::default()
-                    .query_type(vk::QueryType::TIMESTAMP)
-                    .query_count(2);
-                Some(vk_call(
-                    "vkCreateQueryPool",
-                    d.create_query_pool(&info, None),
-                )?)
-            } else {
-                None
-            };
-            let result = ctx.submit_and_wait(|cmd| {
-                // Host writes before the submit are visible to the device (submission order).
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
-                d.cmd_bind_descriptor_sets(
-                    cmd,
-                    vk::PipelineBindPoint::COMPUTE,
-                    self.layout,
-                    0,
-                    &[set],
-                    &[],
-                );
-                if !push.is_empty() {
-                    d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
-                }
-                if let Some(q) = queries {
-                    d.cmd_reset_query_pool(cmd, q, 0, 2);
-                    d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::TOP_OF_PIPE, q, 0);
-                }
-                d.cmd_dispatch(cmd, groups[0], groups[1], 1);
-                if let Some(q) = queries {
-                    d.cmd_write_timestamp(cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, q, 1);
-                }
-                // Results are visible to the host and to later passes and copies.
-                let barrier = [vk::MemoryBarrier::default()
-                    .src_access_mask(vk::AccessFlags::SHADER_WRITE)
-                    .dst_access_mask(
-                        vk::AccessFlags::HOST_READ
-                            | vk::AccessFlags::SHADER_READ
-                            | vk::AccessFlags::SHADER_WRITE
-                            | vk::AccessFlags::TRANSFER_READ
-                            | vk::AccessFlags::TRANSFER_WRITE,
-                    )];
-                d.cmd_pipeline_barrier(
-                    cmd,
-                    vk::PipelineStageFlags::COMPUTE_SHADER,
-                    vk::PipelineStageFlags::HOST
-                        | vk::PipelineStageFlags::COMPUTE_SHADER
-                        | vk::PipelineStageFlags::TRANSFER,
-                    vk::DependencyFlags::empty(),
-                    &barrier,
-                    &[],
-                    &[],
-                );
-            });
-            let _ = d.free_descriptor_sets(self.pool, &[set]);
-            let mut elapsed = None;
-            if let Some(q) = queries {
-                let mut ticks = [0u64; 2];
-                if result.is_ok()
-                    && d.get_query_pool_results(
-                        q,
-                        0,
-                        &mut ticks,
-                        vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
-                    )
-                    .is_ok()
-                {
-                    elapsed = Some(
-                        ticks[1].wrapping_sub(ticks[0]) as f64 * ctx.timestamp_period as f64 * 1e-9,
-                    );
-                }
-                d.destroy_query_pool(q, None);
+            Ok(set)
+        }
+    }
+
+    /// Frees a set from [`ComputePass::allocate_set`] once no pending submission uses it.
+    pub fn free_set(&self, ctx: &GpuContext, set: vk::DescriptorSet) {
+        // SAFETY: the caller waited for every submission using the set.
+        let _ = unsafe { ctx.device.free_descriptor_sets(self.pool, &[set]) };
+    }
+
+    /// Records one dispatch with `set` bound.
+    pub fn record(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        set: vk::DescriptorSet,
+        push: &[u8],
+        dispatch: Dispatch,
+    ) {
+        let d = &ctx.device;
+        // SAFETY: the command buffer is recording; the set matches the layout.
+        unsafe {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::COMPUTE,
+                self.layout,
+                0,
+                &[set],
+                &[],
+            );
+            if !push.is_empty() {
+                d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
             }
-            result.map(|_| elapsed)
+            match dispatch {
+                Dispatch::Groups(x, y) => d.cmd_dispatch(cmd, x, y, 1),
+                Dispatch::Indirect(buffer, offset) => d.cmd_dispatch_indirect(cmd, buffer, offset),
+            }
         }
     }
 

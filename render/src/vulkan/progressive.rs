@@ -178,6 +178,42 @@ impl Progressive {
         Ok((gpu, restarted))
     }
 
+    /// Benchmarks: GPU times of `count` back-to-back dispatches of the same first batch of
+    /// `spp` (≤ [`SAMPLES_PER_DISPATCH`]) samples per pixel with `variant`, in one submission.
+    /// Leaves the accumulation restarted.
+    #[allow(clippy::too_many_arguments)]
+    pub fn time_repeated(
+        &mut self,
+        ctx: &GpuContext,
+        tracer: &mut PathTracer,
+        world: &GpuWorld,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        variant: Variant,
+        spp: u32,
+        count: u32,
+    ) -> Result<Vec<f64>, GpuError> {
+        let job = RenderJob {
+            width: self.internal.0,
+            height: self.internal.1,
+            spp: spp.clamp(1, SAMPLES_PER_DISPATCH),
+            seed: self.seed,
+        };
+        let p = TraceParams::new(view, params, &job).batch(job.spp, 0, false);
+        let times = tracer.dispatch_repeated(
+            ctx,
+            world,
+            variant,
+            &p,
+            &mut self.uniforms,
+            self.accum.binding(),
+            count,
+            true,
+        );
+        self.restart();
+        times
+    }
+
     /// The mean radiance so far, at the internal resolution.
     pub fn hdr(&self, ctx: &GpuContext) -> Result<Image, GpuError> {
         let raw = read_device(ctx, self.accum.binding())?;

@@ -1,21 +1,38 @@
 //! The path tracer on the GPU (`shaders/trace.comp`): the CPU reference integrator ported
 //! to a compute shader, one invocation per pixel, in pipeline variants specialised to what a
-//! scene needs ([`Variant`], built on first use and cached).
+//! scene needs ([`Variant`], built on first use and cached). With the sun, shadow rays are
+//! queued and traced by a second pass (`shaders/shadow.comp`, one invocation per ray) where
+//! the device can (float atomic adds, subgroup ballots).
 
 use super::buffer::{Binding, HostBuffer};
-use super::pass::ComputePass;
+use super::pass::{ComputePass, Dispatch, run_batch};
 use super::progressive::Progressive;
+use super::staging::barrier;
 use super::world::GpuWorld;
 use super::{GpuContext, GpuError};
 use crate::cpu::RenderJob;
 use crate::image::Image;
 use crate::params::{SceneParams, Sky};
+use ash::vk;
 use brickmap::{MaterialKind, MaterialTable, WorldView};
 use glam::DVec3;
 use gpu_allocator::MemoryLocation;
 use std::collections::HashMap;
 
 const SPIRV: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/trace.comp.spv"));
+const SHADOW_SPIRV: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/shadow.comp.spv"));
+
+/// Storage bindings of both passes: the world (0..4), parameters, accumulation, counters,
+/// shadow rays, queue header.
+const BINDINGS: u32 = 10;
+/// Bytes per queued shadow ray (`ShadowRay` in shaders/shadow_queue.glsl).
+const SHADOW_RAY_BYTES: u64 = 48;
+/// Queue capacity bounds, in rays: enough for one shadow ray per sample of a dispatch,
+/// within these; rays that do not fit are traced in place (correct, slower).
+const QUEUE_MIN: u64 = 1 << 16;
+const QUEUE_MAX: u64 = 1 << 21;
+/// The queue header before a trace dispatch: no groups, y = z = 1, no rays.
+const QUEUE_RESET: [u32; 4] = [0, 1, 1, 0];
 
 /// Samples per pixel one dispatch computes at most.
 pub const SAMPLES_PER_DISPATCH: u32 = 16;
@@ -117,7 +134,8 @@ impl TraceParams {
     }
 }
 
-/// What a pipeline variant contains (`constant_id` 0..7 of shaders/trace.comp).
+/// What a pipeline variant contains (`constant_id` 0..8 of shaders/trace.comp; 9, the shadow
+/// queue, is the tracer's choice).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Variant {
     /// Code for lambertian materials.
@@ -183,7 +201,7 @@ impl Variant {
         }
     }
 
-    fn constants(&self) -> [u32; 9] {
+    fn constants(&self, shadow_queue: bool) -> [u32; 10] {
         [
             self.lambertian as u32,
             self.metal as u32,
@@ -194,6 +212,7 @@ impl Variant {
             self.max_bounces,
             self.count_rays as u32,
             self.experiment,
+            shadow_queue as u32,
         ]
     }
 }
@@ -209,6 +228,8 @@ pub struct RayCounts {
     pub shadow: u64,
     /// Traversal steps of camera, continuation and shadow rays.
     pub steps: [u64; 3],
+    /// The most steps one camera or continuation ray took, and one shadow ray.
+    pub max_steps: [u64; 2],
 }
 
 impl RayCounts {
@@ -218,32 +239,116 @@ impl RayCounts {
     }
 }
 
+/// The shadow-ray queue: rays and the header (also the shadow pass's indirect dispatch).
+struct ShadowQueue {
+    rays: HostBuffer,
+    header: HostBuffer,
+    capacity: u64,
+}
+
 /// The path-tracing pipelines, one per variant in use.
 pub struct PathTracer {
-    passes: HashMap<Variant, ComputePass>,
+    passes: HashMap<(Variant, bool), ComputePass>,
+    /// The shadow pass, by ray counting and experiment.
+    shadow_passes: HashMap<(bool, u32), ComputePass>,
+    queue: Option<ShadowQueue>,
+    queue_limit: u64,
+    deferred_shadows: bool,
     counters: HostBuffer,
 }
 
 impl PathTracer {
-    /// Creates the tracer; pipelines are built when a variant is first used.
+    /// Creates the tracer; pipelines are built when a variant is first used. Shadow rays are
+    /// queued for a second pass when the device can ([`GpuContext::shadow_queue`]).
     pub fn new(ctx: &GpuContext) -> Result<Self, GpuError> {
         Ok(Self {
             passes: HashMap::new(),
+            shadow_passes: HashMap::new(),
+            queue: None,
+            queue_limit: QUEUE_MAX,
+            deferred_shadows: ctx.shadow_queue,
             counters: HostBuffer::new(ctx, "ray counters", 32, MemoryLocation::GpuToCpu)?,
         })
     }
 
-    /// Builds a variant's pipeline now (it is cached).
+    /// Whether shadow rays are queued for the shadow pass (else traced where they start).
+    pub fn deferred_shadows(&self) -> bool {
+        self.deferred_shadows
+    }
+
+    /// Queue shadow rays (where the device can) or trace them in place: the images are the
+    /// same up to float rounding; benchmarks compare the two.
+    pub fn set_deferred_shadows(&mut self, ctx: &GpuContext, on: bool) {
+        self.deferred_shadows = on && ctx.shadow_queue;
+    }
+
+    /// The most shadow rays one dispatch queues (at most the default, 2²¹ = 96 MiB of
+    /// queue); the rest are traced in place. Tests use small limits to exercise overflow.
+    pub fn set_queue_limit(&mut self, rays: u64) {
+        self.queue_limit = rays.clamp(1, QUEUE_MAX);
+    }
+
+    fn queued(&self, variant: Variant) -> bool {
+        self.deferred_shadows && variant.sun
+    }
+
+    /// Builds a variant's pipelines now (they are cached).
     pub fn prepare(&mut self, ctx: &GpuContext, variant: Variant) -> Result<(), GpuError> {
-        if let std::collections::hash_map::Entry::Vacant(slot) = self.passes.entry(variant) {
+        let queued = self.queued(variant);
+        if let std::collections::hash_map::Entry::Vacant(slot) =
+            self.passes.entry((variant, queued))
+        {
             slot.insert(ComputePass::specialized(
                 ctx,
                 SPIRV,
-                8,
+                BINDINGS,
                 0,
-                &variant.constants(),
+                &variant.constants(queued),
             )?);
         }
+        let key = (variant.count_rays, variant.experiment);
+        if queued && !self.shadow_passes.contains_key(&key) {
+            let pass = ComputePass::specialized(
+                ctx,
+                SHADOW_SPIRV,
+                BINDINGS,
+                0,
+                &[variant.count_rays as u32, variant.experiment],
+            )?;
+            self.shadow_passes.insert(key, pass);
+        }
+        Ok(())
+    }
+
+    /// A queue of `rays` capacity (within the bounds and the limit), replacing one of
+    /// another size.
+    fn ensure_queue(&mut self, ctx: &GpuContext, rays: u64) -> Result<(), GpuError> {
+        let capacity = rays.clamp(QUEUE_MIN, QUEUE_MAX).min(self.queue_limit);
+        if self.queue.as_ref().is_some_and(|q| q.capacity == capacity) {
+            return Ok(());
+        }
+        if let Some(old) = self.queue.take() {
+            old.rays.destroy(ctx);
+            old.header.destroy(ctx);
+        }
+        let rays = HostBuffer::new(
+            ctx,
+            "shadow rays",
+            capacity * SHADOW_RAY_BYTES,
+            MemoryLocation::GpuOnly,
+        )?;
+        let header = match HostBuffer::new(ctx, "shadow queue", 16, MemoryLocation::GpuOnly) {
+            Ok(h) => h,
+            Err(e) => {
+                rays.destroy(ctx);
+                return Err(e);
+            }
+        };
+        self.queue = Some(ShadowQueue {
+            rays,
+            header,
+            capacity,
+        });
         Ok(())
     }
 
@@ -254,7 +359,20 @@ impl PathTracer {
         variant: Variant,
     ) -> Result<Vec<(String, String)>, GpuError> {
         self.prepare(ctx, variant)?;
-        Ok(self.passes[&variant].statistics(ctx))
+        let mut stats = self.passes[&(variant, self.queued(variant))].statistics(ctx);
+        if let Some(shadow) = self
+            .shadow_passes
+            .get(&(variant.count_rays, variant.experiment))
+            .filter(|_| self.queued(variant))
+        {
+            stats.extend(
+                shadow
+                    .statistics(ctx)
+                    .into_iter()
+                    .map(|(k, v)| (format!("shadow pass {k}"), v)),
+            );
+        }
+        Ok(stats)
     }
 
     /// Variants built so far.
@@ -275,17 +393,100 @@ impl PathTracer {
         accum: Binding,
         time: bool,
     ) -> Result<Option<f64>, GpuError> {
+        self.dispatch_repeated(ctx, world, variant, p, uniforms, accum, 1, time)
+            .map(|t| t.first().copied())
+    }
+
+    /// [`PathTracer::dispatch`] `count` times back to back in one submission (benchmarks:
+    /// the GPU stays busy, so its clocks stay up); the GPU time of each when `time` is set.
+    #[allow(clippy::too_many_arguments)]
+    pub fn dispatch_repeated(
+        &mut self,
+        ctx: &GpuContext,
+        world: &GpuWorld,
+        variant: Variant,
+        p: &TraceParams,
+        uniforms: &mut HostBuffer,
+        accum: Binding,
+        count: u32,
+        time: bool,
+    ) -> Result<Vec<f64>, GpuError> {
         self.prepare(ctx, variant)?;
+        let queued = self.queued(variant);
+        if queued {
+            self.ensure_queue(
+                ctx,
+                p.image[0] as u64 * p.image[1] as u64 * p.image[2] as u64,
+            )?;
+        }
         uniforms.write(bytemuck::bytes_of(p));
         let mut bound = world.bindings();
         bound.extend([uniforms.binding(), accum, self.counters.binding()]);
-        self.passes[&variant].run_timed(
-            ctx,
-            &bound,
-            &[],
-            [p.image[0].div_ceil(8), p.image[1].div_ceil(8)],
-            time,
-        )
+        let queue = self.queue.as_ref().filter(|_| queued);
+        match queue {
+            Some(q) => bound.extend([q.rays.binding(), q.header.binding()]),
+            // Unused without the queue (SHADOW_QUEUE is false): any valid buffer.
+            None => bound.extend([self.counters.binding(), self.counters.binding()]),
+        }
+        let trace = &self.passes[&(variant, queued)];
+        let shadow = self
+            .shadow_passes
+            .get(&(variant.count_rays, variant.experiment))
+            .filter(|_| queued);
+        let trace_set = trace.allocate_set(ctx, &bound)?;
+        let shadow_set = match shadow.map(|s| s.allocate_set(ctx, &bound)).transpose() {
+            Ok(set) => set,
+            Err(e) => {
+                trace.free_set(ctx, trace_set);
+                return Err(e);
+            }
+        };
+        let groups = Dispatch::Groups(p.image[0].div_ceil(8), p.image[1].div_ceil(8));
+        let result = run_batch(ctx, count, time, |cmd| {
+            let q = queue.map(|q| q.header.binding());
+            if let Some(h) = q {
+                // SAFETY: recording; the header is a transfer destination of 16 bytes.
+                unsafe {
+                    ctx.device.cmd_update_buffer(
+                        cmd,
+                        h.buffer,
+                        h.offset,
+                        bytemuck::cast_slice(&QUEUE_RESET),
+                    );
+                    barrier(
+                        ctx,
+                        cmd,
+                        vk::PipelineStageFlags::TRANSFER,
+                        vk::AccessFlags::TRANSFER_WRITE,
+                        vk::PipelineStageFlags::COMPUTE_SHADER,
+                        vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
+                    );
+                }
+            }
+            trace.record(ctx, cmd, trace_set, &[], groups);
+            if let (Some(h), Some(shadow), Some(set)) = (q, shadow, shadow_set) {
+                // SAFETY: recording.
+                unsafe {
+                    barrier(
+                        ctx,
+                        cmd,
+                        vk::PipelineStageFlags::COMPUTE_SHADER,
+                        vk::AccessFlags::SHADER_WRITE,
+                        vk::PipelineStageFlags::COMPUTE_SHADER
+                            | vk::PipelineStageFlags::DRAW_INDIRECT,
+                        vk::AccessFlags::SHADER_READ
+                            | vk::AccessFlags::SHADER_WRITE
+                            | vk::AccessFlags::INDIRECT_COMMAND_READ,
+                    );
+                }
+                shadow.record(ctx, cmd, set, &[], Dispatch::Indirect(h.buffer, h.offset));
+            }
+        });
+        trace.free_set(ctx, trace_set);
+        if let (Some(s), Some(set)) = (shadow, shadow_set) {
+            s.free_set(ctx, set);
+        }
+        result
     }
 
     /// Renders `job.spp` samples per pixel with the scene's variant; returns the linear image
@@ -362,6 +563,7 @@ impl PathTracer {
             secondary: c[1] as u64,
             shadow: c[2] as u64,
             steps: [c[3] as u64, c[4] as u64, c[5] as u64],
+            max_steps: [c[6] as u64, c[7] as u64],
         };
         Ok((image, gpu, counts))
     }
@@ -370,6 +572,13 @@ impl PathTracer {
     pub fn destroy(self, ctx: &GpuContext) {
         for (_, pass) in self.passes {
             pass.destroy(ctx);
+        }
+        for (_, pass) in self.shadow_passes {
+            pass.destroy(ctx);
+        }
+        if let Some(q) = self.queue {
+            q.rays.destroy(ctx);
+            q.header.destroy(ctx);
         }
         self.counters.destroy(ctx);
     }

@@ -333,3 +333,92 @@ pub fn far_places() -> (World, Vec<SceneParams>) {
         .collect();
     (w, views)
 }
+
+/// Every material kind (lambertian floor, glass, water, rough and mirror metal, a lamp),
+/// the sun casting shadows and a gradient sky, seen obliquely; 4 bounces.
+pub fn showcase() -> (World, SceneParams) {
+    let w = World::new(
+        GridDims::new(6, 4, 6).unwrap(),
+        WorldConfig::with_workers(2),
+    )
+    .unwrap();
+    let floor = add_material(&w, MaterialKind::Lambertian, 0, [150, 140, 120]);
+    let glass = add_material(&w, MaterialKind::Dielectric, 0, [240, 250, 255]);
+    let water = add_material(&w, MaterialKind::Dielectric, 1, [200, 230, 255]);
+    let rough = add_material(&w, MaterialKind::Metal, 30, [230, 200, 120]);
+    let mirror = add_material(&w, MaterialKind::Metal, 0, [250, 250, 250]);
+    w.set_param(MaterialKind::Emissive, 2, 6.0).unwrap();
+    let lamp = add_material(&w, MaterialKind::Emissive, 2, [255, 220, 180]);
+    for (shape, m) in [
+        (
+            Shape::Box {
+                min: IVec3::ZERO,
+                max: IVec3::new(47, 2, 47),
+            },
+            floor,
+        ),
+        (
+            Shape::Box {
+                min: IVec3::new(0, 3, 28),
+                max: IVec3::new(47, 5, 47),
+            },
+            water,
+        ),
+        (
+            Shape::Box {
+                min: IVec3::new(8, 3, 8),
+                max: IVec3::new(15, 10, 15),
+            },
+            glass,
+        ),
+        (
+            Shape::Sphere {
+                centre: DVec3::new(30.0, 8.0, 14.0),
+                radius: 5.0,
+            },
+            rough,
+        ),
+        (
+            Shape::Box {
+                min: IVec3::new(40, 3, 4),
+                max: IVec3::new(41, 14, 20),
+            },
+            mirror,
+        ),
+    ] {
+        w.apply(EditOp::Shape {
+            shape,
+            mode: Mode::Add(m),
+        })
+        .unwrap();
+    }
+    w.apply(EditOp::Voxels(vec![VoxelEdit {
+        pos: IVec3::new(22, 12, 30),
+        op: VoxelOp::Set(lamp),
+    }]))
+    .unwrap();
+    let sun = Sun {
+        enabled: true,
+        position: DVec3::new(80.0, 90.0, 60.0),
+        radius: 8.0,
+        colour: [1.0, 0.9, 0.8],
+        intensity: 15.0,
+        animate: false,
+        speed_deg_per_s: 0.0,
+    };
+    let cam = Camera::looking_at(
+        DVec3::new(-8.0, 26.0, -8.0),
+        DVec3::new(24.0, 6.0, 24.0),
+        55.0,
+    );
+    let p = params(
+        cam,
+        Sky::Gradient {
+            horizon: [0.8, 0.85, 1.0],
+            zenith: [0.2, 0.35, 0.8],
+        },
+        Some(sun),
+        4,
+    );
+    (w, p)
+}
