@@ -3,6 +3,7 @@
 // render/src/vulkan/trace.rs (TraceParams).
 #version 450
 #extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_vote : require
 layout(local_size_x = 8, local_size_y = 8) in;
 
 // Pipeline variants (render/src/vulkan/trace.rs `Variant`): what the scene needs. Code for
@@ -20,7 +21,7 @@ layout(constant_id = 7) const bool COUNT_RAYS = false;
 // Benchmark experiments (bench-gpu --experiment), 0 in every real render: bit 0 ends paths
 // at the first hit (primary rays only), bit 1 decodes colours without pow, bit 2 counts
 // every shadow ray as unblocked without tracing it, bit 3 skips sun sampling (NEE), bit 4
-// makes shaders/shadow.comp skip its work.
+// makes shaders/shadow.comp skip its work, bit 6 starts a subgroup's next samples together.
 layout(constant_id = 8) const uint EXPERIMENT = 0u;
 // Shadow rays go to a queue that shaders/shadow.comp traces next, one per invocation, instead
 // of being traced here: in a warp only some lanes have a shadow ray at a vertex, and tracing
@@ -368,6 +369,8 @@ void main() {
     if (more) begin_path(px, index, next_sample++);
     bool path_alive = true; // false: the path ended (its shadow ray may still be pending)
     while (more) {
+      bool idle = !path_alive && !shadow_pending;
+      if (!idle) {
         bool shadow = shadow_pending;
         bool camera = path_camera && !shadow;
         uint kind = shadow ? 2u : (camera ? 0u : 1u);
@@ -408,7 +411,10 @@ void main() {
                 }
             }
         }
-        if (!path_alive && !shadow_pending) {
+      }
+        bool ended = !path_alive && !shadow_pending;
+        bool together = (EXPERIMENT & 64u) == 0u || subgroupAll(ended);
+        if (ended && together) {
             more = next_sample < p.image.z;
             if (more) {
                 begin_path(px, index, next_sample++);
