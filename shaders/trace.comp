@@ -369,49 +369,50 @@ void main() {
     if (more) begin_path(px, index, next_sample++);
     bool path_alive = true; // false: the path ended (its shadow ray may still be pending)
     while (more) {
-      bool idle = !path_alive && !shadow_pending;
-      if (!idle) {
-        bool shadow = shadow_pending;
-        bool camera = path_camera && !shadow;
-        uint kind = shadow ? 2u : (camera ? 0u : 1u);
-        if (COUNT_RAYS) g_rays[kind]++;
-        g_steps = 0u;
-        ivec3 voxel;
-        ivec3 normal;
-        float t;
-        bool hit = trace(path_o, shadow ? shadow_d : path_d, camera, path_start,
-                         shadow ? AIR : path_medium, shadow ? shadow_t : 1.0 / 0.0, voxel, normal, t);
-        if (COUNT_RAYS) {
-            g_rays[kind + 3u] += g_steps;
-            atomicMax(counters[shadow ? 7 : 6], g_steps);
-        }
-        if (shadow) {
-            if (!hit) pixel_sum += shadow_l;
-            shadow_pending = false;
-        } else {
-            path_alive = scatter(hit, voxel, normal, t);
-        }
-        if (SHADOW_QUEUE) {
-            // A shadow ray made by this vertex goes to the queue; the subgroup reserves its
-            // slots with one atomic.
-            bool want = shadow_pending;
-            uvec4 ballot = subgroupBallot(want);
-            uint n = subgroupBallotBitCount(ballot);
-            if (n > 0u) {
-                uint base = 0u;
-                if (subgroupElect()) {
-                    base = atomicAdd(queue_count, n);
-                    atomicMax(queue_groups, (min(base + n, shadow_rays.length()) + 63u) / 64u);
-                }
-                base = subgroupBroadcastFirst(base);
-                uint slot = base + subgroupBallotExclusiveBitCount(ballot);
-                if (want && push_shadow_ray(slot, path_o, path_start, shadow_d, shadow_t, shadow_l, index)) {
-                    shadow_pending = false;
-                    if (COUNT_RAYS) g_rays[2]++;
+        // Idle: this path ended and the subgroup has not (only with experiment bit 6).
+        bool idle = !path_alive && !shadow_pending;
+        if (!idle) {
+            bool shadow = shadow_pending;
+            bool camera = path_camera && !shadow;
+            uint kind = shadow ? 2u : (camera ? 0u : 1u);
+            if (COUNT_RAYS) g_rays[kind]++;
+            g_steps = 0u;
+            ivec3 voxel;
+            ivec3 normal;
+            float t;
+            bool hit = trace(path_o, shadow ? shadow_d : path_d, camera, path_start,
+                             shadow ? AIR : path_medium, shadow ? shadow_t : 1.0 / 0.0, voxel, normal, t);
+            if (COUNT_RAYS) {
+                g_rays[kind + 3u] += g_steps;
+                atomicMax(counters[shadow ? 7 : 6], g_steps);
+            }
+            if (shadow) {
+                if (!hit) pixel_sum += shadow_l;
+                shadow_pending = false;
+            } else {
+                path_alive = scatter(hit, voxel, normal, t);
+            }
+            if (SHADOW_QUEUE) {
+                // A shadow ray made by this vertex goes to the queue; the subgroup reserves its
+                // slots with one atomic.
+                bool want = shadow_pending;
+                uvec4 ballot = subgroupBallot(want);
+                uint n = subgroupBallotBitCount(ballot);
+                if (n > 0u) {
+                    uint base = 0u;
+                    if (subgroupElect()) {
+                        base = atomicAdd(queue_count, n);
+                        atomicMax(queue_groups, (min(base + n, shadow_rays.length()) + 63u) / 64u);
+                    }
+                    base = subgroupBroadcastFirst(base);
+                    uint slot = base + subgroupBallotExclusiveBitCount(ballot);
+                    if (want && push_shadow_ray(slot, path_o, path_start, shadow_d, shadow_t, shadow_l, index)) {
+                        shadow_pending = false;
+                        if (COUNT_RAYS) g_rays[2]++;
+                    }
                 }
             }
         }
-      }
         bool ended = !path_alive && !shadow_pending;
         bool together = (EXPERIMENT & 64u) == 0u || subgroupAll(ended);
         if (ended && together) {

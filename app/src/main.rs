@@ -681,12 +681,6 @@ fn bench_gpu(
         let mut params = scene.params.clone();
         params.settings.max_bounces = bounces;
         params.sun.enabled = sun;
-        let job = |seed: u64| render::cpu::RenderJob {
-            width,
-            height,
-            spp,
-            seed,
-        };
         // The scene's variant and the everything variant, alternated in rounds of
         // back-to-back dispatches (one submission each, so the GPU stays busy and its clocks
         // stay up) so both see the same machine state; the first two rounds of each are
@@ -724,7 +718,12 @@ fn bench_gpu(
             &world,
             &view,
             &params,
-            &job(0),
+            &render::cpu::RenderJob {
+                width,
+                height,
+                spp,
+                seed: 0,
+            },
             scene_variant,
         ) {
             Ok((_, _, rays)) => rays,

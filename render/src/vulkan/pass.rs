@@ -253,22 +253,8 @@ impl ComputePass {
         push: &[u8],
         groups: [u32; 2],
     ) -> Result<(), GpuError> {
-        self.run_timed(ctx, buffers, push, groups, false)
+        self.run_repeated(ctx, buffers, push, groups, 1, false)
             .map(|_| ())
-    }
-
-    /// [`ComputePass::run`], also measuring the dispatch's GPU time with timestamp queries
-    /// when `time` is set (None when the queue cannot time).
-    pub fn run_timed(
-        &self,
-        ctx: &GpuContext,
-        buffers: &[Binding],
-        push: &[u8],
-        groups: [u32; 2],
-        time: bool,
-    ) -> Result<Option<f64>, GpuError> {
-        self.run_repeated(ctx, buffers, push, groups, 1, time)
-            .map(|t| t.first().copied())
     }
 
     /// `count` identical dispatches back to back in one submission (each after the previous

@@ -120,6 +120,16 @@ impl Progressive {
         })
     }
 
+    /// `spp` samples per pixel at the internal resolution with this accumulation's seed.
+    fn job(&self, spp: u32) -> RenderJob {
+        RenderJob {
+            width: self.internal.0,
+            height: self.internal.1,
+            spp,
+            seed: self.seed,
+        }
+    }
+
     /// Adds `spp` samples per pixel with `variant`, restarting first if the image key
     /// changed; returns the GPU time of the dispatches and whether it started over.
     #[allow(clippy::too_many_arguments)]
@@ -133,13 +143,7 @@ impl Progressive {
         variant: Variant,
         spp: u32,
     ) -> Result<(Option<f64>, bool), GpuError> {
-        let job = RenderJob {
-            width: self.internal.0,
-            height: self.internal.1,
-            spp,
-            seed: self.seed,
-        };
-        let base = TraceParams::new(view, params, &job);
+        let base = TraceParams::new(view, params, &self.job(spp));
         let mut hasher = DefaultHasher::new();
         base.image_key().hash(&mut hasher);
         variant.hash(&mut hasher);
@@ -193,13 +197,8 @@ impl Progressive {
         spp: u32,
         count: u32,
     ) -> Result<Vec<f64>, GpuError> {
-        let job = RenderJob {
-            width: self.internal.0,
-            height: self.internal.1,
-            spp: spp.clamp(1, SAMPLES_PER_DISPATCH),
-            seed: self.seed,
-        };
-        let p = TraceParams::new(view, params, &job).batch(job.spp, 0, false);
+        let spp = spp.clamp(1, SAMPLES_PER_DISPATCH);
+        let p = TraceParams::new(view, params, &self.job(spp)).batch(spp, 0, false);
         let times = tracer.dispatch_repeated(
             ctx,
             world,

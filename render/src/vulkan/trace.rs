@@ -324,11 +324,16 @@ impl PathTracer {
         Ok(())
     }
 
-    /// A queue of `rays` capacity (within the bounds and the limit), replacing one of
-    /// another size.
+    /// A queue of at least `rays` capacity (within the bounds and the limit): kept while it
+    /// is large enough (a smaller batch does not reallocate it), replaced when too small or
+    /// above a lowered limit.
     fn ensure_queue(&mut self, ctx: &GpuContext, rays: u64) -> Result<(), GpuError> {
         let capacity = rays.clamp(QUEUE_MIN, QUEUE_MAX).min(self.queue_limit);
-        if self.queue.as_ref().is_some_and(|q| q.capacity == capacity) {
+        if self
+            .queue
+            .as_ref()
+            .is_some_and(|q| q.capacity >= capacity && q.capacity <= self.queue_limit)
+        {
             return Ok(());
         }
         if let Some(old) = self.queue.take() {
