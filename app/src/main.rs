@@ -120,6 +120,10 @@ enum Command {
         /// ceil(W·F)×ceil(H·F) and upscaled bilinearly.
         #[arg(long, default_value_t = 1.0)]
         scale: f64,
+        /// GPU: samples per pixel in one dispatch, 1..=16 (default: chosen from the image
+        /// size).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16))]
+        samples_per_dispatch: Option<u32>,
     },
     /// Replay an edit script headlessly, reporting each step; exits non-zero at the first
     /// failed step.
@@ -353,6 +357,7 @@ fn run(cli: Cli) -> Result<()> {
             device,
             seed,
             scale,
+            samples_per_dispatch,
         } => render_command(RenderArgs {
             scene,
             out,
@@ -365,6 +370,7 @@ fn run(cli: Cli) -> Result<()> {
             device,
             seed,
             scale,
+            samples_per_dispatch,
             workers,
         }),
         Command::Replay {
@@ -399,7 +405,7 @@ fn run(cli: Cli) -> Result<()> {
                     spp: 16,
                     seed: 1,
                 };
-                let (image, _, _) = render_on(&device, &view, &doc.scene.params, &job)?;
+                let (image, _, _) = render_on(&device, &view, &doc.scene.params, &job, None)?;
                 app::atomic::write_atomic(path, |w| {
                     image.write_png(w, doc.scene.params.settings.exposure)
                 })?;
@@ -556,6 +562,7 @@ struct RenderArgs {
     device: String,
     seed: u64,
     scale: f64,
+    samples_per_dispatch: Option<u32>,
     workers: usize,
 }
 
@@ -596,7 +603,8 @@ fn render_command(a: RenderArgs) -> Result<()> {
         spp: a.spp,
         seed: a.seed,
     };
-    let (image, backend, timing) = render_on(&a.device, &view, &params, &job)?;
+    let (image, backend, timing) =
+        render_on(&a.device, &view, &params, &job, a.samples_per_dispatch)?;
     let image = if internal == (a.width, a.height) {
         image
     } else {
@@ -785,6 +793,7 @@ fn render_on(
     view: &brickmap::WorldView<'_>,
     params: &render::SceneParams,
     job: &render::cpu::RenderJob,
+    samples_per_dispatch: Option<u32>,
 ) -> Result<(render::Image, String, String)> {
     let started = Instant::now();
     Ok(if device == "cpu" {
@@ -824,6 +833,7 @@ fn render_on(
         )?;
         let world = GpuWorld::upload(&ctx, view)?;
         let mut tracer = PathTracer::new(&ctx)?;
+        tracer.set_samples_per_dispatch(samples_per_dispatch);
         let rendered = with_progress(
             format!(
                 "rendering {}x{} at {} spp on {}",

@@ -724,9 +724,11 @@ mod progressive {
             assert!(!r.restarted);
             assert_eq!(r.samples, 4 * k);
         }
-        // 4 frames of 4 samples are the 16-sample render with the same seed.
+        // 4 frames of 4 samples are the 16-sample render with the same seed, here in dispatches
+        // of 3, 3, 3, 3, 3 and 1 samples (one submission).
         let accumulated = acc.hdr(&ctx).unwrap();
         let mut one = PathTracer::new(&ctx).unwrap();
+        one.set_samples_per_dispatch(Some(3));
         let (direct, _) = one
             .render(
                 &ctx,

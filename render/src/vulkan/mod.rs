@@ -93,8 +93,8 @@ pub struct GpuContext {
     pub storage_alignment: u64,
     /// VK_KHR_pipeline_executable_properties, when the driver has it.
     pub pipeline_stats: Option<ash::khr::pipeline_executable_properties::Device>,
-    /// Float atomic adds on storage buffers (VK_EXT_shader_atomic_float) and subgroup ballots
-    /// in compute shaders: what the path tracer's shadow-ray queue needs.
+    /// Float atomic adds on storage buffers (VK_EXT_shader_atomic_float): what the path
+    /// tracer's shadow-ray queue needs besides the subgroup operations every chosen device has.
     pub shadow_queue: bool,
 }
 
@@ -259,14 +259,21 @@ impl GpuContext {
             let mut props = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
             instance.get_physical_device_properties2(physical, &mut props);
         }
+        // The path tracer's subgroup operations (every desktop driver and lavapipe have them).
+        let needed = vk::SubgroupFeatureFlags::BASIC
+            | vk::SubgroupFeatureFlags::VOTE
+            | vk::SubgroupFeatureFlags::BALLOT;
+        if !subgroup
+            .supported_stages
+            .contains(vk::ShaderStageFlags::COMPUTE)
+            || !subgroup.supported_operations.contains(needed)
+        {
+            return Err(GpuError::NoDevice(format!(
+                "{name} (it lacks subgroup basic, vote or ballot operations in compute shaders, which the path tracer needs)"
+            )));
+        }
         let shadow_queue = has(ash::ext::shader_atomic_float::NAME)
-            && atomic_float.shader_buffer_float32_atomic_add == vk::TRUE
-            && subgroup
-                .supported_stages
-                .contains(vk::ShaderStageFlags::COMPUTE)
-            && subgroup
-                .supported_operations
-                .contains(vk::SubgroupFeatureFlags::BASIC | vk::SubgroupFeatureFlags::BALLOT);
+            && atomic_float.shader_buffer_float32_atomic_add == vk::TRUE;
         let mut extensions = Vec::new();
         if has_stats {
             extensions.push(ash::khr::pipeline_executable_properties::NAME.as_ptr());

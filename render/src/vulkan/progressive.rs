@@ -6,7 +6,7 @@
 
 use super::buffer::{HostBuffer, read_device};
 use super::tonemap::ToneMapper;
-use super::trace::{PathTracer, SAMPLES_PER_DISPATCH, TraceParams, Variant};
+use super::trace::{MAX_SAMPLES_PER_DISPATCH, PathTracer, TraceParams, Variant};
 use super::world::GpuWorld;
 use super::{GpuContext, GpuError};
 use crate::cpu::RenderJob;
@@ -156,7 +156,8 @@ impl Progressive {
         let mut gpu = Some(0.0);
         let mut done = 0;
         while done < spp {
-            let batch = (spp - done).min(SAMPLES_PER_DISPATCH);
+            let pixels = self.internal.0 as u64 * self.internal.1 as u64;
+            let batch = (spp - done).min(tracer.samples_per_dispatch(pixels));
             let p = base.batch(batch, self.samples, self.samples > 0);
             let t = tracer.dispatch(
                 ctx,
@@ -183,7 +184,8 @@ impl Progressive {
     }
 
     /// Benchmarks: GPU times of `count` back-to-back dispatches of the same first batch of
-    /// `spp` (≤ [`SAMPLES_PER_DISPATCH`]) samples per pixel with `variant`, in one submission.
+    /// `spp` (≤ [`MAX_SAMPLES_PER_DISPATCH`]) samples per pixel with `variant`, in one
+    /// submission.
     /// Leaves the accumulation restarted.
     #[allow(clippy::too_many_arguments)]
     pub fn time_repeated(
@@ -197,7 +199,7 @@ impl Progressive {
         spp: u32,
         count: u32,
     ) -> Result<Vec<f64>, GpuError> {
-        let spp = spp.clamp(1, SAMPLES_PER_DISPATCH);
+        let spp = spp.clamp(1, MAX_SAMPLES_PER_DISPATCH);
         let p = TraceParams::new(view, params, &self.job(spp)).batch(spp, 0, false);
         let times = tracer.dispatch_repeated(
             ctx,

@@ -34,12 +34,19 @@ const QUEUE_MAX: u64 = 1 << 21;
 /// The queue header before a trace dispatch: no groups, y = z = 1, no rays.
 const QUEUE_RESET: [u32; 4] = [0, 1, 1, 0];
 
-/// Samples per pixel one dispatch computes at most. Few: an invocation starts its next sample
-/// as soon as a path ends, so over many samples the lanes of a warp drift apart and trace
-/// unrelated rays (incoherent memory access), and more samples per dispatch overflow the
-/// shadow queue. Measured on the H100 (thesis scene, 1024 × 576 × 64 spp): 16 per dispatch
-/// 76 ms, 4 per dispatch 50 ms (the seed's one-sample-at-a-time loop: 66 ms).
-pub const SAMPLES_PER_DISPATCH: u32 = 4;
+/// Samples per pixel one dispatch computes by default: few, since an invocation starts its
+/// next sample as soon as a path ends, so over many samples the lanes of a warp drift apart
+/// and trace unrelated rays (incoherent memory access); but each dispatch ends in a tail
+/// where the GPU drains. Measured on the H100 (thesis scene, 64 spp, `render`): at
+/// 1024 × 576, 2 / 4 / 6 / 8 / 16 per dispatch took 53.6 / 50.7 / 49.4 / 48.7 / 76 ms; at
+/// 512 × 288, 1 / 2 / 4 / 8 took 30.1 / 28.0 / 28.3 / 29.5 ms. So 8 from
+/// [`LARGE_IMAGE`] pixels on, else 4.
+pub const SAMPLES_PER_DISPATCH: [u32; 2] = [4, 8];
+/// Pixels from which an image takes the larger number of samples per dispatch.
+pub const LARGE_IMAGE: u64 = 1024 * 576 / 2;
+/// The most samples per pixel one dispatch may take (long-running invocations lose samples on
+/// lavapipe; see [`PathTracer::render`]).
+pub const MAX_SAMPLES_PER_DISPATCH: u32 = 16;
 
 /// Keep in sync with `Params` in shaders/trace.comp (std430: eleven vec4, three uvec4).
 #[repr(C)]
@@ -258,6 +265,7 @@ pub struct PathTracer {
     queue: Option<ShadowQueue>,
     queue_limit: u64,
     deferred_shadows: bool,
+    samples_per_dispatch: Option<u32>,
     counters: HostBuffer,
 }
 
@@ -271,6 +279,7 @@ impl PathTracer {
             queue: None,
             queue_limit: QUEUE_MAX,
             deferred_shadows: ctx.shadow_queue,
+            samples_per_dispatch: None,
             counters: HostBuffer::new(ctx, "ray counters", 32, MemoryLocation::GpuToCpu)?,
         })
     }
@@ -290,6 +299,18 @@ impl PathTracer {
     /// queue); the rest are traced in place. Tests use small limits to exercise overflow.
     pub fn set_queue_limit(&mut self, rays: u64) {
         self.queue_limit = rays.clamp(1, QUEUE_MAX);
+    }
+
+    /// Samples per pixel in one dispatch: `Some(n)` fixes it (1..=16), `None` chooses from
+    /// the image size ([`SAMPLES_PER_DISPATCH`]).
+    pub fn set_samples_per_dispatch(&mut self, samples: Option<u32>) {
+        self.samples_per_dispatch = samples.map(|n| n.clamp(1, MAX_SAMPLES_PER_DISPATCH));
+    }
+
+    /// Samples per pixel one dispatch of an image of `pixels` takes.
+    pub fn samples_per_dispatch(&self, pixels: u64) -> u32 {
+        self.samples_per_dispatch
+            .unwrap_or(SAMPLES_PER_DISPATCH[usize::from(pixels >= LARGE_IMAGE)])
     }
 
     fn queued(&self, variant: Variant) -> bool {
@@ -500,10 +521,11 @@ impl PathTracer {
 
     /// Renders `job.spp` samples per pixel with the scene's variant; returns the linear image
     /// and the GPU time spent (timestamp queries summed over the dispatches; None when the
-    /// queue cannot time). Samples accumulate on the GPU in batches of at most
-    /// [`SAMPLES_PER_DISPATCH`] per dispatch: long-running invocations lose samples on
-    /// lavapipe (measured: 256 samples per invocation came out 9% dark there, exact on the
-    /// H100), and short dispatches are what a viewport does anyway.
+    /// queue cannot time). Samples accumulate on the GPU in batches of
+    /// [`PathTracer::samples_per_dispatch`], at most [`MAX_SAMPLES_PER_DISPATCH`]:
+    /// long-running invocations lose samples on lavapipe (measured: 256 samples per invocation
+    /// came out 9% dark there, exact on the H100), and short dispatches are what a viewport
+    /// does anyway.
     pub fn render(
         &mut self,
         ctx: &GpuContext,
