@@ -155,9 +155,10 @@ impl Progressive {
         let restarted = self.samples == 0;
         let mut gpu = Some(0.0);
         let mut done = 0;
+        let per_dispatch =
+            tracer.samples_per_dispatch(self.internal.0 as u64 * self.internal.1 as u64);
         while done < spp {
-            let pixels = self.internal.0 as u64 * self.internal.1 as u64;
-            let batch = (spp - done).min(tracer.samples_per_dispatch(pixels));
+            let batch = (spp - done).min(per_dispatch);
             let p = base.batch(batch, self.samples, self.samples > 0);
             let t = tracer.dispatch(
                 ctx,
