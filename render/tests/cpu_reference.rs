@@ -4,7 +4,7 @@
 //! mean's standard error is estimated from the spread of pixel means (s / √pixels), and a
 //! check passes within 4 standard errors (a false failure about once in 16,000 runs).
 
-use brickmap::{EditOp, MaterialKind, Mode, Shape, World};
+use brickmap::{EditOp, MaterialKind, Mode, Shape};
 use glam::{DVec3, IVec3};
 mod common;
 
@@ -12,18 +12,9 @@ use common::{
     SKY, add_material, assert_finite_and_nonnegative, block_scene, mean_and_error, params,
     sun_floor, world,
 };
-use render::cpu::{CpuScene, RenderJob};
-use render::{Camera, Image, SceneParams, Sky};
+use render::{Camera, Sky};
 
-fn render(w: &World, p: &SceneParams, size: u32, spp: u32, seed: u64) -> Image {
-    let view = w.read();
-    CpuScene::new(&view, p).render(&RenderJob {
-        width: size,
-        height: size,
-        spp,
-        seed,
-    })
-}
+use common::cpu_render as render;
 
 fn looking_at(eye: DVec3, target: DVec3, fov: f64) -> Camera {
     Camera::looking_at(eye, target, fov)

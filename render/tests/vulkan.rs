@@ -257,7 +257,7 @@ mod trace {
     use brickmap::{MaterialKind, World};
     use common::sun_floor;
     use render::SceneParams;
-    use render::cpu::{CpuScene, RenderJob};
+    use render::cpu::RenderJob;
     use render::vulkan::trace::PathTracer;
     use render::vulkan::world::GpuWorld;
 
@@ -292,15 +292,7 @@ mod trace {
         image
     }
 
-    fn cpu_render(w: &World, p: &SceneParams, size: u32, spp: u32, seed: u64) -> Image {
-        let view = w.read();
-        CpuScene::new(&view, p).render(&RenderJob {
-            width: size,
-            height: size,
-            spp,
-            seed,
-        })
-    }
+    use super::common::cpu_render;
 
     #[test]
     fn gpu_white_furnace_is_exact() {

@@ -422,3 +422,14 @@ pub fn showcase() -> (World, SceneParams) {
     );
     (w, p)
 }
+
+/// A square CPU reference render.
+pub fn cpu_render(w: &World, p: &SceneParams, size: u32, spp: u32, seed: u64) -> Image {
+    let view = w.read();
+    render::cpu::CpuScene::new(&view, p).render(&render::cpu::RenderJob {
+        width: size,
+        height: size,
+        spp,
+        seed,
+    })
+}
