@@ -141,11 +141,9 @@ fn synchronization_validation_reports_a_missing_barrier() {
 #[test]
 fn gpu_traversal_matches_the_cpu_ray_cast() {
     use brickmap::{
-        EditOp, GridDims, Mode, Ray, Shape, VoxelEdit, VoxelOp, World, WorldConfig, terrain,
+        EditOp, GridDims, Mode, Shape, VoxelEdit, VoxelOp, World, WorldConfig, terrain,
     };
     use glam::{DVec3, IVec3, Vec3};
-    use render::vulkan::primary::PrimaryTracer;
-    use render::vulkan::world::GpuWorld;
     let Some(ctx) = context(DeviceChoice::Best) else {
         return;
     };
@@ -170,13 +168,8 @@ fn gpu_traversal_matches_the_cpu_ray_cast() {
             mode: Mode::Add(1),
         })
         .unwrap();
-    let mut s = 7u64;
-    let mut next = || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = XorShift(7);
+    let mut next = || rng.next();
     let scattered: Vec<VoxelEdit> = (0..300)
         .map(|_| VoxelEdit {
             pos: IVec3::new(
@@ -213,16 +206,78 @@ fn gpu_traversal_matches_the_cpu_ray_cast() {
             rays.push((if k % 4 == 0 { o.floor() } else { o }, d));
         }
     }
-    let gpu_world = GpuWorld::upload(&ctx, &view).unwrap();
-    let tracer = PrimaryTracer::new(&ctx).unwrap();
-    let gpu = tracer.trace(&ctx, &gpu_world, &rays).unwrap();
+    let (agree, hits) = gpu_and_cpu_first_hits(&ctx, &view, &rays, None);
+    let n = rays.len();
+    // f32 on the GPU may resolve a few exact edge/corner ties differently from the f64 CPU cast.
+    eprintln!("GPU and CPU agree on {agree} of {n} rays ({hits} hits)");
+    assert!(
+        agree as f64 >= 0.999 * n as f64,
+        "GPU and CPU agree on {agree} of {n} rays"
+    );
+    assert!(hits > n / 4, "the scene is hit: {hits} of {n}");
+    assert_eq!(ctx.validation_errors(), 0, "validation errors");
+}
+
+/// Xorshift64: uniform numbers in [0, 1) for test rays.
+struct XorShift(u64);
+
+impl XorShift {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// Occupancy seen from inside a dielectric medium: every voxel that is not the medium.
+struct NotMedium<'a, 'w> {
+    view: &'a brickmap::WorldView<'w>,
+    medium: u8,
+}
+
+impl brickmap::Occupancy for NotMedium<'_, '_> {
+    fn dims(&self) -> brickmap::GridDims {
+        self.view.dims()
+    }
+    fn coarse_occupied(&self, _: glam::UVec3) -> bool {
+        true
+    }
+    fn brick_occupied(&self, _: glam::UVec3) -> bool {
+        true
+    }
+    fn solid(&self, v: glam::IVec3) -> bool {
+        self.view.voxel(v).unwrap() != Some(self.medium)
+    }
+}
+
+/// Traces `rays` on the GPU (shaders/primary.comp) and with the f64 CPU ray cast (in air, or
+/// voxel by voxel inside `medium`); returns how many agree (same voxel and t, or both miss)
+/// and how many of those are hits.
+fn gpu_and_cpu_first_hits(
+    ctx: &GpuContext,
+    view: &brickmap::WorldView,
+    rays: &[(glam::Vec3, glam::Vec3)],
+    medium: Option<u8>,
+) -> (usize, usize) {
+    use render::vulkan::primary::PrimaryTracer;
+    use render::vulkan::world::GpuWorld;
+    let gpu_world = GpuWorld::upload(ctx, view).unwrap();
+    let tracer = PrimaryTracer::new(ctx).unwrap();
+    let gpu = tracer.trace(ctx, &gpu_world, rays, medium).unwrap();
+    tracer.destroy(ctx);
+    gpu_world.destroy(ctx);
     let (mut agree, mut hits) = (0, 0);
     for ((o, d), g) in rays.iter().zip(&gpu) {
-        let ray = Ray {
+        let ray = brickmap::Ray {
             origin: o.as_dvec3(),
             dir: d.as_dvec3(),
         };
-        let cpu = brickmap::cast(&view, &ray, f64::INFINITY).unwrap();
+        let cpu = match medium {
+            None => brickmap::cast(view, &ray, f64::INFINITY),
+            Some(medium) => brickmap::cast(&NotMedium { view, medium }, &ray, f64::INFINITY),
+        }
+        .unwrap();
         match (cpu, g) {
             (None, None) => agree += 1,
             (Some(c), Some(g)) if c.voxel == g.voxel => {
@@ -238,16 +293,115 @@ fn gpu_traversal_matches_the_cpu_ray_cast() {
             _ => {}
         }
     }
+    (agree, hits)
+}
+
+#[test]
+fn gpu_traversal_inside_a_medium_matches_the_cpu_ray_cast() {
+    // Water filling whole bricks (which the GPU skips whole) and parts of bricks at its edges,
+    // with stone spheres, scattered stones and air bubbles inside it.
+    use brickmap::{
+        EditOp, GridDims, Material, MaterialKind, Mode, Shape, VoxelEdit, VoxelOp, World,
+        WorldConfig,
+    };
+    use glam::{DVec3, IVec3, Vec3};
+    let Some(ctx) = context(DeviceChoice::Best) else {
+        return;
+    };
+    let world = World::new(
+        GridDims::new(8, 4, 8).unwrap(),
+        WorldConfig::with_workers(2),
+    )
+    .unwrap();
+    world.push_material(Material::lambertian(1)).unwrap();
+    let water = world
+        .push_material(Material {
+            kind: MaterialKind::Dielectric,
+            param: 1,
+            colour: 2,
+        })
+        .unwrap();
+    let box_of = |min: IVec3, max: IVec3, mode| EditOp::Shape {
+        shape: Shape::Box { min, max },
+        mode,
+    };
+    world
+        .apply(box_of(
+            IVec3::new(3, 2, 5),
+            IVec3::new(60, 28, 57),
+            Mode::Add(water),
+        ))
+        .unwrap();
+    world
+        .apply(EditOp::Shape {
+            shape: Shape::Sphere {
+                centre: DVec3::new(40.0, 12.0, 20.0),
+                radius: 5.0,
+            },
+            mode: Mode::Add(0),
+        })
+        .unwrap();
+    let mut rng = XorShift(11);
+    let point = |rng: &mut XorShift| {
+        IVec3::new(
+            4 + (rng.next() * 56.0) as i32,
+            3 + (rng.next() * 25.0) as i32,
+            6 + (rng.next() * 51.0) as i32,
+        )
+    };
+    let edits: Vec<VoxelEdit> = (0..120)
+        .map(|k| VoxelEdit {
+            pos: point(&mut rng),
+            op: if k % 2 == 0 {
+                VoxelOp::Set(0)
+            } else {
+                VoxelOp::Clear
+            },
+        })
+        .collect();
+    world.apply(EditOp::Voxels(edits)).unwrap();
+    let view = world.read();
+    let full = (0..8 * 4 * 8)
+        .filter(|i| {
+            let b = IVec3::new(i % 8, i / 8 % 4, i / 32);
+            (0..512).all(|v| {
+                view.voxel(b * 8 + IVec3::new(v % 8, v / 8 % 8, v / 64))
+                    .unwrap()
+                    == Some(water)
+            })
+        })
+        .count();
+    assert!(full >= 20, "bricks full of water: {full}");
+    // Rays from points in the water: random directions, and along axes and diagonals.
+    let mut rays = Vec::new();
+    for k in 0..8_000 {
+        let o = point(&mut rng).as_vec3()
+            + Vec3::new(rng.next() as f32, rng.next() as f32, rng.next() as f32);
+        let d = if k % 4 == 0 {
+            Vec3::new(
+                [1.0, -1.0, 0.0][k / 4 % 3],
+                [0.0, -1.0, 1.0][k / 7 % 3],
+                [1.0, 0.0, -1.0][k / 11 % 3],
+            )
+        } else {
+            Vec3::new(rng.next() as f32, rng.next() as f32, rng.next() as f32) * 2.0 - 1.0
+        };
+        if d != Vec3::ZERO && view.voxel(o.floor().as_ivec3()).unwrap() == Some(water) {
+            rays.push((if k % 4 == 0 { o.floor() + 0.5 } else { o }, d));
+        }
+    }
+    let (agree, hits) = gpu_and_cpu_first_hits(&ctx, &view, &rays, Some(water));
     let n = rays.len();
-    // f32 on the GPU may resolve a few exact edge/corner ties differently from the f64 CPU cast.
-    eprintln!("GPU and CPU agree on {agree} of {n} rays ({hits} hits)");
+    eprintln!("inside water: GPU and CPU agree on {agree} of {n} rays ({hits} hits)");
+    assert!(n > 5_000, "rays from inside the water: {n}");
     assert!(
         agree as f64 >= 0.999 * n as f64,
         "GPU and CPU agree on {agree} of {n} rays"
     );
-    assert!(hits > n / 4, "the scene is hit: {hits} of {n}");
-    tracer.destroy(&ctx);
-    gpu_world.destroy(&ctx);
+    assert!(
+        hits == agree,
+        "every ray in the water ends at the water's edge: {hits} of {agree}"
+    );
     assert_eq!(ctx.validation_errors(), 0, "validation errors");
 }
 
@@ -382,7 +536,7 @@ mod trace {
                 .unwrap()
                 .map(|(hit, _)| hit)
                 .expect("the camera looks at geometry");
-            let gpu = primary.trace(&ctx, &world, &[(o, d)]).unwrap()[0]
+            let gpu = primary.trace(&ctx, &world, &[(o, d)], None).unwrap()[0]
                 .expect("the GPU finds the geometry too");
             let apart = (gpu.voxel - cpu.voxel).abs().max_element();
             assert!(

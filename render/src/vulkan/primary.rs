@@ -12,7 +12,7 @@ use gpu_allocator::MemoryLocation;
 const SPIRV: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/primary.comp.spv"));
 const GROUP: u32 = 64;
 
-/// Push constants. Keep in sync with `Push` in shaders/primary.comp (std430: uvec3 then two
+/// Push constants. Keep in sync with `Push` in shaders/primary.comp (std430: uvec3 then three
 /// uints).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -20,8 +20,10 @@ struct Push {
     dims: [u32; 3],
     count: u32,
     words_per_column: u32,
+    /// The medium the rays travel in: material + 1, 0 for air.
+    medium: u32,
 }
-const _: () = assert!(std::mem::size_of::<Push>() == 20);
+const _: () = assert!(std::mem::size_of::<Push>() == 24);
 
 /// The first hit of a ray on the GPU.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,12 +48,14 @@ impl PrimaryTracer {
         )?))
     }
 
-    /// The first solid voxel along each ray (origin, direction), or None.
+    /// The first interaction along each ray (origin, direction), or None: in air (`medium`
+    /// None) the first solid voxel, inside a dielectric material the first voxel that is not it.
     pub fn trace(
         &self,
         ctx: &GpuContext,
         world: &GpuWorld,
         rays: &[(Vec3, Vec3)],
+        medium: Option<u8>,
     ) -> Result<Vec<Option<GpuHit>>, GpuError> {
         let packed: Vec<[f32; 4]> = rays
             .iter()
@@ -80,6 +84,7 @@ impl PrimaryTracer {
             dims: world.dims(),
             count: rays.len() as u32,
             words_per_column: world.words_per_column(),
+            medium: medium.map_or(0, |m| u32::from(m) + 1),
         };
         let mut bound = world.bindings();
         bound.extend([input.binding(), output.binding()]);

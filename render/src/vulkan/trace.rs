@@ -40,7 +40,8 @@ const QUEUE_RESET: [u32; 4] = [0, 1, 1, 0];
 /// where the GPU drains. Measured on the H100 (thesis scene, 64 spp, `render`): at
 /// 1024 × 576, 2 / 4 / 6 / 8 per dispatch took 53.6 / 50.7 / 49.4 / 48.7 ms (16: 76 ms, in
 /// an earlier build); at 512 × 288, 1 / 2 / 4 / 8 took 30.1 / 28.0 / 28.3 / 29.5 ms. So 8
-/// from [`LARGE_IMAGE`] pixels on, else 4.
+/// from [`LARGE_IMAGE`] pixels on, else 4. With the faster traversal of the fifth session:
+/// 4 / 8 / 16 = 39.4 / 38.0 / 67.4 ms at 1024 × 576, 4 / 8 = 22.0 / 22.8 ms at 512 × 288.
 pub const SAMPLES_PER_DISPATCH: [u32; 2] = [4, 8];
 /// Pixels from which an image takes the larger number of samples per dispatch.
 pub const LARGE_IMAGE: u64 = 1024 * 576 / 2;
