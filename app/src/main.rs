@@ -165,6 +165,13 @@ enum Command {
         /// Trace shadow rays where they start instead of queueing them for the shadow pass.
         #[arg(long)]
         inline_shadows: bool,
+        /// Instead of the complexities: image error against GPU time at complexity 3's
+        /// settings (1, 2, 4 … 256 spp against a reference render).
+        #[arg(long)]
+        convergence: bool,
+        /// Samples per pixel of the convergence reference.
+        #[arg(long, default_value_t = 4096)]
+        reference_spp: u32,
     },
     /// Print a scene file's dimensions, voxel count, materials and memory.
     Info {
@@ -424,13 +431,18 @@ fn run(cli: Cli) -> Result<()> {
             device,
             experiment,
             inline_shadows,
+            convergence,
+            reference_spp,
         } => bench_gpu(
-            width,
-            height,
-            frames.max(1),
+            BenchGpu {
+                width,
+                height,
+                frames: frames.max(1),
+                experiment,
+                inline_shadows,
+                convergence: convergence.then_some(reference_spp),
+            },
             device,
-            experiment,
-            inline_shadows,
             workers,
         ),
         Command::Info { file } => {
@@ -642,15 +654,26 @@ fn parse_ivec3_f(s: &str) -> Result<DVec3> {
     }
 }
 
-fn bench_gpu(
+/// What `bench-gpu` measures.
+struct BenchGpu {
     width: u32,
     height: u32,
     frames: usize,
-    device: Option<String>,
     experiment: u32,
     inline_shadows: bool,
-    workers: usize,
-) -> Result<()> {
+    /// Error against time with a reference of this many samples, instead of the complexities.
+    convergence: Option<u32>,
+}
+
+fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<()> {
+    let BenchGpu {
+        width,
+        height,
+        frames,
+        experiment,
+        inline_shadows,
+        convergence,
+    } = bench;
     use render::vulkan::{
         ContextOptions, DeviceChoice, GpuContext,
         progressive::Progressive,
@@ -681,6 +704,23 @@ fn bench_gpu(
             "traced in place"
         }
     );
+    if let Some(reference_spp) = convergence {
+        let mut params = scene.params.clone();
+        params.settings.max_bounces = 3;
+        params.sun.enabled = true;
+        let result = convergence_table(
+            &ctx,
+            &mut tracer,
+            &world,
+            &view,
+            &params,
+            (width, height),
+            reference_spp,
+        );
+        tracer.destroy(&ctx);
+        world.destroy(&ctx);
+        return emit(&(text + &result?));
+    }
     for (label, bounces, spp, sun) in [
         ("complexity 1 (1 bounce, 1 spp, no sun)", 1, 1, false),
         ("complexity 2 (1 bounce, 1 spp, sun)", 1, 1, true),
@@ -784,6 +824,66 @@ fn bench_gpu(
         return Err(e.into());
     }
     emit(&text)
+}
+
+/// Image error against GPU time (render::convergence): a reference of `reference_spp` samples,
+/// then renders of 1, 2, 4 … 256 samples with other seeds, each three times (the middle time
+/// and the mean MSE are used).
+fn convergence_table(
+    ctx: &render::vulkan::GpuContext,
+    tracer: &mut render::vulkan::trace::PathTracer,
+    world: &render::vulkan::world::GpuWorld,
+    view: &brickmap::WorldView<'_>,
+    params: &render::SceneParams,
+    (width, height): (u32, u32),
+    reference_spp: u32,
+) -> Result<String> {
+    use render::convergence::{Measurement, table};
+    let job = |spp, seed| render::cpu::RenderJob {
+        width,
+        height,
+        spp,
+        seed,
+    };
+    let (reference, reference_time) = with_progress(
+        format!("reference: {width}x{height} at {reference_spp} spp"),
+        || Ok(tracer.render(ctx, world, view, params, &job(reference_spp, 1))?),
+    )?;
+    let Some(reference_time) = reference_time else {
+        bail!("this queue cannot take timestamps");
+    };
+    let mean = reference.mean().iter().sum::<f64>() / 3.0;
+    let mut measurements = Vec::new();
+    for spp in (0..9).map(|k| 1u32 << k) {
+        let (mut times, mut mse) = (Vec::new(), 0.0);
+        for seed in 2..5 {
+            let (image, time) = tracer.render(ctx, world, view, params, &job(spp, seed))?;
+            times.push(time.unwrap_or(f64::NAN));
+            mse += image.mse(&reference).context("image sizes differ")? / 3.0;
+        }
+        times.sort_by(f64::total_cmp);
+        measurements.push(Measurement {
+            spp,
+            seconds: times[1],
+            mse,
+        });
+    }
+    let mut text = format!(
+        "convergence  3 bounces, sun; reference {reference_spp} spp in {:.1} ms (GPU), mean pixel value {mean:.4}\n  \
+         spp   GPU ms    rel. RMSE   MSE·spp/σ² (1: no bias)   MSE·time (rel. to 1 spp)\n",
+        reference_time * 1e3
+    );
+    for row in table(&measurements, reference_spp, mean) {
+        text += &format!(
+            "  {:<5} {:<9.3} {:<11.4} {:<25.3} {:.3}\n",
+            row.measured.spp,
+            row.measured.seconds * 1e3,
+            row.relative_rmse,
+            row.variance_ratio,
+            row.relative_cost
+        );
+    }
+    Ok(text)
 }
 
 /// Renders on a device: "cpu" (the reference), "gpu" (the best Vulkan device) or part of a

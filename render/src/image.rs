@@ -53,6 +53,23 @@ impl Image {
         m
     }
 
+    /// Mean squared difference from `reference` over every channel of every pixel (f64), or
+    /// None when the sizes differ.
+    pub fn mse(&self, reference: &Image) -> Option<f64> {
+        if (self.width, self.height) != (reference.width, reference.height) {
+            return None;
+        }
+        let n = (self.pixels.len() * 3).max(1) as f64;
+        Some(
+            self.pixels
+                .iter()
+                .zip(&reference.pixels)
+                .flat_map(|(a, b)| (0..3).map(move |k| (a[k] as f64 - b[k] as f64).powi(2)))
+                .sum::<f64>()
+                / n,
+        )
+    }
+
     /// The image resampled to `width`×`height` by bilinear interpolation between pixel
     /// centres (edges clamped), as the display pass upscales the internal resolution.
     pub fn resized_bilinear(&self, width: u32, height: u32) -> Image {
