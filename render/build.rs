@@ -36,18 +36,33 @@ fn main() {
         );
         let source = ShaderSource::from(text);
         let name = path.file_name().unwrap().to_string_lossy().to_string();
-        let spirv = ShaderInput::new(
-            &source,
-            ShaderStage::Compute,
-            &options,
-            None::<&[(&str, Option<&str>)]>,
-            None,
-        )
-        .and_then(|input| glslang::Shader::new(compiler, input).parse())
-        .and_then(|shader| shader.compile())
-        .unwrap_or_else(|e| panic!("shader {name} does not compile:\n{e}"));
-        let bytes: Vec<u8> = spirv.iter().flat_map(|w| w.to_le_bytes()).collect();
-        std::fs::write(out.join(format!("{name}.spv")), bytes).expect("OUT_DIR is writable");
+        // Modules compiled again with a macro defined, as `<name>.<macro>.spv`: code that needs
+        // a device feature (float atomics) lives in its own module.
+        let extra: &[&str] = if name == "trace.comp" {
+            &["SAMPLE_SLICES"]
+        } else {
+            &[]
+        };
+        for define in std::iter::once(None).chain(extra.iter().map(|d| Some(*d))) {
+            let defines: Vec<(&str, Option<&str>)> =
+                define.iter().map(|d| (*d, Some("1"))).collect();
+            let spirv = ShaderInput::new(
+                &source,
+                ShaderStage::Compute,
+                &options,
+                Some(&defines[..]),
+                None,
+            )
+            .and_then(|input| glslang::Shader::new(compiler, input).parse())
+            .and_then(|shader| shader.compile())
+            .unwrap_or_else(|e| panic!("shader {name} ({define:?}) does not compile:\n{e}"));
+            let bytes: Vec<u8> = spirv.iter().flat_map(|w| w.to_le_bytes()).collect();
+            let file = match define {
+                None => format!("{name}.spv"),
+                Some(d) => format!("{name}.{d}.spv"),
+            };
+            std::fs::write(out.join(file), bytes).expect("OUT_DIR is writable");
+        }
     }
 }
 

@@ -4,6 +4,13 @@
 #version 450
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_vote : require
+// The sliced module (render/build.rs defines SAMPLE_SLICES): a pixel's samples of a dispatch
+// are split among gl_NumWorkGroups.z invocations (slice = workgroup z), which add their sums
+// to the accumulation with float atomics (the host zeroes it first when starting). Small
+// images fill the GPU this way.
+#ifdef SAMPLE_SLICES
+#extension GL_EXT_shader_atomic_float : require
+#endif
 layout(local_size_x = 8, local_size_y = 8) in;
 
 // Pipeline variants (render/src/vulkan/trace.rs `Variant`): what the scene needs. Code for
@@ -47,7 +54,7 @@ struct Params {
     vec4 sky_horizon;   // rgb
     vec4 sky_zenith;    // rgb, w: 1 for a gradient, 0 for uniform (horizon colour)
     uvec4 grid;         // bricks xyz, coarse words per column
-    uvec4 image;        // width, height, samples per pixel in this dispatch, B (the shader
+    uvec4 image;        // width, height, samples per pixel and slice in this dispatch, B (the shader
                         // uses the variant's MAX_BOUNCES; B is kept for the image key)
     uvec4 seed;         // seed, camera medium (material + 1, 0 for air), first sample index,
                         // 1 to add to the accumulation (0 to start it)
@@ -364,7 +371,8 @@ void main() {
     uint index = px.y * p.image.x + px.x;
     for (int k = 0; k < 6; k++) g_rays[k] = 0u;
     pixel_sum = vec3(0.0);
-    uint next_sample = 0u;
+    uint next_sample = gl_WorkGroupID.z * p.image.z; // this slice's first sample
+    uint end_sample = next_sample + p.image.z;
     bool more = p.image.z > 0u; // samples left (the current path's included)
     if (more) begin_path(px, index, next_sample++);
     bool path_alive = true; // false: the path ended (its shadow ray may still be pending)
@@ -416,7 +424,7 @@ void main() {
         bool ended = !path_alive && !shadow_pending;
         bool together = (EXPERIMENT & 64u) == 0u || subgroupAll(ended);
         if (ended && together) {
-            more = next_sample < p.image.z;
+            more = next_sample < end_sample;
             if (more) {
                 begin_path(px, index, next_sample++);
                 path_alive = true;
@@ -424,7 +432,14 @@ void main() {
         }
     }
     vec4 mine = vec4(pixel_sum, float(p.image.z));
+#ifdef SAMPLE_SLICES
+    atomicAdd(accum[index].x, mine.x);
+    atomicAdd(accum[index].y, mine.y);
+    atomicAdd(accum[index].z, mine.z);
+    atomicAdd(accum[index].w, mine.w);
+#else
     accum[index] = p.seed.w != 0u ? accum[index] + mine : mine;
+#endif
     if (COUNT_RAYS) {
         for (int k = 0; k < 6; k++) atomicAdd(counters[k], g_rays[k]);
     }

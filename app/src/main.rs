@@ -124,6 +124,10 @@ enum Command {
         /// size).
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16))]
         samples_per_dispatch: Option<u32>,
+        /// GPU: invocations each pixel's samples are split among in one dispatch, 1..=8
+        /// (default: enough for 0.6 M invocations, where the device has float atomics).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8))]
+        slices: Option<u32>,
     },
     /// Replay an edit script headlessly, reporting each step; exits non-zero at the first
     /// failed step.
@@ -172,6 +176,10 @@ enum Command {
         /// Samples per pixel of the convergence reference.
         #[arg(long, default_value_t = 4096)]
         reference_spp: u32,
+        /// Invocations each pixel's samples are split among, 1..=8 (default: the renderer's
+        /// choice for the image size).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8))]
+        slices: Option<u32>,
     },
     /// Print a scene file's dimensions, voxel count, materials and memory.
     Info {
@@ -365,6 +373,7 @@ fn run(cli: Cli) -> Result<()> {
             seed,
             scale,
             samples_per_dispatch,
+            slices,
         } => render_command(RenderArgs {
             scene,
             out,
@@ -378,6 +387,7 @@ fn run(cli: Cli) -> Result<()> {
             seed,
             scale,
             samples_per_dispatch,
+            slices,
             workers,
         }),
         Command::Replay {
@@ -412,7 +422,8 @@ fn run(cli: Cli) -> Result<()> {
                     spp: 16,
                     seed: 1,
                 };
-                let (image, _, _) = render_on(&device, &view, &doc.scene.params, &job, None)?;
+                let (image, _, _) =
+                    render_on(&device, &view, &doc.scene.params, &job, (None, None))?;
                 app::atomic::write_atomic(path, |w| {
                     image.write_png(w, doc.scene.params.settings.exposure)
                 })?;
@@ -433,6 +444,7 @@ fn run(cli: Cli) -> Result<()> {
             inline_shadows,
             convergence,
             reference_spp,
+            slices,
         } => bench_gpu(
             BenchGpu {
                 width,
@@ -441,6 +453,7 @@ fn run(cli: Cli) -> Result<()> {
                 experiment,
                 inline_shadows,
                 convergence: convergence.then_some(reference_spp),
+                slices,
             },
             device,
             workers,
@@ -575,6 +588,7 @@ struct RenderArgs {
     seed: u64,
     scale: f64,
     samples_per_dispatch: Option<u32>,
+    slices: Option<u32>,
     workers: usize,
 }
 
@@ -615,8 +629,13 @@ fn render_command(a: RenderArgs) -> Result<()> {
         spp: a.spp,
         seed: a.seed,
     };
-    let (image, backend, timing) =
-        render_on(&a.device, &view, &params, &job, a.samples_per_dispatch)?;
+    let (image, backend, timing) = render_on(
+        &a.device,
+        &view,
+        &params,
+        &job,
+        (a.samples_per_dispatch, a.slices),
+    )?;
     let image = if internal == (a.width, a.height) {
         image
     } else {
@@ -663,6 +682,8 @@ struct BenchGpu {
     inline_shadows: bool,
     /// Error against time with a reference of this many samples, instead of the complexities.
     convergence: Option<u32>,
+    /// Invocations per pixel (None: the renderer's choice).
+    slices: Option<u32>,
 }
 
 fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<()> {
@@ -673,6 +694,7 @@ fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<
         experiment,
         inline_shadows,
         convergence,
+        slices,
     } = bench;
     use render::vulkan::{
         ContextOptions, DeviceChoice, GpuContext,
@@ -696,6 +718,11 @@ fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<
     let mut failure = None;
     let mut tracer = PathTracer::new(&ctx)?;
     tracer.set_deferred_shadows(&ctx, !inline_shadows);
+    tracer.set_sample_slices(slices);
+    text += &format!(
+        "slices       each pixel's samples split among up to {} invocations\n",
+        tracer.sample_slices(width as u64 * height as u64)
+    );
     text += &format!(
         "shadow rays  {}\n",
         if tracer.deferred_shadows() {
@@ -893,7 +920,7 @@ fn render_on(
     view: &brickmap::WorldView<'_>,
     params: &render::SceneParams,
     job: &render::cpu::RenderJob,
-    samples_per_dispatch: Option<u32>,
+    (samples_per_dispatch, slices): (Option<u32>, Option<u32>),
 ) -> Result<(render::Image, String, String)> {
     let started = Instant::now();
     Ok(if device == "cpu" {
@@ -934,6 +961,7 @@ fn render_on(
         let world = GpuWorld::upload(&ctx, view)?;
         let mut tracer = PathTracer::new(&ctx)?;
         tracer.set_samples_per_dispatch(samples_per_dispatch);
+        tracer.set_sample_slices(slices);
         let rendered = with_progress(
             format!(
                 "rendering {}x{} at {} spp on {}",

@@ -574,20 +574,85 @@ mod trace {
         assert_eq!(ctx.validation_errors(), 0);
     }
 
+    /// Whether the device has float atomic adds (shadow queue, sample slices); every driver we
+    /// test on has them, so without them the test fails under VOXBRICK_REQUIRE_GPU=1 and
+    /// otherwise skips, saying so.
+    fn float_atomics(ctx: &GpuContext, what: &str) -> bool {
+        if !ctx.shadow_queue {
+            assert_ne!(
+                std::env::var("VOXBRICK_REQUIRE_GPU").as_deref(),
+                Ok("1"),
+                "{} cannot {what}",
+                ctx.name
+            );
+            eprintln!("SKIPPED: {} cannot {what}", ctx.name);
+        }
+        ctx.shadow_queue
+    }
+
+    #[test]
+    fn sliced_samples_render_what_one_invocation_per_pixel_renders() {
+        // The same samples (same random sequences) whether a pixel's samples of a dispatch run
+        // in one invocation or are split among several and added with atomics; 13 spp in
+        // dispatches of 2 × 3 leaves a short last dispatch with fewer slices.
+        let Some(ctx) = context(DeviceChoice::Best) else {
+            return;
+        };
+        if !float_atomics(&ctx, "split samples") {
+            return;
+        }
+        let (w, p) = common::showcase();
+        let view = w.read();
+        let world = GpuWorld::upload(&ctx, &view).unwrap();
+        let job = RenderJob {
+            width: 24,
+            height: 16,
+            spp: 13,
+            seed: 9,
+        };
+        let mut tracer = PathTracer::new(&ctx).unwrap();
+        let mut render = |per: u32, slices: u32| {
+            tracer.set_samples_per_dispatch(Some(per));
+            tracer.set_sample_slices(Some(slices));
+            assert_eq!(tracer.sample_slices(384), slices);
+            tracer
+                .render_counted(&ctx, &world, &view, &p, &job)
+                .unwrap()
+        };
+        let (whole, _, rays) = render(4, 1);
+        let (sliced, _, sliced_rays) = render(2, 3);
+        assert_eq!(sliced_rays, rays);
+        assert!(rays.primary == 24 * 16 * 13, "{rays:?}");
+        for (a, b) in sliced.pixels.iter().zip(&whole.pixels) {
+            for k in 0..3 {
+                assert!(
+                    (a[k] - b[k]).abs() <= 1e-5 * b[k].abs().max(1.0),
+                    "{a:?} vs {b:?}"
+                );
+            }
+        }
+        // Without a fixed split, a small image is split (the GPU would be mostly idle).
+        tracer.set_sample_slices(None);
+        assert_eq!(
+            tracer.sample_slices(24 * 16),
+            render::vulkan::trace::MAX_SLICES
+        );
+        assert_eq!(tracer.sample_slices(1024 * 576), 2);
+        assert_eq!(tracer.sample_slices(1920 * 1080), 1);
+        tracer.set_samples_per_dispatch(None);
+        assert_eq!(tracer.samples_per_dispatch(1920 * 1080), 8);
+        assert_eq!(tracer.samples_per_dispatch(1024 * 576), 4);
+        tracer.destroy(&ctx);
+        world.destroy(&ctx);
+        assert_eq!(ctx.validation_errors(), 0);
+    }
+
     #[test]
     fn queued_shadow_rays_render_what_shadow_rays_traced_in_place_render() {
         let Some(ctx) = context(DeviceChoice::Best) else {
             return;
         };
-        if !ctx.shadow_queue {
-            // Every driver we test on has float atomics; a device without them traces in place.
-            assert_ne!(
-                std::env::var("VOXBRICK_REQUIRE_GPU").as_deref(),
-                Ok("1"),
-                "{} cannot queue shadow rays",
-                ctx.name
-            );
-            eprintln!("SKIPPED: {} cannot queue shadow rays", ctx.name);
+        if !float_atomics(&ctx, "queue shadow rays") {
             return;
         }
         let (w, p) = common::showcase();

@@ -9,8 +9,8 @@ use ash::vk;
 /// How many workgroups a recorded dispatch runs.
 #[derive(Clone, Copy, Debug)]
 pub enum Dispatch {
-    /// x × y × 1 groups.
-    Groups(u32, u32),
+    /// x × y × z groups.
+    Groups(u32, u32, u32),
     /// Read by the device from a buffer (three u32 at the offset).
     Indirect(vk::Buffer, u64),
 }
@@ -271,7 +271,13 @@ impl ComputePass {
     ) -> Result<Vec<f64>, GpuError> {
         let set = self.allocate_set(ctx, buffers)?;
         let result = run_batch(ctx, count, time, |cmd| {
-            self.record(ctx, cmd, set, push, Dispatch::Groups(groups[0], groups[1]))
+            self.record(
+                ctx,
+                cmd,
+                set,
+                push,
+                Dispatch::Groups(groups[0], groups[1], 1),
+            )
         });
         self.free_set(ctx, set);
         result
@@ -352,7 +358,7 @@ impl ComputePass {
                 d.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::COMPUTE, 0, push);
             }
             match dispatch {
-                Dispatch::Groups(x, y) => d.cmd_dispatch(cmd, x, y, 1),
+                Dispatch::Groups(x, y, z) => d.cmd_dispatch(cmd, x, y, z),
                 Dispatch::Indirect(buffer, offset) => d.cmd_dispatch_indirect(cmd, buffer, offset),
             }
         }

@@ -155,16 +155,21 @@ impl Progressive {
         let restarted = self.samples == 0;
         let mut gpu = Some(0.0);
         let mut done = 0;
-        let per_dispatch =
-            tracer.samples_per_dispatch(self.internal.0 as u64 * self.internal.1 as u64);
+        let pixels = self.internal.0 as u64 * self.internal.1 as u64;
+        let (per_invocation, slices) = (
+            tracer.samples_per_dispatch(pixels),
+            tracer.sample_slices(pixels),
+        );
         while done < spp {
-            let batch = (spp - done).min(per_dispatch);
-            let p = base.batch(batch, self.samples, self.samples > 0);
+            let (per, split) = batch_shape(spp - done, per_invocation, slices);
+            let batch = per * split;
+            let p = base.batch(per, self.samples, self.samples > 0);
             let t = tracer.dispatch(
                 ctx,
                 world,
                 variant,
                 &p,
+                split,
                 &mut self.uniforms,
                 self.accum.binding(),
                 true,
@@ -186,7 +191,8 @@ impl Progressive {
 
     /// Benchmarks: GPU times of `count` back-to-back dispatches of the same first batch of
     /// `spp` (≤ [`MAX_SAMPLES_PER_DISPATCH`]) samples per pixel with `variant`, in one
-    /// submission.
+    /// submission; the samples are split among as many invocations per pixel as the tracer's
+    /// [`PathTracer::sample_slices`] allows and divides `spp`.
     /// Leaves the accumulation restarted.
     #[allow(clippy::too_many_arguments)]
     pub fn time_repeated(
@@ -201,12 +207,18 @@ impl Progressive {
         count: u32,
     ) -> Result<Vec<f64>, GpuError> {
         let spp = spp.clamp(1, MAX_SAMPLES_PER_DISPATCH);
-        let p = TraceParams::new(view, params, &self.job(spp)).batch(spp, 0, false);
+        let pixels = self.internal.0 as u64 * self.internal.1 as u64;
+        let slices = (1..=tracer.sample_slices(pixels).min(spp))
+            .rev()
+            .find(|s| spp.is_multiple_of(*s))
+            .unwrap_or(1);
+        let p = TraceParams::new(view, params, &self.job(spp)).batch(spp / slices, 0, false);
         let times = tracer.dispatch_repeated(
             ctx,
             world,
             variant,
             &p,
+            slices,
             &mut self.uniforms,
             self.accum.binding(),
             count,
@@ -254,5 +266,44 @@ impl Progressive {
     pub fn destroy(self, ctx: &GpuContext) {
         self.accum.destroy(ctx);
         self.uniforms.destroy(ctx);
+    }
+}
+
+/// The next dispatch of `left` samples per pixel: (samples per invocation, invocations per
+/// pixel), at most `per` × `slices` and never more than `left` in all.
+fn batch_shape(left: u32, per: u32, slices: u32) -> (u32, u32) {
+    let split = slices.clamp(1, left.max(1));
+    let per = per.clamp(1, (left / split).max(1));
+    (per, split)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::batch_shape;
+
+    #[test]
+    fn batches_cover_the_samples_exactly_within_the_limits() {
+        for per in 1..=16 {
+            for slices in 1..=8 {
+                for spp in 1..=200 {
+                    let (mut left, mut dispatches) = (spp, 0);
+                    while left > 0 {
+                        let (p, s) = batch_shape(left, per, slices);
+                        assert!(p >= 1 && p <= per && s >= 1 && s <= slices);
+                        assert!(p * s <= left, "{spp} spp: {p} x {s} of {left}");
+                        left -= p * s;
+                        dispatches += 1;
+                    }
+                    // Never more than one short dispatch per shrinking of the split.
+                    assert!(
+                        dispatches <= spp.div_ceil(per * slices) + slices,
+                        "{spp} {per} {slices}: {dispatches}"
+                    );
+                }
+            }
+        }
+        assert_eq!(batch_shape(64, 4, 4), (4, 4));
+        assert_eq!(batch_shape(7, 2, 4), (1, 4));
+        assert_eq!(batch_shape(3, 2, 4), (1, 3));
     }
 }

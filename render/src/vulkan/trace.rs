@@ -21,6 +21,10 @@ use std::collections::HashMap;
 
 const SPIRV: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/trace.comp.spv"));
 const SHADOW_SPIRV: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/shadow.comp.spv"));
+/// trace.comp with SAMPLE_SLICES: a pixel's samples split among several invocations, added
+/// with float atomics (render/build.rs).
+const SLICED_SPIRV: &[u8] =
+    include_bytes!(concat!(env!("OUT_DIR"), "/trace.comp.SAMPLE_SLICES.spv"));
 
 /// Storage bindings of both passes: the world (0..4), parameters, accumulation, counters,
 /// shadow rays, queue header.
@@ -48,6 +52,18 @@ pub const LARGE_IMAGE: u64 = 1024 * 576 / 2;
 /// The most samples per pixel one dispatch may take (long-running invocations lose samples on
 /// lavapipe; see [`PathTracer::render`]).
 pub const MAX_SAMPLES_PER_DISPATCH: u32 = 16;
+/// Invocations a dispatch should have at least: an image with fewer pixels splits each
+/// pixel's samples among up to [`MAX_SLICES`] invocations (where the device has float
+/// atomics), [`SLICED_SAMPLES`] each, so the GPU is full. Measured on the H100 (thesis scene,
+/// `render` 64 spp, slices × samples per invocation; BENCHMARKS.md): at 1024 × 576 1 × 8 /
+/// 2 × 4 / 4 × 2 / 8 × 1 = 38.1 / 35.5 / 35.3 / 38.9 ms; at 512 × 288 1 × 4 / 4 × 4 / 8 × 1 /
+/// 8 × 2 / 8 × 4 = 22.0 / 11.2 / 10.4 / 9.8 / 9.6 ms; at 256 × 144 1 × 4 / 8 × 2..8 = 19.0 /
+/// 4.0 ms. 16 samples per dispatch at 1024 × 576 overflow the shadow queue (60–64 ms).
+pub const FULL_DISPATCH: u64 = 2 * 1024 * 576;
+/// The most invocations one pixel's samples are split among in a dispatch.
+pub const MAX_SLICES: u32 = 8;
+/// Samples per invocation when a pixel's samples are split.
+pub const SLICED_SAMPLES: u32 = 4;
 
 /// Keep in sync with `Params` in shaders/trace.comp (std430: eleven vec4, three uvec4).
 #[repr(C)]
@@ -260,13 +276,17 @@ struct ShadowQueue {
 
 /// The path-tracing pipelines, one per variant in use.
 pub struct PathTracer {
-    passes: HashMap<(Variant, bool), ComputePass>,
+    /// Trace pipelines by variant, shadow queue and sample slicing.
+    passes: HashMap<(Variant, bool, bool), ComputePass>,
     /// The shadow pass, by ray counting and experiment.
     shadow_passes: HashMap<(bool, u32), ComputePass>,
     queue: Option<ShadowQueue>,
     queue_limit: u64,
     deferred_shadows: bool,
     samples_per_dispatch: Option<u32>,
+    sample_slices: Option<u32>,
+    /// Whether the device can split samples (float atomic adds).
+    can_slice: bool,
     counters: HostBuffer,
 }
 
@@ -281,6 +301,8 @@ impl PathTracer {
             queue_limit: QUEUE_MAX,
             deferred_shadows: ctx.shadow_queue,
             samples_per_dispatch: None,
+            sample_slices: None,
+            can_slice: ctx.shadow_queue,
             counters: HostBuffer::new(ctx, "ray counters", 32, MemoryLocation::GpuToCpu)?,
         })
     }
@@ -308,25 +330,54 @@ impl PathTracer {
         self.samples_per_dispatch = samples.map(|n| n.clamp(1, MAX_SAMPLES_PER_DISPATCH));
     }
 
-    /// Samples per pixel one dispatch of an image of `pixels` takes.
+    /// Samples per pixel and invocation one dispatch of an image of `pixels` takes:
+    /// [`SLICED_SAMPLES`] when the pixel's samples are split, else [`SAMPLES_PER_DISPATCH`].
     pub fn samples_per_dispatch(&self, pixels: u64) -> u32 {
         self.samples_per_dispatch
-            .unwrap_or(SAMPLES_PER_DISPATCH[usize::from(pixels >= LARGE_IMAGE)])
+            .unwrap_or(if self.sample_slices(pixels) > 1 {
+                SLICED_SAMPLES
+            } else {
+                SAMPLES_PER_DISPATCH[usize::from(pixels >= LARGE_IMAGE)]
+            })
+    }
+
+    /// Invocations a pixel's samples are split among: `Some(n)` fixes it (1..=[`MAX_SLICES`];
+    /// 1 on a device without float atomic adds), `None` chooses from the image size.
+    pub fn set_sample_slices(&mut self, slices: Option<u32>) {
+        self.sample_slices = slices.map(|n| n.clamp(1, MAX_SLICES));
+    }
+
+    /// Invocations per pixel in a dispatch of an image of `pixels`: enough for
+    /// [`FULL_DISPATCH`] invocations, at most [`MAX_SLICES`].
+    pub fn sample_slices(&self, pixels: u64) -> u32 {
+        if !self.can_slice {
+            return 1;
+        }
+        self.sample_slices.unwrap_or_else(|| {
+            FULL_DISPATCH
+                .div_ceil(pixels.max(1))
+                .clamp(1, u64::from(MAX_SLICES)) as u32
+        })
     }
 
     fn queued(&self, variant: Variant) -> bool {
         self.deferred_shadows && variant.sun
     }
 
-    /// Builds a variant's pipelines now (they are cached).
-    pub fn prepare(&mut self, ctx: &GpuContext, variant: Variant) -> Result<(), GpuError> {
+    /// Builds a variant's pipelines now (they are cached), sliced or not.
+    pub fn prepare(
+        &mut self,
+        ctx: &GpuContext,
+        variant: Variant,
+        sliced: bool,
+    ) -> Result<(), GpuError> {
         let queued = self.queued(variant);
         if let std::collections::hash_map::Entry::Vacant(slot) =
-            self.passes.entry((variant, queued))
+            self.passes.entry((variant, queued, sliced))
         {
             slot.insert(ComputePass::specialized(
                 ctx,
-                SPIRV,
+                if sliced { SLICED_SPIRV } else { SPIRV },
                 BINDINGS,
                 0,
                 &variant.constants(queued),
@@ -389,8 +440,8 @@ impl PathTracer {
         ctx: &GpuContext,
         variant: Variant,
     ) -> Result<Vec<(String, String)>, GpuError> {
-        self.prepare(ctx, variant)?;
-        let mut stats = self.passes[&(variant, self.queued(variant))].statistics(ctx);
+        self.prepare(ctx, variant, false)?;
+        let mut stats = self.passes[&(variant, self.queued(variant), false)].statistics(ctx);
         if let Some(shadow) = self
             .shadow_passes
             .get(&(variant.count_rays, variant.experiment))
@@ -411,8 +462,10 @@ impl PathTracer {
         self.passes.len()
     }
 
-    /// One dispatch of `p` (its batch of samples) into `accum` (one vec4 per pixel: radiance
-    /// sum and sample count); returns its GPU time when `time` is set and the queue can time.
+    /// One dispatch of `p` (its batch of samples, `p.image[2]` per invocation) into `accum`
+    /// (one vec4 per pixel: radiance sum and sample count), each pixel's samples split among
+    /// `slices` invocations (1 unless [`PathTracer::sample_slices`] allows more); returns its
+    /// GPU time when `time` is set and the queue can time.
     #[allow(clippy::too_many_arguments)]
     pub fn dispatch(
         &mut self,
@@ -420,11 +473,12 @@ impl PathTracer {
         world: &GpuWorld,
         variant: Variant,
         p: &TraceParams,
+        slices: u32,
         uniforms: &mut HostBuffer,
         accum: Binding,
         time: bool,
     ) -> Result<Option<f64>, GpuError> {
-        self.dispatch_repeated(ctx, world, variant, p, uniforms, accum, 1, time)
+        self.dispatch_repeated(ctx, world, variant, p, slices, uniforms, accum, 1, time)
             .map(|t| t.first().copied())
     }
 
@@ -437,17 +491,24 @@ impl PathTracer {
         world: &GpuWorld,
         variant: Variant,
         p: &TraceParams,
+        slices: u32,
         uniforms: &mut HostBuffer,
         accum: Binding,
         count: u32,
         time: bool,
     ) -> Result<Vec<f64>, GpuError> {
-        self.prepare(ctx, variant)?;
+        let slices = if self.can_slice {
+            slices.clamp(1, MAX_SLICES)
+        } else {
+            1
+        };
+        let sliced = slices > 1;
+        self.prepare(ctx, variant, sliced)?;
         let queued = self.queued(variant);
         if queued {
             self.ensure_queue(
                 ctx,
-                p.image[0] as u64 * p.image[1] as u64 * p.image[2] as u64,
+                p.image[0] as u64 * p.image[1] as u64 * p.image[2] as u64 * slices as u64,
             )?;
         }
         uniforms.write(bytemuck::bytes_of(p));
@@ -459,7 +520,7 @@ impl PathTracer {
             // Unused without the queue (SHADOW_QUEUE is false): any valid buffer.
             None => bound.extend([self.counters.binding(), self.counters.binding()]),
         }
-        let trace = &self.passes[&(variant, queued)];
+        let trace = &self.passes[&(variant, queued, sliced)];
         let shadow = self
             .shadow_passes
             .get(&(variant.count_rays, variant.experiment))
@@ -472,8 +533,25 @@ impl PathTracer {
                 return Err(e);
             }
         };
-        let groups = Dispatch::Groups(p.image[0].div_ceil(8), p.image[1].div_ceil(8));
+        let groups = Dispatch::Groups(p.image[0].div_ceil(8), p.image[1].div_ceil(8), slices);
+        // The sliced shader only adds: a new accumulation starts from zero.
+        let zero = (sliced && p.seed[3] == 0).then_some(accum);
         let result = run_batch(ctx, count, time, |cmd| {
+            if let Some(a) = zero {
+                // SAFETY: recording; the accumulation range is a transfer destination.
+                unsafe {
+                    ctx.device
+                        .cmd_fill_buffer(cmd, a.buffer, a.offset, a.range, 0);
+                    barrier(
+                        ctx,
+                        cmd,
+                        vk::PipelineStageFlags::TRANSFER,
+                        vk::AccessFlags::TRANSFER_WRITE,
+                        vk::PipelineStageFlags::COMPUTE_SHADER,
+                        vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
+                    );
+                }
+            }
             let q = queue.map(|q| q.header.binding());
             if let Some(h) = q {
                 // SAFETY: recording; the header is a transfer destination of 16 bytes.
