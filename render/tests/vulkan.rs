@@ -574,10 +574,25 @@ mod trace {
         assert_eq!(ctx.validation_errors(), 0);
     }
 
-    /// Whether the device has float atomic adds (shadow queue, sample slices); every driver we
-    /// test on has them, so without them the test fails under VOXBRICK_REQUIRE_GPU=1 and
-    /// otherwise skips, saying so.
-    fn float_atomics(ctx: &GpuContext, what: &str) -> bool {
+    /// Two renders of the same samples, summed in another order: equal up to f32 rounding.
+    fn assert_same_up_to_rounding(a: &Image, b: &Image, what: &str) {
+        for (x, y) in a.pixels.iter().zip(&b.pixels) {
+            for k in 0..3 {
+                assert!(
+                    (x[k] - y[k]).abs() <= 1e-5 * y[k].abs().max(1.0),
+                    "{what}: {x:?} vs {y:?}"
+                );
+            }
+        }
+    }
+
+    /// A context and the showcase scene uploaded, on a device with float atomic adds (shadow
+    /// queue, sample slices). Every driver we test on has them, so without them the test fails
+    /// under VOXBRICK_REQUIRE_GPU=1 and otherwise skips, saying so.
+    fn showcase_with_float_atomics(
+        what: &str,
+    ) -> Option<(GpuContext, World, SceneParams, GpuWorld)> {
+        let ctx = context(DeviceChoice::Best)?;
         if !ctx.shadow_queue {
             assert_ne!(
                 std::env::var("VOXBRICK_REQUIRE_GPU").as_deref(),
@@ -586,8 +601,11 @@ mod trace {
                 ctx.name
             );
             eprintln!("SKIPPED: {} cannot {what}", ctx.name);
+            return None;
         }
-        ctx.shadow_queue
+        let (w, p) = common::showcase();
+        let world = GpuWorld::upload(&ctx, &w.read()).unwrap();
+        Some((ctx, w, p, world))
     }
 
     #[test]
@@ -595,15 +613,10 @@ mod trace {
         // The same samples (same random sequences) whether a pixel's samples of a dispatch run
         // in one invocation or are split among several and added with atomics; 13 spp in
         // dispatches of 2 × 3 leaves a short last dispatch with fewer slices.
-        let Some(ctx) = context(DeviceChoice::Best) else {
+        let Some((ctx, w, p, world)) = showcase_with_float_atomics("split samples") else {
             return;
         };
-        if !float_atomics(&ctx, "split samples") {
-            return;
-        }
-        let (w, p) = common::showcase();
         let view = w.read();
-        let world = GpuWorld::upload(&ctx, &view).unwrap();
         let job = RenderJob {
             width: 24,
             height: 16,
@@ -623,14 +636,7 @@ mod trace {
         let (sliced, _, sliced_rays) = render(2, 3);
         assert_eq!(sliced_rays, rays);
         assert!(rays.primary == 24 * 16 * 13, "{rays:?}");
-        for (a, b) in sliced.pixels.iter().zip(&whole.pixels) {
-            for k in 0..3 {
-                assert!(
-                    (a[k] - b[k]).abs() <= 1e-5 * b[k].abs().max(1.0),
-                    "{a:?} vs {b:?}"
-                );
-            }
-        }
+        assert_same_up_to_rounding(&sliced, &whole, "sliced");
         // Without a fixed split, a small image is split (the GPU would be mostly idle).
         tracer.set_sample_slices(None);
         assert_eq!(
@@ -649,15 +655,10 @@ mod trace {
 
     #[test]
     fn queued_shadow_rays_render_what_shadow_rays_traced_in_place_render() {
-        let Some(ctx) = context(DeviceChoice::Best) else {
+        let Some((ctx, w, p, world)) = showcase_with_float_atomics("queue shadow rays") else {
             return;
         };
-        if !float_atomics(&ctx, "queue shadow rays") {
-            return;
-        }
-        let (w, p) = common::showcase();
         let view = w.read();
-        let world = GpuWorld::upload(&ctx, &view).unwrap();
         let job = RenderJob {
             width: 24,
             height: 16,
@@ -680,14 +681,7 @@ mod trace {
         for limit in [u64::MAX, 100] {
             let (queued, queued_rays) = render(true, limit);
             assert_eq!(queued_rays, rays, "queue limit {limit}");
-            for (a, b) in queued.pixels.iter().zip(&in_place.pixels) {
-                for k in 0..3 {
-                    assert!(
-                        (a[k] - b[k]).abs() <= 1e-5 * b[k].abs().max(1.0),
-                        "queue limit {limit}: {a:?} vs {b:?}"
-                    );
-                }
-            }
+            assert_same_up_to_rounding(&queued, &in_place, &format!("queue limit {limit}"));
         }
         tracer.destroy(&ctx);
         world.destroy(&ctx);

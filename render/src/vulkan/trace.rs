@@ -537,31 +537,23 @@ impl PathTracer {
         // The sliced shader only adds: a new accumulation starts from zero.
         let zero = (sliced && p.seed[3] == 0).then_some(accum);
         let result = run_batch(ctx, count, time, |cmd| {
-            if let Some(a) = zero {
-                // SAFETY: recording; the accumulation range is a transfer destination.
-                unsafe {
+            let q = queue.map(|q| q.header.binding());
+            // SAFETY: recording; the accumulation range and the 16-byte queue header are
+            // transfer destinations.
+            unsafe {
+                if let Some(a) = zero {
                     ctx.device
                         .cmd_fill_buffer(cmd, a.buffer, a.offset, a.range, 0);
-                    barrier(
-                        ctx,
-                        cmd,
-                        vk::PipelineStageFlags::TRANSFER,
-                        vk::AccessFlags::TRANSFER_WRITE,
-                        vk::PipelineStageFlags::COMPUTE_SHADER,
-                        vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
-                    );
                 }
-            }
-            let q = queue.map(|q| q.header.binding());
-            if let Some(h) = q {
-                // SAFETY: recording; the header is a transfer destination of 16 bytes.
-                unsafe {
+                if let Some(h) = q {
                     ctx.device.cmd_update_buffer(
                         cmd,
                         h.buffer,
                         h.offset,
                         bytemuck::cast_slice(&QUEUE_RESET),
                     );
+                }
+                if zero.is_some() || q.is_some() {
                     barrier(
                         ctx,
                         cmd,
