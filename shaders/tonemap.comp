@@ -7,7 +7,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(std430, set = 0, binding = 0) readonly buffer Hdr { vec4 hdr[]; };    // rgb sum, count
 layout(std430, set = 0, binding = 1) writeonly buffer Ldr { uint ldr[]; };   // RGBA8 packed
-layout(push_constant) uniform Push { uvec2 src; uvec2 dst; float scale; } pc;
+// bgra = 1 writes the bytes in B, G, R, A order (a B8G8R8A8 swapchain image is copied from it).
+layout(push_constant) uniform Push { uvec2 src; uvec2 dst; float scale; uint bgra; } pc;
 
 vec3 aces_fitted(vec3 c) {
     const mat3 INPUT = mat3(0.59719, 0.07600, 0.02840,
@@ -44,5 +45,7 @@ void main() {
     vec3 c = mix(mix(texel(i.x, i.y), texel(i.x + 1, i.y), f.x),
                  mix(texel(i.x, i.y + 1), texel(i.x + 1, i.y + 1), f.x), f.y) * pc.scale;
     vec3 t = aces_fitted(c);
-    ldr[px.y * pc.dst.x + px.x] = encode_srgb(t.r) | (encode_srgb(t.g) << 8) | (encode_srgb(t.b) << 16) | (255u << 24);
+    uint r = encode_srgb(t.r), b = encode_srgb(t.b);
+    if (pc.bgra != 0u) { uint x = r; r = b; b = x; }
+    ldr[px.y * pc.dst.x + px.x] = r | (encode_srgb(t.g) << 8) | (b << 16) | (255u << 24);
 }

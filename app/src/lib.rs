@@ -4,6 +4,7 @@
 pub mod atomic;
 pub mod editor;
 pub mod formats;
+pub mod gpu;
 pub mod scene;
 
 pub use scene::Scene;

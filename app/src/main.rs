@@ -696,27 +696,19 @@ fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<
         convergence,
         slices,
     } = bench;
-    use render::vulkan::{
-        ContextOptions, DeviceChoice, GpuContext,
-        progressive::Progressive,
-        trace::{PathTracer, Variant},
-        world::GpuWorld,
-    };
+    use render::vulkan::trace::Variant;
     let scene = thesis_scene(workers)?;
-    let choice = device.map_or(DeviceChoice::Best, DeviceChoice::Name);
-    let ctx = GpuContext::new(&ContextOptions {
-        device: choice,
-        validation: false,
-    })?;
     let view = scene.world.read();
-    let world = GpuWorld::upload(&ctx, &view)?;
+    let mut session = app::gpu::session(device.as_deref().unwrap_or("gpu"), &view)?;
+    let ctx = session.ctx().clone();
     let mut text = format!(
-        "device       {}\nscene        thesis (512x256x512, {} solid voxels), {width}x{height}\n",
+        "device       {} ({})\nscene        thesis (512x256x512, {} solid voxels), {width}x{height}\n",
         ctx.name,
+        ctx.driver,
         view.solid_count()
     );
     let mut failure = None;
-    let mut tracer = PathTracer::new(&ctx)?;
+    let tracer = session.tracer();
     tracer.set_deferred_shadows(&ctx, !inline_shadows);
     tracer.set_sample_slices(slices);
     text += &format!(
@@ -735,17 +727,8 @@ fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<
         let mut params = scene.params.clone();
         params.settings.max_bounces = 3;
         params.sun.enabled = true;
-        let result = convergence_table(
-            &ctx,
-            &mut tracer,
-            &world,
-            &view,
-            &params,
-            (width, height),
-            reference_spp,
-        );
-        tracer.destroy(&ctx);
-        world.destroy(&ctx);
+        let result =
+            convergence_table(&mut session, &view, &params, (width, height), reference_spp);
         return emit(&(text + &result?));
     }
     for (label, bounces, spp, sun) in [
@@ -767,10 +750,9 @@ fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<
         let variants = [scene_variant, Variant::everything(bounces)];
         let mut times = [Vec::with_capacity(frames), Vec::with_capacity(frames)];
         const ROUND: u32 = 10;
-        let mut acc = Progressive::new(&ctx, (width, height), (width, height), 1)?;
         'rounds: for round in 0..frames.div_ceil(ROUND as usize) + 2 {
             for (k, v) in variants.iter().enumerate() {
-                match acc.time_repeated(&ctx, &mut tracer, &world, &view, &params, *v, spp, ROUND) {
+                match session.time_repeated(&view, &params, *v, (width, height), spp, ROUND) {
                     Ok(t) if round >= 2 => times[k].extend(t),
                     Ok(_) => {}
                     Err(e) => {
@@ -780,7 +762,6 @@ fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<
                 }
             }
         }
-        acc.destroy(&ctx);
         if failure.is_some() {
             break;
         }
@@ -788,9 +769,7 @@ fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<
             text += &format!("{label}: this queue cannot take timestamps\n");
             continue;
         }
-        let rays = match tracer.render_counted_variant(
-            &ctx,
-            &world,
+        let rays = match session.render_counted(
             &view,
             &params,
             &render::cpu::RenderJob {
@@ -799,7 +778,7 @@ fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<
                 spp,
                 seed: 0,
             },
-            scene_variant,
+            Some(scene_variant),
         ) {
             Ok((_, _, rays)) => rays,
             Err(e) => {
@@ -808,9 +787,8 @@ fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<
             }
         };
         let n = times[0].len();
-        let stats = tracer
-            .statistics(&ctx, scene_variant)
-            .unwrap_or_default()
+        let stats = session
+            .statistics(scene_variant)
             .into_iter()
             .map(|(k, v)| format!("{k}={v}"))
             .collect::<Vec<_>>()
@@ -845,8 +823,6 @@ fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<
             rays.max_steps[1],
         );
     }
-    tracer.destroy(&ctx);
-    world.destroy(&ctx);
     if let Some(e) = failure {
         return Err(e.into());
     }
@@ -857,9 +833,7 @@ fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<
 /// then renders of 1, 2, 4 … 256 samples with other seeds, each three times (the middle time
 /// and the mean MSE are used).
 fn convergence_table(
-    ctx: &render::vulkan::GpuContext,
-    tracer: &mut render::vulkan::trace::PathTracer,
-    world: &render::vulkan::world::GpuWorld,
+    session: &mut render::viewport::Viewport,
     view: &brickmap::WorldView<'_>,
     params: &render::SceneParams,
     (width, height): (u32, u32),
@@ -874,7 +848,7 @@ fn convergence_table(
     };
     let (reference, reference_time) = with_progress(
         format!("reference: {width}x{height} at {reference_spp} spp"),
-        || Ok(tracer.render(ctx, world, view, params, &job(reference_spp, 1))?),
+        || Ok(session.render(view, params, &job(reference_spp, 1))?),
     )?;
     let Some(reference_time) = reference_time else {
         bail!("this queue cannot take timestamps");
@@ -884,7 +858,7 @@ fn convergence_table(
     for spp in (0..9).map(|k| 1u32 << k) {
         let (mut times, mut mse) = (Vec::new(), 0.0);
         for seed in 2..5 {
-            let (image, time) = tracer.render(ctx, world, view, params, &job(spp, seed))?;
+            let (image, time) = session.render(view, params, &job(spp, seed))?;
             times.push(time.unwrap_or(f64::NAN));
             mse += image.mse(&reference).context("image sizes differ")? / 3.0;
         }
@@ -943,34 +917,19 @@ fn render_on(
             ),
         )
     } else {
-        use render::vulkan::{
-            ContextOptions, DeviceChoice, GpuContext, trace::PathTracer, world::GpuWorld,
-        };
-        let choice = if device == "gpu" {
-            DeviceChoice::Best
-        } else {
-            DeviceChoice::Name(device.to_string())
-        };
-        let ctx = GpuContext::new(&ContextOptions {
-            device: choice,
-            validation: false,
-        })
-        .with_context(
-            || "no usable Vulkan device (the CPU reference renderer runs with --device cpu)",
-        )?;
-        let world = GpuWorld::upload(&ctx, view)?;
-        let mut tracer = PathTracer::new(&ctx)?;
-        tracer.set_samples_per_dispatch(samples_per_dispatch);
-        tracer.set_sample_slices(slices);
+        let mut session = app::gpu::session(device, view)?;
+        session
+            .tracer()
+            .set_samples_per_dispatch(samples_per_dispatch);
+        session.tracer().set_sample_slices(slices);
+        let name = session.ctx().name.clone();
         let rendered = with_progress(
             format!(
-                "rendering {}x{} at {} spp on {}",
-                job.width, job.height, job.spp, ctx.name
+                "rendering {}x{} at {} spp on {name}",
+                job.width, job.height, job.spp
             ),
-            || Ok(tracer.render_counted(&ctx, &world, view, params, job)?),
+            || Ok(session.render_counted(view, params, job, None)?),
         );
-        tracer.destroy(&ctx);
-        world.destroy(&ctx);
         let (image, gpu, rays) = rendered?;
         let timing = match gpu {
             Some(t) => format!(
@@ -987,6 +946,6 @@ fn render_on(
                 started.elapsed().as_secs_f64()
             ),
         };
-        (image, ctx.name.clone(), timing)
+        (image, name, timing)
     })
 }

@@ -1,10 +1,13 @@
 //! The renderer: the scene parameters, the CPU reference path tracer (`cpu`) and images;
-//! the Vulkan compute path tracer arrives with the rest of its issue.
+//! the Vulkan layer (`vulkan`), the GPU session every caller uses (`viewport`) and the
+//! window presenter with egui painting (`present`).
 
 pub mod convergence;
 pub mod cpu;
 pub mod image;
 pub mod params;
+pub mod present;
+pub mod viewport;
 pub mod vulkan;
 
 pub use image::Image;

@@ -12,6 +12,7 @@ fn context(device: DeviceChoice) -> Option<GpuContext> {
     match GpuContext::new(&ContextOptions {
         device,
         validation: true,
+        ..Default::default()
     }) {
         Ok(c) => Some(c),
         Err(e @ GpuError::NoVulkan(_))
@@ -78,7 +79,7 @@ fn unknown_device_names_are_a_clear_error() {
     }
     let err = GpuContext::new(&ContextOptions {
         device: DeviceChoice::Name("no such gpu 9000".into()),
-        validation: false,
+        ..Default::default()
     })
     .err()
     .expect("no such device");

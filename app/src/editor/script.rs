@@ -397,22 +397,10 @@ fn render_step(
         );
         (cpu(r.seed), "cpu".to_string())
     } else {
-        use render::vulkan::{
-            ContextOptions, DeviceChoice, GpuContext, trace::PathTracer, world::GpuWorld,
-        };
-        let choice = if options.device == "gpu" {
-            DeviceChoice::Best
-        } else {
-            DeviceChoice::Name(options.device.clone())
-        };
-        let ctx = GpuContext::new(&ContextOptions { device: choice, validation: false })
-            .context("no usable Vulkan device for render steps (replay with --device cpu for the CPU reference)")?;
-        let world = GpuWorld::upload(&ctx, &view)?;
-        let mut tracer = PathTracer::new(&ctx)?;
-        let rendered = tracer.render(&ctx, &world, &view, &params, &job(r.seed));
-        tracer.destroy(&ctx);
-        world.destroy(&ctx);
-        (rendered?.0, ctx.name.clone())
+        let mut session = crate::gpu::session(&options.device, &view)
+            .context("no GPU for render steps (replay with --device cpu for the CPU reference)")?;
+        let rendered = session.render(&view, &params, &job(r.seed))?;
+        (rendered.0, session.ctx().name.clone())
     };
     ensure!(image.all_finite(), "the image has NaN or infinite pixels");
     let mean = image.mean();

@@ -1,7 +1,7 @@
 //! Storage buffers (host-visible ones the CPU writes and reads back, device-local ones that
 //! copies fill), bindings of buffer ranges, and reading a device-local range back.
 
-use super::staging::{barrier, before_transfer};
+use super::barrier::{barrier, before_transfer};
 use super::{GpuContext, GpuError, vk_call};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -52,10 +52,7 @@ impl HostBuffer {
         })?;
         // SAFETY: plain query on a live buffer.
         let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
-        let mut guard = ctx.allocator.lock().expect("allocator lock");
-        let allocator = guard
-            .as_mut()
-            .expect("allocator lives as long as the context");
+        let mut allocator = ctx.allocator.lock().expect("allocator lock");
         let allocation = match allocator.allocate(&AllocationCreateDesc {
             name,
             requirements,
@@ -126,8 +123,7 @@ impl HostBuffer {
     /// Frees the buffer (the GPU must be done with it).
     pub fn destroy(mut self, ctx: &GpuContext) {
         if let Some(a) = self.allocation.take()
-            && let Ok(mut guard) = ctx.allocator.lock()
-            && let Some(allocator) = guard.as_mut()
+            && let Ok(mut allocator) = ctx.allocator.lock()
         {
             let _ = allocator.free(a);
         }

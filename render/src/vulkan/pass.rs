@@ -1,8 +1,8 @@
 //! A compute pass: one SPIR-V module, N storage buffers in set 0 (bindings 0..N), push
 //! constants, dispatched synchronously with the results made visible to the host.
 
+use super::barrier::barrier;
 use super::buffer::Binding;
-use super::staging::barrier;
 use super::{GpuContext, GpuError, vk_call};
 use ash::vk;
 
@@ -302,27 +302,7 @@ impl ComputePass {
                         .set_layouts(&layouts),
                 ),
             )?[0];
-            let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
-                .iter()
-                .map(|b| {
-                    [vk::DescriptorBufferInfo::default()
-                        .buffer(b.buffer)
-                        .offset(b.offset)
-                        .range(b.range)]
-                })
-                .collect();
-            let writes: Vec<vk::WriteDescriptorSet> = infos
-                .iter()
-                .enumerate()
-                .map(|(b, info)| {
-                    vk::WriteDescriptorSet::default()
-                        .dst_set(set)
-                        .dst_binding(b as u32)
-                        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                        .buffer_info(info)
-                })
-                .collect();
-            d.update_descriptor_sets(&writes, &[]);
+            write_set(ctx, set, buffers);
             Ok(set)
         }
     }
@@ -417,5 +397,126 @@ impl ComputePass {
             d.destroy_descriptor_set_layout(self.set_layout, None);
             d.destroy_shader_module(self.module, None);
         }
+    }
+}
+
+/// Points `set`'s bindings 0.. at `buffers`.
+fn write_set(ctx: &GpuContext, set: vk::DescriptorSet, buffers: &[Binding]) {
+    let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
+        .iter()
+        .map(|b| {
+            [vk::DescriptorBufferInfo::default()
+                .buffer(b.buffer)
+                .offset(b.offset)
+                .range(b.range)]
+        })
+        .collect();
+    let writes: Vec<vk::WriteDescriptorSet> = infos
+        .iter()
+        .enumerate()
+        .map(|(b, info)| {
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(b as u32)
+                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                .buffer_info(info)
+        })
+        .collect();
+    // SAFETY: the set is not in use by a pending submission (fresh from its pool).
+    unsafe { ctx.device.update_descriptor_sets(&writes, &[]) };
+}
+
+/// Descriptor sets made once per (pass, buffers) and kept: what one frame slot of the
+/// interactive loop binds. When the buffers change (a grown world, a resized image) new sets
+/// are made; [`SetCache::clear`] drops them all once the slot's submission is done.
+pub struct SetCache {
+    pool: vk::DescriptorPool,
+    sets: std::collections::HashMap<
+        (vk::DescriptorSetLayout, Vec<(vk::Buffer, u64, u64)>),
+        vk::DescriptorSet,
+    >,
+}
+
+/// Sets a cache holds before it starts over.
+const CACHED_SETS: u32 = 32;
+/// New sets one frame may make: trace, shadow and display passes, with room to spare.
+pub const SET_HEADROOM: u32 = 8;
+/// Storage buffers per cached set at most.
+const CACHED_BUFFERS: u32 = 16;
+
+impl SetCache {
+    /// An empty cache with its own pool.
+    pub fn new(ctx: &GpuContext) -> Result<Self, GpuError> {
+        let sizes = [vk::DescriptorPoolSize::default()
+            .ty(vk::DescriptorType::STORAGE_BUFFER)
+            .descriptor_count(CACHED_SETS * CACHED_BUFFERS)];
+        let info = vk::DescriptorPoolCreateInfo::default()
+            .max_sets(CACHED_SETS)
+            .pool_sizes(&sizes);
+        // SAFETY: the create info outlives the call; the pool is destroyed in `destroy`.
+        let pool = vk_call("vkCreateDescriptorPool", unsafe {
+            ctx.device.create_descriptor_pool(&info, None)
+        })?;
+        Ok(Self {
+            pool,
+            sets: Default::default(),
+        })
+    }
+
+    /// The set binding `buffers` for `pass`, made on first use (at most [`SET_HEADROOM`]
+    /// new ones per frame after [`SetCache::trim`]).
+    pub fn get(
+        &mut self,
+        ctx: &GpuContext,
+        pass: &ComputePass,
+        buffers: &[Binding],
+    ) -> Result<vk::DescriptorSet, GpuError> {
+        assert_eq!(buffers.len() as u32, pass.buffers, "one buffer per binding");
+        let key = (
+            pass.set_layout,
+            buffers
+                .iter()
+                .map(|b| (b.buffer, b.offset, b.range))
+                .collect(),
+        );
+        if let Some(&set) = self.sets.get(&key) {
+            return Ok(set);
+        }
+        let layouts = [pass.set_layout];
+        // SAFETY: pool and layout are alive.
+        let set = vk_call("vkAllocateDescriptorSets", unsafe {
+            ctx.device.allocate_descriptor_sets(
+                &vk::DescriptorSetAllocateInfo::default()
+                    .descriptor_pool(self.pool)
+                    .set_layouts(&layouts),
+            )
+        })?[0];
+        write_set(ctx, set, buffers);
+        self.sets.insert(key, set);
+        Ok(set)
+    }
+
+    /// At the start of a frame, once the slot's previous submission finished: starts over
+    /// when fewer than [`SET_HEADROOM`] sets are left.
+    pub fn trim(&mut self, ctx: &GpuContext) {
+        if self.sets.len() as u32 + SET_HEADROOM > CACHED_SETS {
+            self.clear(ctx);
+        }
+    }
+
+    /// Drops every set (no pending submission may use them).
+    pub fn clear(&mut self, ctx: &GpuContext) {
+        self.sets.clear();
+        // SAFETY: the caller guarantees no pending submission uses the sets.
+        let _ = unsafe {
+            ctx.device
+                .reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty())
+        };
+    }
+
+    /// Destroys the pool (no pending submission may use its sets).
+    pub fn destroy(self, ctx: &GpuContext) {
+        // SAFETY: as above.
+        unsafe { ctx.device.destroy_descriptor_pool(self.pool, None) };
     }
 }

@@ -4,9 +4,10 @@
 //! applies exposure, the ACES fitted curve and sRGB, and upscales bilinearly to the output
 //! resolution (exposure is display-only: changing it keeps the samples).
 
-use super::buffer::{HostBuffer, read_device};
+use super::buffer::{Binding, HostBuffer, read_device};
+use super::pass::SetCache;
 use super::tonemap::ToneMapper;
-use super::trace::{MAX_SAMPLES_PER_DISPATCH, PathTracer, TraceParams, Variant};
+use super::trace::{MAX_SAMPLES_PER_DISPATCH, PathTracer, RayCounts, TraceParams, Variant};
 use super::world::GpuWorld;
 use super::{GpuContext, GpuError};
 use crate::cpu::RenderJob;
@@ -144,14 +145,7 @@ impl Progressive {
         spp: u32,
     ) -> Result<(Option<f64>, bool), GpuError> {
         let base = TraceParams::new(view, params, &self.job(spp));
-        let mut hasher = DefaultHasher::new();
-        base.image_key().hash(&mut hasher);
-        variant.hash(&mut hasher);
-        let key = hasher.finish();
-        if self.key != Some(key) {
-            self.samples = 0;
-            self.key = Some(key);
-        }
+        self.check_key(&base, variant);
         let restarted = self.samples == 0;
         let mut gpu = Some(0.0);
         let mut done = 0;
@@ -187,6 +181,75 @@ impl Progressive {
             done += batch;
         }
         Ok((gpu, restarted))
+    }
+
+    /// Starts over when the image key (every trace parameter and the variant) changed.
+    fn check_key(&mut self, base: &TraceParams, variant: Variant) {
+        let mut hasher = DefaultHasher::new();
+        base.image_key().hash(&mut hasher);
+        variant.hash(&mut hasher);
+        let key = hasher.finish();
+        if self.key != Some(key) {
+            self.samples = 0;
+            self.key = Some(key);
+        }
+    }
+
+    /// The interactive frame's trace: records one dispatch of up to `spp` samples per pixel,
+    /// never past `target` in all
+    /// (fewer when the tracer's batch shape says so) into `cmd` with the frame slot's
+    /// parameter buffer and sets, without submitting; restarts on a changed key. Returns
+    /// (samples added, whether it restarted). `base` is [`TraceParams::new`] for this
+    /// accumulation's size, computed by the caller under a short world read lock.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_batch(
+        &mut self,
+        ctx: &GpuContext,
+        cmd: ash::vk::CommandBuffer,
+        tracer: &mut PathTracer,
+        world: &GpuWorld,
+        base: TraceParams,
+        variant: Variant,
+        (spp, target): (u32, u32),
+        uniforms: &mut HostBuffer,
+        sets: &mut SetCache,
+    ) -> Result<(u32, bool), GpuError> {
+        self.check_key(&base, variant);
+        let restarted = self.samples == 0;
+        let spp = spp.min(target.saturating_sub(self.samples));
+        if spp == 0 {
+            return Ok((0, restarted));
+        }
+        let pixels = self.internal.0 as u64 * self.internal.1 as u64;
+        let (per, split) = batch_shape(
+            spp,
+            tracer.samples_per_dispatch(pixels),
+            tracer.sample_slices(pixels),
+        );
+        let p = base.batch(per, self.samples, self.samples > 0);
+        tracer.record(
+            ctx,
+            cmd,
+            world,
+            variant,
+            &p,
+            split,
+            uniforms,
+            self.accum.binding(),
+            sets,
+        )?;
+        self.samples += per * split;
+        Ok((per * split, restarted))
+    }
+
+    /// The accumulation buffer (radiance sum and count per pixel).
+    pub fn accumulation(&self) -> Binding {
+        self.accum.binding()
+    }
+
+    /// The job this accumulation traces, `spp` samples per pixel.
+    pub fn job_of(&self, spp: u32) -> RenderJob {
+        self.job(spp)
     }
 
     /// Benchmarks: GPU times of `count` back-to-back dispatches of the same first batch of
@@ -266,6 +329,82 @@ impl Progressive {
     pub fn destroy(self, ctx: &GpuContext) {
         self.accum.destroy(ctx);
         self.uniforms.destroy(ctx);
+    }
+}
+
+/// One-shot renders (CLI, scripts, tests): an accumulation of the image's size, filled and
+/// read back. Here rather than in trace.rs so the tracer does not depend on the accumulation.
+impl PathTracer {
+    /// Renders `job.spp` samples per pixel with the scene's variant; returns the linear image
+    /// and the GPU time spent (timestamp queries summed over the dispatches; None when the
+    /// queue cannot time). Samples accumulate on the GPU in batches of
+    /// [`PathTracer::samples_per_dispatch`], at most [`MAX_SAMPLES_PER_DISPATCH`]:
+    /// long-running invocations lose samples on lavapipe (measured: 256 samples per invocation
+    /// came out 9% dark there, exact on the H100), and short dispatches are what a viewport
+    /// does anyway.
+    pub fn render(
+        &mut self,
+        ctx: &GpuContext,
+        world: &GpuWorld,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        job: &RenderJob,
+    ) -> Result<(Image, Option<f64>), GpuError> {
+        let variant = Variant::for_scene(view.materials(), params);
+        self.render_variant(ctx, world, view, params, job, variant)
+    }
+
+    /// [`PathTracer::render`] with a chosen variant (benchmarks compare variants; a variant
+    /// lacking something the scene has renders it wrongly).
+    pub fn render_variant(
+        &mut self,
+        ctx: &GpuContext,
+        world: &GpuWorld,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        job: &RenderJob,
+        variant: Variant,
+    ) -> Result<(Image, Option<f64>), GpuError> {
+        let size = (job.width, job.height);
+        let mut acc = Progressive::new(ctx, size, size, job.seed)?;
+        let result = acc
+            .accumulate(ctx, self, world, view, params, variant, job.spp)
+            .and_then(|(gpu, _)| acc.hdr(ctx).map(|img| (img, gpu)));
+        acc.destroy(ctx);
+        result
+    }
+
+    /// [`PathTracer::render`] with a counting variant of the scene's (the same image, plus
+    /// one atomic add per pixel and dispatch): also returns the rays traced, by kind.
+    pub fn render_counted(
+        &mut self,
+        ctx: &GpuContext,
+        world: &GpuWorld,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        job: &RenderJob,
+    ) -> Result<(Image, Option<f64>, RayCounts), GpuError> {
+        let variant = Variant::for_scene(view.materials(), params);
+        self.render_counted_variant(ctx, world, view, params, job, variant)
+    }
+
+    /// [`PathTracer::render_counted`] with a chosen variant.
+    pub fn render_counted_variant(
+        &mut self,
+        ctx: &GpuContext,
+        world: &GpuWorld,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        job: &RenderJob,
+        variant: Variant,
+    ) -> Result<(Image, Option<f64>, RayCounts), GpuError> {
+        let variant = Variant {
+            count_rays: true,
+            ..variant
+        };
+        self.reset_counters();
+        let (image, gpu) = self.render_variant(ctx, world, view, params, job, variant)?;
+        Ok((image, gpu, self.read_counters()))
     }
 }
 

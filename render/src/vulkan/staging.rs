@@ -5,6 +5,7 @@
 //! uploads own their bytes (copied when they were queued), so a deferred upload never reads
 //! world data that may have changed since.
 
+use super::barrier::{after_transfer, barrier, before_transfer};
 use super::buffer::HostBuffer;
 use super::{GpuContext, GpuError, vk_call};
 use ash::vk;
@@ -279,71 +280,4 @@ fn push_copy(
         }
     }
     commands.push((dst, vec![c]));
-}
-
-/// Orders transfers after earlier shader and transfer writes and reads (WAR and WAW).
-///
-/// # Safety
-/// `cmd` must be recording.
-pub(crate) unsafe fn before_transfer(ctx: &GpuContext, cmd: vk::CommandBuffer) {
-    // SAFETY: forwarded from the caller.
-    unsafe {
-        barrier(
-            ctx,
-            cmd,
-            vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
-            vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
-            vk::PipelineStageFlags::TRANSFER,
-            vk::AccessFlags::TRANSFER_READ | vk::AccessFlags::TRANSFER_WRITE,
-        )
-    }
-}
-
-/// Makes transfer writes visible to later compute shaders and transfers.
-///
-/// # Safety
-/// `cmd` must be recording.
-pub(crate) unsafe fn after_transfer(ctx: &GpuContext, cmd: vk::CommandBuffer) {
-    // SAFETY: forwarded from the caller.
-    unsafe {
-        barrier(
-            ctx,
-            cmd,
-            vk::PipelineStageFlags::TRANSFER,
-            vk::AccessFlags::TRANSFER_WRITE,
-            vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::TRANSFER,
-            vk::AccessFlags::SHADER_READ
-                | vk::AccessFlags::TRANSFER_READ
-                | vk::AccessFlags::TRANSFER_WRITE,
-        )
-    }
-}
-
-/// A global memory barrier.
-///
-/// # Safety
-/// `cmd` must be recording.
-pub(crate) unsafe fn barrier(
-    ctx: &GpuContext,
-    cmd: vk::CommandBuffer,
-    src_stage: vk::PipelineStageFlags,
-    src_access: vk::AccessFlags,
-    dst_stage: vk::PipelineStageFlags,
-    dst_access: vk::AccessFlags,
-) {
-    let b = [vk::MemoryBarrier::default()
-        .src_access_mask(src_access)
-        .dst_access_mask(dst_access)];
-    // SAFETY: the caller guarantees `cmd` is recording.
-    unsafe {
-        ctx.device.cmd_pipeline_barrier(
-            cmd,
-            src_stage,
-            dst_stage,
-            vk::DependencyFlags::empty(),
-            &b,
-            &[],
-            &[],
-        )
-    };
 }

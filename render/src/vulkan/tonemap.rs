@@ -4,9 +4,10 @@
 //! `Image::resized_bilinear` and `Image::to_srgb8` on the CPU.
 
 use super::buffer::{Binding, HostBuffer};
-use super::pass::ComputePass;
+use super::pass::{ComputePass, Dispatch, SetCache};
 use super::{GpuContext, GpuError};
 use crate::image::Image;
+use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 const SPIRV: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/tonemap.comp.spv"));
@@ -18,8 +19,9 @@ struct Push {
     src: [u32; 2],
     dst: [u32; 2],
     scale: f32,
+    bgra: u32,
 }
-const _: () = assert!(std::mem::size_of::<Push>() == 20);
+const _: () = assert!(std::mem::size_of::<Push>() == 24);
 
 /// The display pipeline.
 pub struct ToneMapper(ComputePass);
@@ -51,6 +53,7 @@ impl ToneMapper {
             src: [src.0, src.1],
             dst: [dst.0, dst.1],
             scale: 2f32.powf(exposure),
+            bgra: 0,
         };
         let result = self.0.run(
             ctx,
@@ -66,6 +69,37 @@ impl ToneMapper {
         });
         ldr.destroy(ctx);
         out
+    }
+
+    /// Records the display of `hdr` (size `src`) into `ldr` (packed 8-bit, size `dst`,
+    /// in B, G, R, A byte order when `bgra`) without submitting; the set comes from `sets`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        sets: &mut SetCache,
+        hdr: Binding,
+        ldr: Binding,
+        (src, dst): ((u32, u32), (u32, u32)),
+        exposure: f32,
+        bgra: bool,
+    ) -> Result<(), GpuError> {
+        let push = Push {
+            src: [src.0, src.1],
+            dst: [dst.0, dst.1],
+            scale: 2f32.powf(exposure),
+            bgra: bgra as u32,
+        };
+        let set = sets.get(ctx, &self.0, &[hdr, ldr])?;
+        self.0.record(
+            ctx,
+            cmd,
+            set,
+            bytemuck::bytes_of(&push),
+            Dispatch::Groups(dst.0.div_ceil(8), dst.1.div_ceil(8), 1),
+        );
+        Ok(())
     }
 
     /// Tone-maps a linear image on the GPU at its own size; returns sRGB 8-bit pixels.

@@ -4,14 +4,12 @@
 //! queued and traced by a second pass (`shaders/shadow.comp`, one invocation per ray) where
 //! the device can (float atomic adds, subgroup ballots).
 
+use super::barrier::barrier;
 use super::buffer::{Binding, HostBuffer};
-use super::pass::{ComputePass, Dispatch, run_batch};
-use super::progressive::Progressive;
-use super::staging::barrier;
+use super::pass::{ComputePass, Dispatch, SetCache, run_batch};
 use super::world::GpuWorld;
 use super::{GpuContext, GpuError};
 use crate::cpu::RenderJob;
-use crate::image::Image;
 use crate::params::{SceneParams, Sky};
 use ash::vk;
 use brickmap::{MaterialKind, MaterialTable, WorldView};
@@ -274,6 +272,16 @@ struct ShadowQueue {
     capacity: u64,
 }
 
+/// A dispatch ready to record: which pipelines, what they bind, how many groups.
+struct Plan {
+    pass: (Variant, bool, bool),
+    shadow: Option<(bool, u32)>,
+    bound: Vec<Binding>,
+    groups: Dispatch,
+    zero: Option<Binding>,
+    header: Option<Binding>,
+}
+
 /// The path-tracing pipelines, one per variant in use.
 pub struct PathTracer {
     /// Trace pipelines by variant, shadow queue and sample slicing.
@@ -497,6 +505,62 @@ impl PathTracer {
         count: u32,
         time: bool,
     ) -> Result<Vec<f64>, GpuError> {
+        let plan = self.plan(ctx, world, variant, p, slices, uniforms, accum)?;
+        let (trace, shadow) = self.passes_of(&plan);
+        let trace_set = trace.allocate_set(ctx, &plan.bound)?;
+        let shadow_set = match shadow.map(|s| s.allocate_set(ctx, &plan.bound)).transpose() {
+            Ok(set) => set,
+            Err(e) => {
+                trace.free_set(ctx, trace_set);
+                return Err(e);
+            }
+        };
+        let result = run_batch(ctx, count, time, |cmd| {
+            self.record_plan(ctx, cmd, &plan, trace_set, shadow_set)
+        });
+        trace.free_set(ctx, trace_set);
+        if let (Some(s), Some(set)) = (shadow, shadow_set) {
+            s.free_set(ctx, set);
+        }
+        result
+    }
+
+    /// Records one dispatch of `p` into `cmd` without submitting (the interactive frame):
+    /// like [`PathTracer::dispatch`], with descriptor sets from `sets` (made once per
+    /// binding set and kept). The caller orders it after earlier writes to the buffers.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &mut self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        world: &GpuWorld,
+        variant: Variant,
+        p: &TraceParams,
+        slices: u32,
+        uniforms: &mut HostBuffer,
+        accum: Binding,
+        sets: &mut SetCache,
+    ) -> Result<(), GpuError> {
+        let plan = self.plan(ctx, world, variant, p, slices, uniforms, accum)?;
+        let (trace, shadow) = self.passes_of(&plan);
+        let trace_set = sets.get(ctx, trace, &plan.bound)?;
+        let shadow_set = shadow.map(|s| sets.get(ctx, s, &plan.bound)).transpose()?;
+        self.record_plan(ctx, cmd, &plan, trace_set, shadow_set);
+        Ok(())
+    }
+
+    /// Builds what a dispatch needs (pipelines, queue) and writes its parameters.
+    #[allow(clippy::too_many_arguments)]
+    fn plan(
+        &mut self,
+        ctx: &GpuContext,
+        world: &GpuWorld,
+        variant: Variant,
+        p: &TraceParams,
+        slices: u32,
+        uniforms: &mut HostBuffer,
+        accum: Binding,
+    ) -> Result<Plan, GpuError> {
         let slices = if self.can_slice {
             slices.clamp(1, MAX_SLICES)
         } else {
@@ -520,154 +584,94 @@ impl PathTracer {
             // Unused without the queue (SHADOW_QUEUE is false): any valid buffer.
             None => bound.extend([self.counters.binding(), self.counters.binding()]),
         }
-        let trace = &self.passes[&(variant, queued, sliced)];
-        let shadow = self
-            .shadow_passes
-            .get(&(variant.count_rays, variant.experiment))
-            .filter(|_| queued);
-        let trace_set = trace.allocate_set(ctx, &bound)?;
-        let shadow_set = match shadow.map(|s| s.allocate_set(ctx, &bound)).transpose() {
-            Ok(set) => set,
-            Err(e) => {
-                trace.free_set(ctx, trace_set);
-                return Err(e);
+        Ok(Plan {
+            pass: (variant, queued, sliced),
+            shadow: queued.then_some((variant.count_rays, variant.experiment)),
+            bound,
+            groups: Dispatch::Groups(p.image[0].div_ceil(8), p.image[1].div_ceil(8), slices),
+            // The sliced shader only adds: a new accumulation starts from zero.
+            zero: (sliced && p.seed[3] == 0).then_some(accum),
+            header: queue.map(|q| q.header.binding()),
+        })
+    }
+
+    fn passes_of(&self, plan: &Plan) -> (&ComputePass, Option<&ComputePass>) {
+        (
+            &self.passes[&plan.pass],
+            plan.shadow.map(|k| &self.shadow_passes[&k]),
+        )
+    }
+
+    /// Records a planned dispatch: zeroing and queue reset, the trace pass, the shadow pass.
+    fn record_plan(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        plan: &Plan,
+        trace_set: vk::DescriptorSet,
+        shadow_set: Option<vk::DescriptorSet>,
+    ) {
+        let (trace, shadow) = self.passes_of(plan);
+        // SAFETY: recording; the accumulation range and the 16-byte queue header are
+        // transfer destinations.
+        unsafe {
+            if let Some(a) = plan.zero {
+                ctx.device
+                    .cmd_fill_buffer(cmd, a.buffer, a.offset, a.range, 0);
             }
-        };
-        let groups = Dispatch::Groups(p.image[0].div_ceil(8), p.image[1].div_ceil(8), slices);
-        // The sliced shader only adds: a new accumulation starts from zero.
-        let zero = (sliced && p.seed[3] == 0).then_some(accum);
-        let result = run_batch(ctx, count, time, |cmd| {
-            let q = queue.map(|q| q.header.binding());
-            // SAFETY: recording; the accumulation range and the 16-byte queue header are
-            // transfer destinations.
-            unsafe {
-                if let Some(a) = zero {
-                    ctx.device
-                        .cmd_fill_buffer(cmd, a.buffer, a.offset, a.range, 0);
-                }
-                if let Some(h) = q {
-                    ctx.device.cmd_update_buffer(
-                        cmd,
-                        h.buffer,
-                        h.offset,
-                        bytemuck::cast_slice(&QUEUE_RESET),
-                    );
-                }
-                if zero.is_some() || q.is_some() {
-                    barrier(
-                        ctx,
-                        cmd,
-                        vk::PipelineStageFlags::TRANSFER,
-                        vk::AccessFlags::TRANSFER_WRITE,
-                        vk::PipelineStageFlags::COMPUTE_SHADER,
-                        vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
-                    );
-                }
+            if let Some(h) = plan.header {
+                ctx.device.cmd_update_buffer(
+                    cmd,
+                    h.buffer,
+                    h.offset,
+                    bytemuck::cast_slice(&QUEUE_RESET),
+                );
             }
-            trace.record(ctx, cmd, trace_set, &[], groups);
-            if let (Some(h), Some(shadow), Some(set)) = (q, shadow, shadow_set) {
-                // SAFETY: recording.
-                unsafe {
-                    barrier(
-                        ctx,
-                        cmd,
-                        vk::PipelineStageFlags::COMPUTE_SHADER,
-                        vk::AccessFlags::SHADER_WRITE,
-                        vk::PipelineStageFlags::COMPUTE_SHADER
-                            | vk::PipelineStageFlags::DRAW_INDIRECT,
-                        vk::AccessFlags::SHADER_READ
-                            | vk::AccessFlags::SHADER_WRITE
-                            | vk::AccessFlags::INDIRECT_COMMAND_READ,
-                    );
-                }
-                shadow.record(ctx, cmd, set, &[], Dispatch::Indirect(h.buffer, h.offset));
+            if plan.zero.is_some() || plan.header.is_some() {
+                barrier(
+                    ctx,
+                    cmd,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                    vk::PipelineStageFlags::COMPUTE_SHADER,
+                    vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
+                );
             }
-        });
-        trace.free_set(ctx, trace_set);
-        if let (Some(s), Some(set)) = (shadow, shadow_set) {
-            s.free_set(ctx, set);
         }
-        result
+        trace.record(ctx, cmd, trace_set, &[], plan.groups);
+        if let (Some(h), Some(shadow), Some(set)) = (plan.header, shadow, shadow_set) {
+            // SAFETY: recording.
+            unsafe {
+                barrier(
+                    ctx,
+                    cmd,
+                    vk::PipelineStageFlags::COMPUTE_SHADER,
+                    vk::AccessFlags::SHADER_WRITE,
+                    vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::DRAW_INDIRECT,
+                    vk::AccessFlags::SHADER_READ
+                        | vk::AccessFlags::SHADER_WRITE
+                        | vk::AccessFlags::INDIRECT_COMMAND_READ,
+                );
+            }
+            shadow.record(ctx, cmd, set, &[], Dispatch::Indirect(h.buffer, h.offset));
+        }
     }
 
-    /// Renders `job.spp` samples per pixel with the scene's variant; returns the linear image
-    /// and the GPU time spent (timestamp queries summed over the dispatches; None when the
-    /// queue cannot time). Samples accumulate on the GPU in batches of
-    /// [`PathTracer::samples_per_dispatch`], at most [`MAX_SAMPLES_PER_DISPATCH`]:
-    /// long-running invocations lose samples on lavapipe (measured: 256 samples per invocation
-    /// came out 9% dark there, exact on the H100), and short dispatches are what a viewport
-    /// does anyway.
-    pub fn render(
-        &mut self,
-        ctx: &GpuContext,
-        world: &GpuWorld,
-        view: &WorldView<'_>,
-        params: &SceneParams,
-        job: &RenderJob,
-    ) -> Result<(Image, Option<f64>), GpuError> {
-        let variant = Variant::for_scene(view.materials(), params);
-        self.render_variant(ctx, world, view, params, job, variant)
-    }
-
-    /// [`PathTracer::render`] with a chosen variant (benchmarks compare variants; a variant
-    /// lacking something the scene has renders it wrongly).
-    pub fn render_variant(
-        &mut self,
-        ctx: &GpuContext,
-        world: &GpuWorld,
-        view: &WorldView<'_>,
-        params: &SceneParams,
-        job: &RenderJob,
-        variant: Variant,
-    ) -> Result<(Image, Option<f64>), GpuError> {
-        let size = (job.width, job.height);
-        let mut acc = Progressive::new(ctx, size, size, job.seed)?;
-        let result = acc
-            .accumulate(ctx, self, world, view, params, variant, job.spp)
-            .and_then(|(gpu, _)| acc.hdr(ctx).map(|img| (img, gpu)));
-        acc.destroy(ctx);
-        result
-    }
-
-    /// [`PathTracer::render`] with a counting variant of the scene's (the same image, plus
-    /// one atomic add per pixel and dispatch): also returns the rays traced, by kind.
-    pub fn render_counted(
-        &mut self,
-        ctx: &GpuContext,
-        world: &GpuWorld,
-        view: &WorldView<'_>,
-        params: &SceneParams,
-        job: &RenderJob,
-    ) -> Result<(Image, Option<f64>, RayCounts), GpuError> {
-        let variant = Variant::for_scene(view.materials(), params);
-        self.render_counted_variant(ctx, world, view, params, job, variant)
-    }
-
-    /// [`PathTracer::render_counted`] with a chosen variant.
-    pub fn render_counted_variant(
-        &mut self,
-        ctx: &GpuContext,
-        world: &GpuWorld,
-        view: &WorldView<'_>,
-        params: &SceneParams,
-        job: &RenderJob,
-        variant: Variant,
-    ) -> Result<(Image, Option<f64>, RayCounts), GpuError> {
-        let variant = Variant {
-            count_rays: true,
-            ..variant
-        };
+    /// Zeroes the ray counters (before a counted render).
+    pub(crate) fn reset_counters(&mut self) {
         self.counters.write(&[0; 32]);
-        let (image, gpu) = self.render_variant(ctx, world, view, params, job, variant)?;
+    }
+
+    /// The ray counters after a counted render.
+    pub(crate) fn read_counters(&self) -> RayCounts {
         let c: [u32; 8] = bytemuck::pod_read_unaligned(&self.counters.read()[..32]);
-        let counts = RayCounts {
+        RayCounts {
             primary: c[0] as u64,
             secondary: c[1] as u64,
             shadow: c[2] as u64,
             steps: [c[3] as u64, c[4] as u64, c[5] as u64],
             max_steps: [c[6] as u64, c[7] as u64],
-        };
-        Ok((image, gpu, counts))
+        }
     }
 
     /// Destroys the pipelines.

@@ -11,8 +11,9 @@
 //! outgrows a region, the buffer is replaced by a larger one and the old contents are copied
 //! on the GPU, so nothing is re-read or lost.
 
+use super::barrier::{after_transfer, before_transfer};
 use super::buffer::{Binding, HostBuffer, read_device};
-use super::staging::{StagingRing, Upload, after_transfer, before_transfer};
+use super::staging::{StagingRing, Upload};
 use super::{GpuContext, GpuError};
 use ash::vk;
 use brickmap::{GpuBuffer, World, WorldView};

@@ -1,0 +1,27 @@
+//! Opening the GPU session for a device named on the command line ("gpu" = the best one, or
+//! part of a device's name): the one place the CLI, replay scripts and benchmarks get a
+//! [`Viewport`] from.
+
+use anyhow::{Context, Result};
+use render::viewport::Viewport;
+use render::vulkan::{ContextOptions, DeviceChoice, GpuContext};
+use std::sync::Arc;
+
+/// The device choice for a `--device` argument other than "cpu".
+pub fn device_choice(device: &str) -> DeviceChoice {
+    if device == "gpu" {
+        DeviceChoice::Best
+    } else {
+        DeviceChoice::Name(device.to_string())
+    }
+}
+
+/// A headless GPU session on `device` with the world of `view` uploaded.
+pub fn session(device: &str, view: &brickmap::WorldView<'_>) -> Result<Viewport> {
+    let ctx = GpuContext::new(&ContextOptions {
+        device: device_choice(device),
+        ..Default::default()
+    })
+    .context("no usable Vulkan device (the CPU reference renderer runs with --device cpu)")?;
+    Ok(Viewport::new(Arc::new(ctx), view)?)
+}

@@ -1,0 +1,444 @@
+//! Presentation: the viewport's display output copied into a window's swapchain image (or
+//! an offscreen image of the window's size, for headless measurement), egui painted on top
+//! with dynamic rendering, then presented. The frame loop's GPU half; it never blocks on the
+//! GPU except when asked for a capture.
+
+use crate::viewport::{FrameRequest, FrameStatus, Viewport};
+use crate::vulkan::buffer::HostBuffer;
+use crate::vulkan::frame::FRAMES_IN_FLIGHT;
+use crate::vulkan::swapchain::{COLOUR, Swapchain, is_bgra};
+use crate::vulkan::{GpuContext, GpuError, vk_call};
+use ash::vk;
+use brickmap::World;
+use egui_ash_renderer::{DynamicRendering, Options, RenderMode, Renderer, allocator::GpuAllocator};
+use gpu_allocator::MemoryLocation;
+use std::sync::Arc;
+
+/// What egui drew this frame.
+pub struct EguiFrame<'a> {
+    /// Tessellated shapes.
+    pub primitives: &'a [egui::ClippedPrimitive],
+    /// Points to pixels.
+    pub pixels_per_point: f32,
+    /// Texture changes (applied before the frame; frees after its fence).
+    pub textures: &'a egui::TexturesDelta,
+}
+
+/// What a call to [`Presenter::frame`] did.
+#[derive(Debug)]
+pub enum Presented {
+    /// A frame went to the screen.
+    Shown(FrameStatus),
+    /// Nothing was drawn: no frame slot or image was free yet (try again soon).
+    NotReady,
+    /// The swapchain was out of date and has been recreated; draw again.
+    Recreated,
+}
+
+/// A captured frame: RGB8 rows top to bottom, exactly what was presented.
+pub struct Capture {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Pixels.
+    pub rgb: Vec<[u8; 3]>,
+}
+
+/// The window's presenter.
+pub struct Presenter {
+    swapchain: Option<Swapchain>,
+    egui: Option<Renderer<GpuAllocator>>,
+    upload_pool: vk::CommandPool,
+    /// egui textures to free once the slot that last used them finished.
+    to_free: [Vec<egui::TextureId>; FRAMES_IN_FLIGHT],
+    recreate: bool,
+    size: (u32, u32),
+    ctx: Arc<GpuContext>,
+}
+
+impl Presenter {
+    /// A presenter for the context's window, `size` pixels.
+    pub fn new(ctx: Arc<GpuContext>, size: (u32, u32)) -> Result<Self, GpuError> {
+        let swapchain = Swapchain::new(ctx.clone(), size, None)?;
+        let egui = Renderer::with_gpu_allocator(
+            Arc::clone(&ctx.allocator),
+            ctx.device.clone(),
+            RenderMode::DynamicRendering(DynamicRendering {
+                color_attachment_format: swapchain.format,
+                depth_attachment_format: None,
+                stencil_attachment_format: None,
+            }),
+            Options {
+                in_flight_frames: FRAMES_IN_FLIGHT,
+                srgb_framebuffer: matches!(
+                    swapchain.format,
+                    vk::Format::B8G8R8A8_SRGB | vk::Format::R8G8B8A8_SRGB
+                ),
+                ..Default::default()
+            },
+        )
+        .map_err(|e| GpuError::NoDevice(format!("egui painter: {e}")))?;
+        // SAFETY: the create info outlives the call; the pool is destroyed in Drop.
+        let upload_pool = vk_call("vkCreateCommandPool", unsafe {
+            ctx.device.create_command_pool(
+                &vk::CommandPoolCreateInfo::default()
+                    .queue_family_index(ctx.queue_family)
+                    .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
+                None,
+            )
+        })?;
+        Ok(Self {
+            swapchain: Some(swapchain),
+            egui: Some(egui),
+            upload_pool,
+            to_free: Default::default(),
+            recreate: false,
+            size,
+            ctx,
+        })
+    }
+
+    /// The window was resized (in physical pixels).
+    pub fn resize(&mut self, size: (u32, u32)) {
+        if size != self.size {
+            self.size = size;
+            self.recreate = true;
+        }
+    }
+
+    /// The swapchain's size, format and present mode.
+    pub fn describe(&self) -> String {
+        self.swapchain.as_ref().map_or_else(String::new, |s| {
+            format!(
+                "{}x{} {:?} {:?}",
+                s.extent.width, s.extent.height, s.format, s.present_mode
+            )
+        })
+    }
+
+    /// Current output size (the swapchain's extent).
+    pub fn extent(&self) -> (u32, u32) {
+        self.swapchain
+            .as_ref()
+            .map_or(self.size, |s| (s.extent.width, s.extent.height))
+    }
+
+    fn recreate_now(&mut self, viewport: &Viewport) -> Result<(), GpuError> {
+        viewport.wait_idle()?;
+        // SAFETY: plain wait; the old swapchain's images must be idle before it goes.
+        vk_call("vkDeviceWaitIdle", unsafe {
+            self.ctx.device.device_wait_idle()
+        })?;
+        let next = Swapchain::new(self.ctx.clone(), self.size, self.swapchain.as_ref())?;
+        self.swapchain = Some(next);
+        self.recreate = false;
+        Ok(())
+    }
+
+    /// Draws one frame: the viewport's trace and display, egui on top, presented. With
+    /// `capture`, waits for the frame and returns the presented pixels.
+    pub fn frame(
+        &mut self,
+        viewport: &mut Viewport,
+        world: &World,
+        req: &FrameRequest<'_>,
+        ui: Option<EguiFrame<'_>>,
+        capture: bool,
+    ) -> Result<(Presented, Option<Capture>), GpuError> {
+        if self.size.0 == 0 || self.size.1 == 0 {
+            return Ok((Presented::NotReady, None));
+        }
+        if self.recreate {
+            self.recreate_now(viewport)?;
+            return Ok((Presented::Recreated, None));
+        }
+        let Some(frame) = viewport.begin_frame()? else {
+            return Ok((Presented::NotReady, None));
+        };
+        let ctx = self.ctx.clone();
+        let d = &ctx.device;
+        let egui = self.egui.as_mut().expect("alive until drop");
+        // The slot finished: textures freed by its last frame can go now.
+        for id in self.to_free[frame.slot()].drain(..) {
+            let _ = egui.free_texture(id);
+        }
+        let swapchain = self.swapchain.as_ref().expect("made in new");
+        let Some((index, suboptimal)) = swapchain.acquire(frame.acquired)? else {
+            self.recreate = true;
+            return Ok((Presented::NotReady, None));
+        };
+        if let Some(ui) = &ui {
+            for (id, deltas) in &ui.textures.set {
+                for delta in deltas {
+                    egui.set_texture(ctx.queue, self.upload_pool, *id, delta)
+                        .map_err(|e| GpuError::NoDevice(format!("egui texture: {e}")))?;
+                }
+            }
+        }
+        let extent = swapchain.extent;
+        let req = FrameRequest {
+            output: (extent.width, extent.height),
+            bgra: is_bgra(swapchain.format),
+            ..*req
+        };
+        let status = viewport.trace_frame(&frame, world, &req)?;
+        let image = swapchain.images[index as usize];
+        let cmd = frame.cmd;
+        let capture_buffer = if capture {
+            Some(HostBuffer::new(
+                &ctx,
+                "capture",
+                extent.width as u64 * extent.height as u64 * 4,
+                MemoryLocation::GpuToCpu,
+            )?)
+        } else {
+            None
+        };
+        // SAFETY: recording into the slot's command buffer; every handle is alive until the
+        // slot's fence signals (the capture buffer: until the wait below).
+        unsafe {
+            image_barrier(
+                d,
+                cmd,
+                image,
+                (
+                    vk::ImageLayout::UNDEFINED,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                ),
+                (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::empty()),
+                (
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                ),
+            );
+            d.cmd_copy_buffer_to_image(
+                cmd,
+                viewport.output(&frame),
+                image,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[vk::BufferImageCopy {
+                    buffer_offset: 0,
+                    buffer_row_length: 0,
+                    buffer_image_height: 0,
+                    image_subresource: LAYER,
+                    image_offset: vk::Offset3D::default(),
+                    image_extent: vk::Extent3D {
+                        width: extent.width,
+                        height: extent.height,
+                        depth: 1,
+                    },
+                }],
+            );
+            image_barrier(
+                d,
+                cmd,
+                image,
+                (
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                ),
+                (
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                ),
+                (
+                    vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT,
+                    vk::AccessFlags::COLOR_ATTACHMENT_READ
+                        | vk::AccessFlags::COLOR_ATTACHMENT_WRITE,
+                ),
+            );
+            if let Some(ui) = &ui {
+                let attachment = [vk::RenderingAttachmentInfo::default()
+                    .image_view(swapchain.views[index as usize])
+                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                    .load_op(vk::AttachmentLoadOp::LOAD)
+                    .store_op(vk::AttachmentStoreOp::STORE)];
+                let info = vk::RenderingInfo::default()
+                    .render_area(vk::Rect2D {
+                        offset: vk::Offset2D::default(),
+                        extent,
+                    })
+                    .layer_count(1)
+                    .color_attachments(&attachment);
+                let rendering = &ctx.presentation.as_ref().expect("window").dynamic_rendering;
+                rendering.cmd_begin_rendering(cmd, &info);
+                egui.cmd_draw(cmd, extent, ui.pixels_per_point, ui.primitives)
+                    .map_err(|e| GpuError::NoDevice(format!("egui draw: {e}")))?;
+                rendering.cmd_end_rendering(cmd);
+            }
+            let last = (
+                vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT,
+                vk::AccessFlags::COLOR_ATTACHMENT_WRITE,
+            );
+            if let Some(buf) = &capture_buffer {
+                image_barrier(
+                    d,
+                    cmd,
+                    image,
+                    (
+                        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    ),
+                    last,
+                    (
+                        vk::PipelineStageFlags::TRANSFER,
+                        vk::AccessFlags::TRANSFER_READ,
+                    ),
+                );
+                d.cmd_copy_image_to_buffer(
+                    cmd,
+                    image,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    buf.raw,
+                    &[vk::BufferImageCopy {
+                        buffer_offset: 0,
+                        buffer_row_length: 0,
+                        buffer_image_height: 0,
+                        image_subresource: LAYER,
+                        image_offset: vk::Offset3D::default(),
+                        image_extent: vk::Extent3D {
+                            width: extent.width,
+                            height: extent.height,
+                            depth: 1,
+                        },
+                    }],
+                );
+                crate::vulkan::barrier::barrier(
+                    &ctx,
+                    cmd,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                    vk::PipelineStageFlags::HOST,
+                    vk::AccessFlags::HOST_READ,
+                );
+                image_barrier(
+                    d,
+                    cmd,
+                    image,
+                    (
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                        vk::ImageLayout::PRESENT_SRC_KHR,
+                    ),
+                    (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::empty()),
+                    (
+                        vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+                        vk::AccessFlags::empty(),
+                    ),
+                );
+            } else {
+                image_barrier(
+                    d,
+                    cmd,
+                    image,
+                    (
+                        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                        vk::ImageLayout::PRESENT_SRC_KHR,
+                    ),
+                    last,
+                    (
+                        vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+                        vk::AccessFlags::empty(),
+                    ),
+                );
+            }
+        }
+        let slot = frame.slot();
+        viewport.submit_frame(
+            frame,
+            &[(
+                frame.acquired,
+                vk::PipelineStageFlags::TRANSFER | vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT,
+            )],
+            &[swapchain.render_finished[index as usize]],
+        )?;
+        if let Some(ui) = &ui {
+            self.to_free[slot].extend(ui.textures.free.iter().copied());
+        }
+        if swapchain.present(index)? || suboptimal {
+            self.recreate = true;
+        }
+        let captured = match capture_buffer {
+            Some(buf) => {
+                let waited = viewport.wait_idle();
+                let bgra = is_bgra(swapchain.format);
+                let rgb = buf
+                    .read()
+                    .chunks_exact(4)
+                    .map(|p| {
+                        if bgra {
+                            [p[2], p[1], p[0]]
+                        } else {
+                            [p[0], p[1], p[2]]
+                        }
+                    })
+                    .collect();
+                buf.destroy(&ctx);
+                waited?;
+                Some(Capture {
+                    width: extent.width,
+                    height: extent.height,
+                    rgb,
+                })
+            }
+            None => None,
+        };
+        Ok((Presented::Shown(status), captured))
+    }
+}
+
+/// One colour layer.
+const LAYER: vk::ImageSubresourceLayers = vk::ImageSubresourceLayers {
+    aspect_mask: vk::ImageAspectFlags::COLOR,
+    mip_level: 0,
+    base_array_layer: 0,
+    layer_count: 1,
+};
+
+/// A layout transition of a whole colour image.
+///
+/// # Safety
+/// `cmd` must be recording.
+unsafe fn image_barrier(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    image: vk::Image,
+    (old, new): (vk::ImageLayout, vk::ImageLayout),
+    (src_stage, src_access): (vk::PipelineStageFlags, vk::AccessFlags),
+    (dst_stage, dst_access): (vk::PipelineStageFlags, vk::AccessFlags),
+) {
+    let b = [vk::ImageMemoryBarrier::default()
+        .old_layout(old)
+        .new_layout(new)
+        .src_access_mask(src_access)
+        .dst_access_mask(dst_access)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(COLOUR)];
+    // SAFETY: the caller guarantees `cmd` is recording.
+    unsafe {
+        d.cmd_pipeline_barrier(
+            cmd,
+            src_stage,
+            dst_stage,
+            vk::DependencyFlags::empty(),
+            &[],
+            &[],
+            &b,
+        )
+    };
+}
+
+impl Drop for Presenter {
+    fn drop(&mut self) {
+        // SAFETY: the device is idle after the wait; egui's objects, then the pool, then the
+        // swapchain (its own Drop).
+        unsafe {
+            let _ = self.ctx.device.device_wait_idle();
+            drop(self.egui.take());
+            self.ctx.device.destroy_command_pool(self.upload_pool, None);
+        }
+        drop(self.swapchain.take());
+    }
+}

@@ -1,0 +1,419 @@
+//! The GPU session: one long-lived owner of the world's GPU mirror, the path tracer, the
+//! accumulation and the display pass, used by every caller — the CLI's `render` and
+//! `bench-gpu`, replay scripts and the editor's frame loop. Drop releases everything.
+//!
+//! Headless callers use [`Viewport::render`] and friends (they wait for the GPU). The
+//! interactive loop uses frames in flight: [`Viewport::begin_frame`] takes the next slot only
+//! if its previous submission finished (it never blocks), [`Viewport::trace_frame`] uploads
+//! what the world changed and records one batch of samples plus the display pass,
+//! [`Viewport::submit_frame`] submits. World locks are held only while dirty ranges are copied
+//! and the frame's parameters are read, never across GPU work.
+
+use crate::cpu::RenderJob;
+use crate::image::Image;
+use crate::params::SceneParams;
+use crate::vulkan::barrier::barrier;
+use crate::vulkan::frame::{FRAMES_IN_FLIGHT, FrameSlot};
+use crate::vulkan::progressive::Progressive;
+use crate::vulkan::tonemap::ToneMapper;
+use crate::vulkan::trace::{PathTracer, RayCounts, TraceParams, Variant};
+use crate::vulkan::world::{GpuWorld, UploadReport};
+use crate::vulkan::{GpuContext, GpuError};
+use ash::vk;
+use brickmap::{World, WorldView};
+use std::mem::ManuallyDrop;
+use std::sync::Arc;
+
+/// What the interactive loop asks of one frame.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameRequest<'a> {
+    /// The scene's camera, sun, sky and settings.
+    pub params: &'a SceneParams,
+    /// The traced (internal) resolution.
+    pub internal: (u32, u32),
+    /// The displayed resolution.
+    pub output: (u32, u32),
+    /// Samples per pixel to add at most this frame (0: display only).
+    pub spp: u32,
+    /// Stop adding samples at this many per pixel (the image is converged).
+    pub target_spp: u32,
+    /// Display exposure in stops.
+    pub exposure: f32,
+    /// Write the output in B, G, R, A byte order (for a B8G8R8A8 target).
+    pub bgra: bool,
+}
+
+/// What one interactive frame did.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FrameStatus {
+    /// Samples per pixel accumulated after this frame.
+    pub samples: u32,
+    /// Samples per pixel this frame added.
+    pub added: u32,
+    /// Whether this frame restarted the accumulation.
+    pub restarted: bool,
+    /// What the world upload did.
+    pub upload: UploadReport,
+}
+
+/// A frame being recorded: the slot's command buffer.
+#[derive(Clone, Copy, Debug)]
+pub struct Frame {
+    slot: usize,
+    /// The command buffer (recording).
+    pub cmd: vk::CommandBuffer,
+    /// The slot's swapchain-acquire semaphore.
+    pub acquired: vk::Semaphore,
+}
+
+/// The GPU session. Fields are released in `Drop`, the context last.
+pub struct Viewport {
+    world: ManuallyDrop<GpuWorld>,
+    tracer: ManuallyDrop<PathTracer>,
+    tone: ManuallyDrop<ToneMapper>,
+    /// Interactive accumulation (created at the requested internal size).
+    live: Option<Progressive>,
+    /// One-shot accumulation kept by benchmarks between calls.
+    bench: Option<Progressive>,
+    frames: Vec<FrameSlot>,
+    next: usize,
+    last_gpu_seconds: Option<f64>,
+    ctx: Arc<GpuContext>,
+}
+
+impl Frame {
+    /// The frame slot (0..[`FRAMES_IN_FLIGHT`]).
+    pub fn slot(&self) -> usize {
+        self.slot
+    }
+}
+
+impl Viewport {
+    /// Uploads the world and builds the tracer and the display pass.
+    pub fn new(ctx: Arc<GpuContext>, view: &WorldView<'_>) -> Result<Self, GpuError> {
+        let world = GpuWorld::upload(&ctx, view)?;
+        let tracer = match PathTracer::new(&ctx) {
+            Ok(t) => t,
+            Err(e) => {
+                world.destroy(&ctx);
+                return Err(e);
+            }
+        };
+        let tone = match ToneMapper::new(&ctx) {
+            Ok(t) => t,
+            Err(e) => {
+                tracer.destroy(&ctx);
+                world.destroy(&ctx);
+                return Err(e);
+            }
+        };
+        Ok(Self {
+            world: ManuallyDrop::new(world),
+            tracer: ManuallyDrop::new(tracer),
+            tone: ManuallyDrop::new(tone),
+            live: None,
+            bench: None,
+            frames: Vec::new(),
+            next: 0,
+            last_gpu_seconds: None,
+            ctx,
+        })
+    }
+
+    /// The context.
+    pub fn ctx(&self) -> &Arc<GpuContext> {
+        &self.ctx
+    }
+
+    /// The path tracer (its sampling options).
+    pub fn tracer(&mut self) -> &mut PathTracer {
+        &mut self.tracer
+    }
+
+    /// The world's GPU mirror.
+    pub fn gpu_world(&self) -> &GpuWorld {
+        &self.world
+    }
+
+    /// Uploads what the world changed since the last update (one staging flush).
+    pub fn update(&mut self, world: &World) -> Result<UploadReport, GpuError> {
+        self.world.update(&self.ctx, world)
+    }
+
+    /// Uploads everything the world changed and waits for the copies.
+    pub fn sync(&mut self, world: &World) -> Result<UploadReport, GpuError> {
+        self.world.sync(&self.ctx, world)
+    }
+
+    /// Renders `job` with the scene's variant and waits: the linear image and GPU time.
+    pub fn render(
+        &mut self,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        job: &RenderJob,
+    ) -> Result<(Image, Option<f64>), GpuError> {
+        self.tracer
+            .render(&self.ctx, &self.world, view, params, job)
+    }
+
+    /// [`Viewport::render`] counting rays by kind.
+    pub fn render_counted(
+        &mut self,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        job: &RenderJob,
+        variant: Option<Variant>,
+    ) -> Result<(Image, Option<f64>, RayCounts), GpuError> {
+        let variant = variant.unwrap_or_else(|| Variant::for_scene(view.materials(), params));
+        self.tracer
+            .render_counted_variant(&self.ctx, &self.world, view, params, job, variant)
+    }
+
+    /// Benchmarks: GPU times of `count` back-to-back dispatches of `spp` samples per pixel
+    /// at `size` with `variant` ([`Progressive::time_repeated`]).
+    pub fn time_repeated(
+        &mut self,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        variant: Variant,
+        size: (u32, u32),
+        spp: u32,
+        count: u32,
+    ) -> Result<Vec<f64>, GpuError> {
+        if self.bench.as_ref().is_none_or(|b| b.internal() != size) {
+            if let Some(old) = self.bench.take() {
+                old.destroy(&self.ctx);
+            }
+            self.bench = Some(Progressive::new(&self.ctx, size, size, 1)?);
+        }
+        let acc = self.bench.as_mut().expect("made above");
+        acc.time_repeated(
+            &self.ctx,
+            &mut self.tracer,
+            &self.world,
+            view,
+            params,
+            variant,
+            spp,
+            count,
+        )
+    }
+
+    /// The driver's statistics of a variant's pipelines.
+    pub fn statistics(&mut self, variant: Variant) -> Vec<(String, String)> {
+        self.tracer
+            .statistics(&self.ctx, variant)
+            .unwrap_or_default()
+    }
+
+    /// Samples per pixel the interactive accumulation holds.
+    pub fn samples(&self) -> u32 {
+        self.live.as_ref().map_or(0, |l| l.samples())
+    }
+
+    /// GPU time of the last interactive frame that finished (timestamp queries).
+    pub fn last_gpu_seconds(&self) -> Option<f64> {
+        self.last_gpu_seconds
+    }
+
+    /// Drops the interactive samples; the next frame starts over.
+    pub fn restart(&mut self) {
+        if let Some(l) = &mut self.live {
+            l.restart();
+        }
+    }
+
+    /// The linear mean of the interactive accumulation (waits for the GPU; tests).
+    pub fn live_hdr(&mut self) -> Result<Option<Image>, GpuError> {
+        self.wait_idle()?;
+        self.live.as_ref().map(|l| l.hdr(&self.ctx)).transpose()
+    }
+
+    /// The next frame slot, if its previous submission finished; never blocks.
+    pub fn begin_frame(&mut self) -> Result<Option<Frame>, GpuError> {
+        while self.frames.len() < FRAMES_IN_FLIGHT {
+            self.frames.push(FrameSlot::new(&self.ctx)?);
+        }
+        let slot = self.next;
+        let s = &mut self.frames[slot];
+        if !s.ready(&self.ctx)? {
+            return Ok(None);
+        }
+        if let Some(t) = s.gpu_seconds(&self.ctx) {
+            self.last_gpu_seconds = Some(t);
+        }
+        let cmd = s.begin(&self.ctx)?;
+        Ok(Some(Frame {
+            slot,
+            cmd,
+            acquired: s.acquired,
+        }))
+    }
+
+    /// Records the frame's GPU work: the world's changed bytes are uploaded (staging ring),
+    /// up to `req.spp` samples added (restarting on any change), and the display pass writes
+    /// the output buffer ([`Viewport::output`]).
+    pub fn trace_frame(
+        &mut self,
+        frame: &Frame,
+        world: &World,
+        req: &FrameRequest<'_>,
+    ) -> Result<FrameStatus, GpuError> {
+        let ctx = self.ctx.clone();
+        let upload = self.world.update(&ctx, world)?;
+        if upload.grew {
+            // The grown world waited for the GPU: every slot's sets may go.
+            for s in &mut self.frames {
+                s.sets.clear(&ctx);
+            }
+        }
+        let internal = (req.internal.0.max(1), req.internal.1.max(1));
+        let output = (req.output.0.max(1), req.output.1.max(1));
+        if self
+            .live
+            .as_ref()
+            .is_none_or(|l| l.internal() != internal || l.output() != output)
+        {
+            // The other slot may still read the old accumulation.
+            self.wait_idle()?;
+            if let Some(old) = self.live.take() {
+                old.destroy(&ctx);
+            }
+            for s in &mut self.frames {
+                s.sets.clear(&ctx);
+            }
+            self.live = Some(Progressive::new(&ctx, internal, output, 1)?);
+        }
+        let live = self.live.as_mut().expect("made above");
+        if upload.changed() {
+            live.restart();
+        }
+        // The frame's parameters under a short read lock.
+        let (base, variant) = {
+            let view = world.read();
+            let base = TraceParams::new(&view, req.params, &live.job_of(1));
+            (base, Variant::for_scene(view.materials(), req.params))
+        };
+        let slot = &mut self.frames[frame.slot];
+        slot.ensure_ldr(&ctx, output.0 as u64 * output.1 as u64 * 4)?;
+        // SAFETY: recording; earlier frames' and the staging ring's writes (same queue,
+        // earlier in submission order) come before this frame's reads and writes.
+        unsafe {
+            barrier(
+                &ctx,
+                frame.cmd,
+                vk::PipelineStageFlags::COMPUTE_SHADER
+                    | vk::PipelineStageFlags::TRANSFER
+                    | vk::PipelineStageFlags::DRAW_INDIRECT,
+                vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
+                vk::PipelineStageFlags::COMPUTE_SHADER
+                    | vk::PipelineStageFlags::TRANSFER
+                    | vk::PipelineStageFlags::DRAW_INDIRECT,
+                vk::AccessFlags::SHADER_READ
+                    | vk::AccessFlags::SHADER_WRITE
+                    | vk::AccessFlags::TRANSFER_READ
+                    | vk::AccessFlags::TRANSFER_WRITE
+                    | vk::AccessFlags::INDIRECT_COMMAND_READ,
+            );
+        }
+        let (added, restarted) = live.record_batch(
+            &ctx,
+            frame.cmd,
+            &mut self.tracer,
+            &self.world,
+            base,
+            variant,
+            (req.spp, req.target_spp),
+            &mut slot.uniforms,
+            &mut slot.sets,
+        )?;
+        // SAFETY: recording: the trace's writes before the display pass reads them.
+        unsafe {
+            barrier(
+                &ctx,
+                frame.cmd,
+                vk::PipelineStageFlags::COMPUTE_SHADER,
+                vk::AccessFlags::SHADER_WRITE,
+                vk::PipelineStageFlags::COMPUTE_SHADER,
+                vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
+            );
+        }
+        let ldr = slot.ldr.as_ref().expect("ensured above").binding();
+        self.tone.record(
+            &ctx,
+            frame.cmd,
+            &mut slot.sets,
+            live.accumulation(),
+            ldr,
+            (internal, output),
+            req.exposure,
+            req.bgra,
+        )?;
+        // SAFETY: recording: the display output is read by transfers (copy to an image).
+        unsafe {
+            barrier(
+                &ctx,
+                frame.cmd,
+                vk::PipelineStageFlags::COMPUTE_SHADER,
+                vk::AccessFlags::SHADER_WRITE,
+                vk::PipelineStageFlags::TRANSFER,
+                vk::AccessFlags::TRANSFER_READ,
+            );
+        }
+        Ok(FrameStatus {
+            samples: live.samples(),
+            added,
+            restarted,
+            upload,
+        })
+    }
+
+    /// The frame's display output: packed 8-bit pixels at the output size, rows top down.
+    pub fn output(&self, frame: &Frame) -> vk::Buffer {
+        self.frames[frame.slot]
+            .ldr
+            .as_ref()
+            .map_or(vk::Buffer::null(), |b| b.raw)
+    }
+
+    /// Ends and submits the frame (waiting on `waits`, signalling `signals`); never blocks.
+    pub fn submit_frame(
+        &mut self,
+        frame: Frame,
+        waits: &[(vk::Semaphore, vk::PipelineStageFlags)],
+        signals: &[vk::Semaphore],
+    ) -> Result<(), GpuError> {
+        self.frames[frame.slot].submit(&self.ctx, waits, signals)?;
+        self.next = (frame.slot + 1) % FRAMES_IN_FLIGHT;
+        Ok(())
+    }
+
+    /// Waits until every frame in flight finished.
+    pub fn wait_idle(&self) -> Result<(), GpuError> {
+        for s in &self.frames {
+            s.wait(&self.ctx)?;
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Viewport {
+    fn drop(&mut self) {
+        // SAFETY: the device is idle after the wait; each field is taken once, here.
+        unsafe {
+            let _ = self.ctx.device.device_wait_idle();
+            for s in self.frames.drain(..) {
+                s.destroy(&self.ctx);
+            }
+            if let Some(l) = self.live.take() {
+                l.destroy(&self.ctx);
+            }
+            if let Some(b) = self.bench.take() {
+                b.destroy(&self.ctx);
+            }
+            ManuallyDrop::take(&mut self.tone).destroy(&self.ctx);
+            ManuallyDrop::take(&mut self.tracer).destroy(&self.ctx);
+            ManuallyDrop::take(&mut self.world).destroy(&self.ctx);
+        }
+    }
+}
