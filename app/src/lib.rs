@@ -6,5 +6,6 @@ pub mod editor;
 pub mod formats;
 pub mod gpu;
 pub mod scene;
+pub mod ui;
 
 pub use scene::Scene;

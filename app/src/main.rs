@@ -1,5 +1,6 @@
-//! `voxbrick`: the voxel scene editor's command line. Subcommands build, convert and inspect
-//! scenes; the editor and the renderer arrive with their issues.
+//! `voxbrick`: the voxel scene editor. Without a subcommand it opens the editor window (on
+//! a file, or the built-in default scene); subcommands build, convert, inspect, render,
+//! replay and benchmark scenes headlessly.
 
 use anyhow::{Context, Result, bail};
 use app::Scene;
@@ -17,14 +18,59 @@ use std::time::{Duration, Instant};
 #[command(
     name = "voxbrick",
     version,
-    about = "Voxel scene editor with a path-traced viewport"
+    about = "Voxel scene editor with a path-traced viewport",
+    args_conflicts_with_subcommands = true
 )]
 struct Cli {
     /// Worker threads for the voxel world (0: one per core).
     #[arg(long, global = true, default_value_t = 0)]
     workers: usize,
+    #[command(flatten)]
+    editor: EditorArgs,
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
+}
+
+/// The editor window (no subcommand).
+#[derive(clap::Args)]
+struct EditorArgs {
+    /// A scene to open (.ron or .vox); default: the built-in default scene.
+    file: Option<PathBuf>,
+    /// Run a replay script's steps in the live editor, capture the presented frame and exit.
+    #[arg(long)]
+    script: Option<PathBuf>,
+    /// With --script: write the presented frame here (PNG).
+    #[arg(long, requires = "script")]
+    capture: Option<PathBuf>,
+    /// With --script: samples per pixel before the capture.
+    #[arg(long, default_value_t = 16)]
+    capture_spp: u32,
+    /// With --script: keep the window open this many milliseconds after the capture.
+    #[arg(long, default_value_t = 0)]
+    linger_ms: u64,
+    /// Window size in pixels, as WxH.
+    #[arg(long, value_parser = parse_window_size, default_value = "1280x720")]
+    window: (u32, u32),
+    /// Vulkan device: gpu (the best) or part of a device's name.
+    #[arg(long, default_value = "gpu")]
+    device: String,
+    /// Enable the Vulkan validation layer (a script run fails on any validation error).
+    #[arg(long)]
+    validation: bool,
+}
+
+fn parse_window_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once('x')
+        .ok_or_else(|| format!("{s:?} is not WxH"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|n| (64..=16384).contains(n))
+            .ok_or_else(|| format!("{v:?} is not a size in 64..=16384"))
+    };
+    Ok((parse(w)?, parse(h)?))
 }
 
 #[derive(Subcommand)]
@@ -259,7 +305,21 @@ fn with_progress<T>(message: String, work: impl FnOnce() -> Result<T>) -> Result
 
 fn run(cli: Cli) -> Result<()> {
     let workers = cli.workers;
-    match cli.command {
+    let Some(command) = cli.command else {
+        let e = cli.editor;
+        return app::ui::run(app::ui::EditorOptions {
+            file: e.file,
+            script: e.script,
+            capture: e.capture,
+            capture_spp: e.capture_spp.max(1),
+            linger: Duration::from_millis(e.linger_ms),
+            size: e.window,
+            workers,
+            device: e.device,
+            validation: e.validation,
+        });
+    };
+    match command {
         Command::Stats { size } => {
             let started = Instant::now();
             let scene = with_progress("building the default scene".into(), || {

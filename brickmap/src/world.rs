@@ -670,6 +670,27 @@ impl WorldView<'_> {
             .voxel(self.world.dims.cell_index(b), bit))
     }
 
+    /// The box of brick cells that hold anything, in voxels (min inclusive, max exclusive;
+    /// brick-granular), or None for an empty world. For framing the content in a view.
+    pub fn occupied_bounds(&self) -> Option<(IVec3, IVec3)> {
+        let b = self.world.dims.bricks();
+        let mut bounds: Option<(UVec3, UVec3)> = None;
+        for x in 0..b.x {
+            for y in 0..b.y {
+                for z in 0..b.z {
+                    let c = UVec3::new(x, y, z);
+                    if self.brick_occupied(c) {
+                        bounds = Some(match bounds {
+                            None => (c, c),
+                            Some((lo, hi)) => (lo.min(c), hi.max(c)),
+                        });
+                    }
+                }
+            }
+        }
+        bounds.map(|(lo, hi)| ((lo * 8).as_ivec3(), ((hi + 1) * 8).as_ivec3()))
+    }
+
     /// Solid voxels in the world.
     pub fn solid_count(&self) -> u64 {
         self.slabs.iter().map(|s| s.solid()).sum()

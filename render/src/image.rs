@@ -30,15 +30,8 @@ impl Image {
 
     /// Writes an 8-bit sRGB PNG after exposure and tone mapping.
     pub fn write_png(&self, out: &mut dyn Write, exposure: f32) -> std::io::Result<()> {
-        let mut encoder = png::Encoder::new(out, self.width, self.height);
-        encoder.set_color(png::ColorType::Rgb);
-        encoder.set_depth(png::BitDepth::Eight);
-        let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
         let bytes: Vec<u8> = self.to_srgb8(exposure).into_iter().flatten().collect();
-        writer
-            .write_image_data(&bytes)
-            .map_err(std::io::Error::other)?;
-        writer.finish().map_err(std::io::Error::other)
+        write_png_rgb8(out, self.width, self.height, &bytes)
     }
 
     /// Mean of every channel of every pixel.
@@ -202,4 +195,21 @@ mod tests {
         assert!(out.starts_with(b"PF\n3 2\n-1.0\n"));
         assert_eq!(out.len(), 12 + 6 * 12);
     }
+}
+
+/// Writes 8-bit RGB pixels (rows top to bottom) as a PNG.
+pub fn write_png_rgb8(
+    out: &mut dyn Write,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+) -> std::io::Result<()> {
+    let mut encoder = png::Encoder::new(out, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
+    writer
+        .write_image_data(rgb)
+        .map_err(std::io::Error::other)?;
+    writer.finish().map_err(std::io::Error::other)
 }

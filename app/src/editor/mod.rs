@@ -97,13 +97,19 @@ impl Document {
     /// Saves (project or .vox by extension) atomically; a project save clears the dirty flag.
     pub fn save(&mut self, path: &Path) -> Result<()> {
         self.scene.save(path)?;
+        self.mark_saved(path);
+        Ok(())
+    }
+
+    /// The bookkeeping of a save that succeeded (the editor writes off the UI thread, then
+    /// calls this): recorded, and a project save becomes the document's file, clean.
+    pub fn mark_saved(&mut self, path: &Path) {
         if let Some(r) = &mut self.recorder {
             r.record(script::Step::Save(path.display().to_string()));
         }
-        if crate::formats::Format::of(path)? == crate::formats::Format::Project {
+        if crate::formats::Format::of(path).ok() == Some(crate::formats::Format::Project) {
             self.path = Some(path.to_path_buf());
             self.dirty = false;
         }
-        Ok(())
     }
 }

@@ -217,47 +217,94 @@ pub fn replay(
     options: &ReplayOptions,
     report: &mut dyn FnMut(&str),
 ) -> Result<Replayed> {
-    let workers = options.workers.or(script.workers).unwrap_or(0);
-    let out_dir = options
-        .out_dir
-        .clone()
-        .unwrap_or_else(|| folder.to_path_buf());
-    std::fs::create_dir_all(&out_dir)
-        .with_context(|| format!("creating the output folder {}", out_dir.display()))?;
-    let history = || {
-        History::with_budget(
-            options
-                .history_budget
-                .unwrap_or(super::history::DEFAULT_BUDGET),
-        )
-    };
-    let scene = match &script.start {
-        Start::New { size, terrain } => {
-            let dims = GridDims::from_voxels(UVec3::new(size.0, size.1, size.2))
-                .context("start: grid size")?;
-            let mut doc = Document::new(Scene::empty(dims, workers)?, history());
-            if let Some(t) = terrain {
-                Command::GenerateTerrain(t.clone())
-                    .apply(&mut doc.scene, folder)
-                    .context("start: terrain")?;
-            }
-            doc.scene
-        }
-        Start::File(f) => Scene::load(&folder.join(f), workers).context("start")?,
-    };
-    let mut doc = Document::new(scene, history());
-    doc.folder = folder.to_path_buf();
-    let mut marks: HashMap<String, u64> = HashMap::new();
-    for (i, step) in script.steps.iter().enumerate() {
-        let n = i + 1;
-        let line = run_step(&mut doc, step, &out_dir, options, &mut marks)
-            .with_context(|| format!("step {n} ({})", step.name()))?;
-        report(&format!("step {n:>4}  {line}"));
+    let (mut run, mut document) = ScriptRun::start(script, folder, options)?;
+    while let Some(line) = run.step(script, &mut document)? {
+        report(&line);
     }
     Ok(Replayed {
-        document: doc,
+        document,
         steps: script.steps.len(),
     })
+}
+
+/// A replay in progress, one step at a time (the live editor runs one step per frame, so
+/// the viewport shows each edit).
+pub struct ScriptRun {
+    out_dir: PathBuf,
+    options: ReplayOptions,
+    marks: HashMap<String, u64>,
+    next: usize,
+}
+
+impl ScriptRun {
+    /// The run and the script's starting document; relative paths start at `folder`.
+    pub fn start(
+        script: &Script,
+        folder: &Path,
+        options: &ReplayOptions,
+    ) -> Result<(Self, Document)> {
+        let workers = options.workers.or(script.workers).unwrap_or(0);
+        let out_dir = options
+            .out_dir
+            .clone()
+            .unwrap_or_else(|| folder.to_path_buf());
+        std::fs::create_dir_all(&out_dir)
+            .with_context(|| format!("creating the output folder {}", out_dir.display()))?;
+        let history = || {
+            History::with_budget(
+                options
+                    .history_budget
+                    .unwrap_or(super::history::DEFAULT_BUDGET),
+            )
+        };
+        let scene = match &script.start {
+            Start::New { size, terrain } => {
+                let dims = GridDims::from_voxels(UVec3::new(size.0, size.1, size.2))
+                    .context("start: grid size")?;
+                let mut doc = Document::new(Scene::empty(dims, workers)?, history());
+                if let Some(t) = terrain {
+                    Command::GenerateTerrain(t.clone())
+                        .apply(&mut doc.scene, folder)
+                        .context("start: terrain")?;
+                }
+                doc.scene
+            }
+            Start::File(f) => Scene::load(&folder.join(f), workers).context("start")?,
+        };
+        let mut document = Document::new(scene, history());
+        document.folder = folder.to_path_buf();
+        let run = Self {
+            out_dir,
+            options: options.clone(),
+            marks: HashMap::new(),
+            next: 0,
+        };
+        Ok((run, document))
+    }
+
+    /// Runs the next step: its report line, or None when every step ran. An error names
+    /// the step.
+    pub fn step(&mut self, script: &Script, document: &mut Document) -> Result<Option<String>> {
+        let Some(step) = script.steps.get(self.next) else {
+            return Ok(None);
+        };
+        self.next += 1;
+        let n = self.next;
+        let line = run_step(
+            document,
+            step,
+            &self.out_dir,
+            &self.options,
+            &mut self.marks,
+        )
+        .with_context(|| format!("step {n} ({})", step.name()))?;
+        Ok(Some(format!("step {n:>4}  {line}")))
+    }
+
+    /// Steps run so far.
+    pub fn steps_run(&self) -> usize {
+        self.next
+    }
 }
 
 fn hash(doc: &Document) -> u64 {

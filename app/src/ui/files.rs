@@ -1,0 +1,367 @@
+//! Files, with nothing ever lost: the user's config folder (recent files, the recovery
+//! file), and file work off the UI thread. Loads build a new scene on a worker thread and
+//! hand it back; saves read the shared document under a read lock while the UI keeps
+//! drawing (edits wait for the save); every write is atomic (temp file + rename), so a
+//! failure leaves the file on disk, the scene and the history as they were.
+
+use crate::Scene;
+use crate::editor::Document;
+use anyhow::{Context, Result};
+use crossbeam_channel::{Receiver, Sender};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, RwLock};
+
+/// Recent files kept.
+const RECENT: usize = 10;
+
+/// The editor's folder in the user's config directory: `$VOXBRICK_CONFIG_DIR`, else
+/// `$XDG_CONFIG_HOME/voxbrick`, else `~/.config/voxbrick`.
+#[derive(Clone, Debug)]
+pub struct ConfigDir(pub PathBuf);
+
+impl ConfigDir {
+    /// The folder from the environment (not created until something is written).
+    pub fn from_env() -> Self {
+        let env = |k| {
+            std::env::var_os(k)
+                .filter(|v| !v.is_empty())
+                .map(PathBuf::from)
+        };
+        Self(
+            env("VOXBRICK_CONFIG_DIR")
+                .or_else(|| env("XDG_CONFIG_HOME").map(|p| p.join("voxbrick")))
+                .or_else(|| env("HOME").map(|p| p.join(".config/voxbrick")))
+                .unwrap_or_else(|| PathBuf::from(".voxbrick")),
+        )
+    }
+
+    fn recent_file(&self) -> PathBuf {
+        self.0.join("recent.ron")
+    }
+
+    /// The autosave target; it exists only while a session with unsaved changes runs (or
+    /// after one crashed).
+    pub fn recovery_file(&self) -> PathBuf {
+        self.0.join("recovery.ron")
+    }
+
+    /// Recent files, newest first (a missing or unreadable list is empty).
+    pub fn recent(&self) -> Vec<PathBuf> {
+        std::fs::read_to_string(self.recent_file())
+            .ok()
+            .and_then(|t| ron::from_str::<Vec<PathBuf>>(&t).ok())
+            .unwrap_or_default()
+    }
+
+    /// Puts `path` first in the recent list.
+    pub fn add_recent(&self, path: &Path) -> Result<()> {
+        let path = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+        let mut list = self.recent();
+        list.retain(|p| p != &path);
+        list.insert(0, path);
+        list.truncate(RECENT);
+        std::fs::create_dir_all(&self.0)
+            .with_context(|| format!("creating {}", self.0.display()))?;
+        let text = ron::ser::to_string_pretty(&list, Default::default())?;
+        crate::atomic::write_atomic(&self.recent_file(), |w| w.write_all(text.as_bytes()))
+            .with_context(|| format!("writing {}", self.recent_file().display()))
+    }
+
+    /// A recovery file left by a session that did not exit cleanly.
+    pub fn pending_recovery(&self) -> Option<PathBuf> {
+        let f = self.recovery_file();
+        f.is_file().then_some(f)
+    }
+
+    /// Removes the recovery file (clean exit, or the user discarded it).
+    pub fn remove_recovery(&self) {
+        let _ = std::fs::remove_file(self.recovery_file());
+    }
+}
+
+/// The document, shared with the file worker: the UI reads it every frame and writes it
+/// for edits; a save reads it on the worker.
+pub type SharedDocument = Arc<RwLock<Document>>;
+
+/// Why a file was asked for.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Purpose {
+    /// Replace the document.
+    Open,
+    /// Write the project here and make it the document's file.
+    SaveAs,
+    /// Add a .vox to the scene (undoable command).
+    Import,
+    /// Write a .vox.
+    Export,
+}
+
+/// A finished piece of background work.
+pub enum Done {
+    /// A file dialog closed (None: cancelled or no dialog available, with the reason).
+    Picked(Purpose, Result<Option<PathBuf>, String>),
+    /// A scene was loaded (or failed to) from a path, or built (the default scene: None).
+    Loaded(Option<PathBuf>, Result<Scene>),
+    /// A save finished; `autosave` saves go to the recovery file and don't clean the document.
+    Saved {
+        /// Where.
+        path: PathBuf,
+        /// Recovery autosave (the document stays dirty).
+        autosave: bool,
+        /// The outcome.
+        result: Result<()>,
+    },
+}
+
+/// Background file work and its results.
+pub struct FileWorker {
+    done_tx: Sender<Done>,
+    /// Results, polled by the frame loop.
+    pub done: Receiver<Done>,
+    /// Jobs running (for the progress indicator).
+    pub running: Vec<String>,
+    wake: Arc<dyn Fn() + Send + Sync>,
+}
+
+impl FileWorker {
+    /// A worker that calls `wake` when a job finishes (to redraw an idle editor).
+    pub fn new(wake: Arc<dyn Fn() + Send + Sync>) -> Self {
+        let (done_tx, done) = crossbeam_channel::unbounded();
+        Self {
+            done_tx,
+            done,
+            running: Vec::new(),
+            wake,
+        }
+    }
+
+    fn spawn(&mut self, what: String, job: impl FnOnce() -> Done + Send + 'static) {
+        let (tx, wake) = (self.done_tx.clone(), self.wake.clone());
+        self.running.push(what);
+        std::thread::spawn(move || {
+            let _ = tx.send(job());
+            wake();
+        });
+    }
+
+    /// A native file dialog on its own thread (the frame loop never waits for it).
+    pub fn pick(&mut self, purpose: Purpose, folder: Option<PathBuf>, name: Option<String>) {
+        let label = format!("{purpose:?} dialog");
+        self.spawn(label, move || {
+            let mut d = rfd::FileDialog::new();
+            d = match purpose {
+                Purpose::Open => d.add_filter("Scenes", &["ron", "vox"]),
+                Purpose::Import => d.add_filter("MagicaVoxel", &["vox"]),
+                Purpose::SaveAs => d.add_filter("voxbrick project", &["ron"]),
+                Purpose::Export => d.add_filter("MagicaVoxel", &["vox"]),
+            };
+            if let Some(f) = folder {
+                d = d.set_directory(f);
+            }
+            if let Some(n) = name {
+                d = d.set_file_name(n);
+            }
+            let picked = match purpose {
+                Purpose::Open | Purpose::Import => d.pick_file(),
+                Purpose::SaveAs | Purpose::Export => d.save_file(),
+            };
+            Done::Picked(purpose, Ok(picked))
+        });
+    }
+
+    /// Loads a scene (.ron or .vox) on a worker thread.
+    pub fn load(&mut self, path: PathBuf, workers: usize) {
+        self.spawn(format!("opening {}", path.display()), move || {
+            let scene =
+                Scene::load(&path, workers).with_context(|| format!("opening {}", path.display()));
+            Done::Loaded(Some(path), scene)
+        });
+    }
+
+    /// Builds the embedded default scene on a worker thread.
+    pub fn build_default(&mut self, workers: usize) {
+        self.spawn("building the default scene".into(), move || {
+            let scene = crate::scene::default_scene(crate::scene::SceneSize::Full, workers);
+            Done::Loaded(None, scene)
+        });
+    }
+
+    /// Saves the document's scene to `path` (project or .vox by extension) on a worker
+    /// thread, reading it under a read lock.
+    pub fn save(&mut self, doc: &SharedDocument, path: PathBuf, autosave: bool) {
+        let doc = doc.clone();
+        let what = if autosave {
+            "autosaving".to_string()
+        } else {
+            format!("saving {}", path.display())
+        };
+        self.spawn(what, move || {
+            let result = match doc.read() {
+                Ok(d) => save_scene(&d.scene, &path, autosave),
+                Err(_) => Err(anyhow::anyhow!("the document is unavailable")),
+            };
+            Done::Saved {
+                path,
+                autosave,
+                result,
+            }
+        });
+    }
+
+    /// Marks one job finished (the caller got its result).
+    pub fn finished(&mut self) {
+        if !self.running.is_empty() {
+            self.running.remove(0);
+        }
+    }
+}
+
+fn save_scene(scene: &Scene, path: &Path, autosave: bool) -> Result<()> {
+    if autosave && let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    scene
+        .save(path)
+        .with_context(|| format!("saving {}", path.display()))
+}
+
+/// The window title: file name (or "untitled"), an unsaved-changes mark, the program.
+pub fn title(doc: &Document) -> String {
+    let name = doc.path.as_ref().and_then(|p| p.file_name()).map_or_else(
+        || "untitled".to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    format!("{}{name} — voxbrick", if doc.dirty { "● " } else { "" })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::editor::command::Command;
+    use crate::editor::history::History;
+    use brickmap::GridDims;
+
+    fn temp(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("voxbrick-ui-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    fn doc() -> SharedDocument {
+        let scene = Scene::empty(GridDims::new(2, 2, 2).unwrap(), 1).unwrap();
+        Arc::new(RwLock::new(Document::new(
+            scene,
+            History::with_budget(1 << 20),
+        )))
+    }
+
+    fn wait(w: &mut FileWorker) -> Done {
+        let d = w
+            .done
+            .recv_timeout(std::time::Duration::from_secs(60))
+            .unwrap();
+        w.finished();
+        d
+    }
+
+    #[test]
+    fn recent_files_are_newest_first_without_duplicates() {
+        let dir = ConfigDir(temp("recent"));
+        assert!(dir.recent().is_empty());
+        for n in ["a.ron", "b.ron", "a.ron"] {
+            dir.add_recent(&dir.0.join(n)).unwrap();
+        }
+        let names: Vec<_> = dir
+            .recent()
+            .iter()
+            .map(|p| p.file_name().unwrap().to_owned())
+            .collect();
+        assert_eq!(names, ["a.ron", "b.ron"]);
+    }
+
+    #[test]
+    fn the_title_marks_unsaved_changes() {
+        let d = doc();
+        let mut d = d.write().unwrap();
+        assert_eq!(title(&d), "untitled — voxbrick");
+        d.execute(Command::Clear).unwrap();
+        assert!(title(&d).starts_with("● untitled"));
+    }
+
+    #[test]
+    fn recovery_is_written_offered_and_removed_and_a_save_cleans_the_document() {
+        let dir = ConfigDir(temp("recovery").join("config"));
+        let d = doc();
+        d.write().unwrap().execute(Command::Clear).unwrap();
+        let mut w = FileWorker::new(Arc::new(|| {}));
+        assert!(dir.pending_recovery().is_none());
+        w.save(&d, dir.recovery_file(), true);
+        let Done::Saved {
+            result, autosave, ..
+        } = wait(&mut w)
+        else {
+            panic!()
+        };
+        result.unwrap();
+        assert!(autosave);
+        // An autosave does not clean the document; the next start is offered the file.
+        assert!(d.read().unwrap().dirty);
+        let offered = dir.pending_recovery().expect("recovery offered");
+        w.load(offered, 1);
+        let Done::Loaded(_, scene) = wait(&mut w) else {
+            panic!()
+        };
+        assert_eq!(
+            scene.unwrap().world.read().content_hash(),
+            d.read().unwrap().scene.world.read().content_hash()
+        );
+        dir.remove_recovery();
+        assert!(dir.pending_recovery().is_none());
+        // A real save, once finished, makes the file the document's and cleans it.
+        let target = dir.0.join("scene.ron");
+        w.save(&d, target.clone(), false);
+        let Done::Saved { result, path, .. } = wait(&mut w) else {
+            panic!()
+        };
+        result.unwrap();
+        d.write().unwrap().mark_saved(&path);
+        assert!(!d.read().unwrap().dirty);
+        assert_eq!(d.read().unwrap().path.as_deref(), Some(target.as_path()));
+    }
+
+    #[test]
+    fn a_failed_save_keeps_the_document_and_the_file_on_disk() {
+        let dir = temp("failed");
+        let d = doc();
+        d.write().unwrap().execute(Command::Clear).unwrap();
+        let target = dir.join("keep.ron");
+        std::fs::write(&target, b"the user's old bytes").unwrap();
+        let mut w = FileWorker::new(Arc::new(|| {}));
+        // A folder where the file should go makes the rename fail; an unknown extension
+        // is refused before anything is written.
+        for bad in [dir.join("sub.ron"), dir.join("scene.txt")] {
+            if bad.extension().is_some_and(|e| e == "ron") {
+                std::fs::create_dir_all(bad.join("x")).unwrap();
+            }
+            let hash = d.read().unwrap().scene.world.read().content_hash();
+            w.save(&d, bad.clone(), false);
+            let Done::Saved { result, .. } = wait(&mut w) else {
+                panic!()
+            };
+            assert!(result.is_err(), "{} should fail", bad.display());
+            let doc = d.read().unwrap();
+            assert!(doc.dirty && doc.path.is_none());
+            assert_eq!(doc.scene.world.read().content_hash(), hash);
+            assert_eq!(doc.history.undo_len(), 1);
+        }
+        assert_eq!(std::fs::read(&target).unwrap(), b"the user's old bytes");
+        // Loading a broken file reports it and builds nothing.
+        std::fs::write(dir.join("broken.ron"), b"(format_version: 1, garbage").unwrap();
+        w.load(dir.join("broken.ron"), 1);
+        let Done::Loaded(_, scene) = wait(&mut w) else {
+            panic!()
+        };
+        assert!(scene.is_err());
+    }
+}

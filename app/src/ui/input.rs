@@ -1,0 +1,211 @@
+//! Input → action: the editor's shortcuts (MagicaVoxel's where it has one) and the mouse
+//! buttons that move the view. Pure functions of keys and modifiers, so they are tested
+//! without a window.
+
+use glam::DVec3;
+use winit::event::MouseButton;
+use winit::keyboard::KeyCode;
+
+/// Modifier keys held.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Mods {
+    /// Control (Command on macOS).
+    pub ctrl: bool,
+    /// Shift.
+    pub shift: bool,
+    /// Alt.
+    pub alt: bool,
+}
+
+/// What a shortcut does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Action {
+    /// Undo the latest step.
+    Undo,
+    /// Redo the latest undone step.
+    Redo,
+    /// New scene.
+    New,
+    /// Open a file.
+    Open,
+    /// Save (Save As when the document has no project file).
+    Save,
+    /// Save under a new name.
+    SaveAs,
+    /// Import a .vox into the scene.
+    Import,
+    /// Export as .vox.
+    Export,
+    /// Frame the scene's content.
+    Frame,
+    /// Store the view in camera slot n (1..=9).
+    StoreView(u8),
+    /// Recall camera slot n.
+    RecallView(u8),
+    /// Show or hide the shortcut list.
+    Help,
+    /// Quit (asks about unsaved changes).
+    Quit,
+}
+
+/// The shortcut for a key pressed with modifiers.
+pub fn action_for_key(key: KeyCode, m: Mods) -> Option<Action> {
+    use KeyCode::*;
+    let digit = match key {
+        Digit1 => Some(1),
+        Digit2 => Some(2),
+        Digit3 => Some(3),
+        Digit4 => Some(4),
+        Digit5 => Some(5),
+        Digit6 => Some(6),
+        Digit7 => Some(7),
+        Digit8 => Some(8),
+        Digit9 => Some(9),
+        _ => None,
+    };
+    if let Some(n) = digit {
+        return match (m.ctrl, m.alt) {
+            (true, false) => Some(Action::StoreView(n)),
+            (false, false) => Some(Action::RecallView(n)),
+            _ => None,
+        };
+    }
+    Some(match (key, m.ctrl, m.shift) {
+        (KeyZ, true, false) => Action::Undo,
+        (KeyZ, true, true) | (KeyY, true, false) => Action::Redo,
+        (KeyN, true, false) => Action::New,
+        (KeyO, true, false) => Action::Open,
+        (KeyS, true, false) => Action::Save,
+        (KeyS, true, true) => Action::SaveAs,
+        (KeyI, true, false) => Action::Import,
+        (KeyE, true, false) => Action::Export,
+        (KeyQ, true, false) => Action::Quit,
+        (KeyF, false, false) => Action::Frame,
+        (F1, false, false) => Action::Help,
+        _ => return None,
+    })
+}
+
+/// How a mouse drag moves the view.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Drag {
+    /// Rotate about the pivot.
+    Orbit,
+    /// Move in the view plane.
+    Pan,
+}
+
+/// The drag a button starts: right orbits (Shift + right pans), middle pans.
+pub fn drag_for_button(button: MouseButton, m: Mods) -> Option<Drag> {
+    match button {
+        MouseButton::Right if m.shift => Some(Drag::Pan),
+        MouseButton::Right => Some(Drag::Orbit),
+        MouseButton::Middle => Some(Drag::Pan),
+        _ => None,
+    }
+}
+
+/// Fly direction (right, up, forward) of a held movement key: W A S D, Q down, E up.
+pub fn fly_axis(key: KeyCode) -> Option<DVec3> {
+    Some(match key {
+        KeyCode::KeyW => DVec3::Z,
+        KeyCode::KeyS => DVec3::NEG_Z,
+        KeyCode::KeyA => DVec3::NEG_X,
+        KeyCode::KeyD => DVec3::X,
+        KeyCode::KeyE => DVec3::Y,
+        KeyCode::KeyQ => DVec3::NEG_Y,
+        _ => return None,
+    })
+}
+
+/// Every shortcut, for the help window: (keys, what it does).
+pub const SHORTCUTS: &[(&str, &str)] = &[
+    ("Right drag", "orbit about the pivot"),
+    ("Middle drag, Shift + right drag", "pan"),
+    ("Wheel", "zoom to the cursor"),
+    ("W A S D, Q / E", "fly (Shift: faster)"),
+    ("F", "frame the scene"),
+    ("Ctrl + 1..9 / 1..9", "store / recall a camera slot"),
+    ("Ctrl + Z", "undo"),
+    ("Ctrl + Shift + Z, Ctrl + Y", "redo"),
+    ("Ctrl + N", "new scene"),
+    ("Ctrl + O", "open"),
+    ("Ctrl + S / Ctrl + Shift + S", "save / save as"),
+    ("Ctrl + I", "import .vox into the scene"),
+    ("Ctrl + E", "export .vox"),
+    ("F1", "this list"),
+    ("Ctrl + Q", "quit"),
+];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CTRL: Mods = Mods {
+        ctrl: true,
+        shift: false,
+        alt: false,
+    };
+    const CTRL_SHIFT: Mods = Mods {
+        ctrl: true,
+        shift: true,
+        alt: false,
+    };
+
+    #[test]
+    fn shortcuts_follow_the_usual_editor_keys() {
+        assert_eq!(action_for_key(KeyCode::KeyZ, CTRL), Some(Action::Undo));
+        assert_eq!(
+            action_for_key(KeyCode::KeyZ, CTRL_SHIFT),
+            Some(Action::Redo)
+        );
+        assert_eq!(action_for_key(KeyCode::KeyY, CTRL), Some(Action::Redo));
+        assert_eq!(action_for_key(KeyCode::KeyS, CTRL), Some(Action::Save));
+        assert_eq!(
+            action_for_key(KeyCode::KeyS, CTRL_SHIFT),
+            Some(Action::SaveAs)
+        );
+        assert_eq!(action_for_key(KeyCode::KeyO, CTRL), Some(Action::Open));
+        assert_eq!(
+            action_for_key(KeyCode::KeyF, Mods::default()),
+            Some(Action::Frame)
+        );
+        assert_eq!(
+            action_for_key(KeyCode::Digit3, CTRL),
+            Some(Action::StoreView(3))
+        );
+        assert_eq!(
+            action_for_key(KeyCode::Digit3, Mods::default()),
+            Some(Action::RecallView(3))
+        );
+    }
+
+    #[test]
+    fn movement_keys_are_not_shortcuts_and_plain_letters_do_not_save() {
+        for key in [KeyCode::KeyW, KeyCode::KeyA, KeyCode::KeyS, KeyCode::KeyD] {
+            assert_eq!(action_for_key(key, Mods::default()), None, "{key:?}");
+            assert!(fly_axis(key).is_some());
+        }
+        assert_eq!(action_for_key(KeyCode::KeyZ, Mods::default()), None);
+        assert_eq!(fly_axis(KeyCode::KeyZ), None);
+        assert_eq!(fly_axis(KeyCode::KeyE), Some(DVec3::Y));
+    }
+
+    #[test]
+    fn buttons_start_the_right_drags() {
+        assert_eq!(
+            drag_for_button(MouseButton::Right, Mods::default()),
+            Some(Drag::Orbit)
+        );
+        let shift = Mods {
+            shift: true,
+            ..Mods::default()
+        };
+        assert_eq!(drag_for_button(MouseButton::Right, shift), Some(Drag::Pan));
+        assert_eq!(
+            drag_for_button(MouseButton::Middle, Mods::default()),
+            Some(Drag::Pan)
+        );
+        assert_eq!(drag_for_button(MouseButton::Left, Mods::default()), None);
+    }
+}

@@ -1,0 +1,1097 @@
+//! The interactive editor: a winit window whose viewport is the live path tracer, with egui
+//! panels on top. `run` owns the event loop; [`Editor`] is the application handler: input →
+//! view camera or actions, the document shared with the file worker, one frame per redraw
+//! through the GPU session ([`Viewport`]) and the window's [`Presenter`]. Progressive
+//! refinement adds samples until the target, then the loop waits for events.
+
+pub mod camera;
+pub mod files;
+pub mod input;
+pub mod panels;
+
+use crate::Scene;
+use crate::editor::Document;
+use crate::editor::command::Command;
+use crate::editor::history::{DEFAULT_BUDGET, History};
+use crate::editor::script::{self, ReplayOptions, Script, ScriptRun};
+use anyhow::{Context, Result, anyhow};
+use camera::ViewCamera;
+use files::{ConfigDir, Done, FileWorker, Purpose, SharedDocument};
+use glam::DVec3;
+use input::{Action, Drag, Mods};
+use panels::{PanelState, UiEvent, UnsavedAnswer, ViewSettings};
+use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use render::present::{EguiFrame, Presented, Presenter};
+use render::viewport::{FrameRequest, Viewport};
+use render::vulkan::{ContextOptions, GpuContext, WindowHandles};
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, RwLock};
+use std::time::{Duration, Instant};
+use winit::application::ApplicationHandler;
+use winit::event::{ElementState, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
+use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::window::{Window, WindowId};
+
+/// How the editor starts.
+#[derive(Clone, Debug, Default)]
+pub struct EditorOptions {
+    /// A file to open (.ron or .vox); None: the built-in default scene.
+    pub file: Option<PathBuf>,
+    /// Run a replay script's steps through the live editor, capture and exit.
+    pub script: Option<PathBuf>,
+    /// Where a script run writes the captured frame (PNG).
+    pub capture: Option<PathBuf>,
+    /// Samples per pixel before a script run captures.
+    pub capture_spp: u32,
+    /// Keep the window open this long after the capture (for screenshots).
+    pub linger: Duration,
+    /// Initial window size in physical pixels.
+    pub size: (u32, u32),
+    /// Worker threads (0: one per core).
+    pub workers: usize,
+    /// Vulkan device choice ("gpu" or part of a name).
+    pub device: String,
+    /// Enable the validation layer (a script run fails on any validation error).
+    pub validation: bool,
+}
+
+/// Wakes the event loop from other threads (file work finished).
+#[derive(Debug, Clone, Copy)]
+pub struct Wake;
+
+/// Runs the editor until the window closes.
+pub fn run(options: EditorOptions) -> Result<()> {
+    let event_loop = EventLoop::<Wake>::with_user_event().build().map_err(|e| {
+        anyhow!("cannot open a window: {e} (no display? set DISPLAY or WAYLAND_DISPLAY)")
+    })?;
+    let proxy = event_loop.create_proxy();
+    let mut editor = Editor::new(options, proxy)?;
+    event_loop
+        .run_app(&mut editor)
+        .map_err(|e| anyhow!("event loop: {e}"))?;
+    std::mem::replace(&mut editor.outcome, Ok(()))
+}
+
+/// What the GPU and the window are, once the window exists. Field order is drop order:
+/// the presenter and the session go before the window their surface belongs to.
+struct Gfx {
+    presenter: Presenter,
+    viewport: Viewport,
+    egui_state: egui_winit::State,
+    window: Arc<Window>,
+}
+
+/// A script run through the live editor.
+struct LiveScript {
+    script: Script,
+    run: ScriptRun,
+    capture: Option<PathBuf>,
+    captured_at: Option<Instant>,
+}
+
+/// What to do once the unsaved-changes question is answered.
+#[derive(Clone, Debug)]
+enum Pending {
+    Quit,
+    Open(Option<PathBuf>),
+    New {
+        size: (u32, u32, u32),
+        terrain: bool,
+    },
+}
+
+/// The application handler.
+pub struct Editor {
+    options: EditorOptions,
+    config: ConfigDir,
+    gfx: Option<Gfx>,
+    egui: egui::Context,
+    doc: SharedDocument,
+    /// Bumped whenever the document is replaced (the GPU world is then rebuilt).
+    generation: u64,
+    gpu_generation: u64,
+    files: FileWorker,
+    view: ViewCamera,
+    slots: [Option<ViewCamera>; 9],
+    settings: ViewSettings,
+    panels: PanelState,
+    mods: Mods,
+    drag: Option<(Drag, (f64, f64))>,
+    cursor: (f64, f64),
+    flying: HashSet<KeyCode>,
+    last_tick: Instant,
+    moving_until: Instant,
+    spp_per_frame: u32,
+    pending: Option<Pending>,
+    save_then: Option<Pending>,
+    last_autosave: Instant,
+    script: Option<LiveScript>,
+    loading_default: bool,
+    pending_textures: egui::TexturesDelta,
+    recovering: bool,
+    quitting: bool,
+    outcome: Result<()>,
+    /// Input event time of the latest camera move not yet on screen (input-to-photon).
+    move_event: Option<Instant>,
+    /// Frames and time of the latest move's first frame (for the status line).
+    latency: Option<Duration>,
+}
+
+impl Editor {
+    fn new(options: EditorOptions, proxy: EventLoopProxy<Wake>) -> Result<Self> {
+        let wake_proxy = proxy.clone();
+        let files = FileWorker::new(Arc::new(move || {
+            let _ = wake_proxy.send_event(Wake);
+        }));
+        let config = ConfigDir::from_env();
+        // Until the first real scene arrives the editor shows an empty one-brick grid.
+        let placeholder = Scene::empty(brickmap::GridDims::new(1, 1, 1)?, 1)?;
+        let mut doc = Document::new(placeholder, History::with_budget(DEFAULT_BUDGET));
+        let mut script_run = None;
+        if let Some(path) = &options.script {
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("reading {}", path.display()))?;
+            let script = script::parse(&text).with_context(|| path.display().to_string())?;
+            let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
+            let (run, document) = ScriptRun::start(
+                &script,
+                &folder,
+                &ReplayOptions {
+                    workers: (options.workers > 0).then_some(options.workers),
+                    out_dir: options
+                        .capture
+                        .as_ref()
+                        .and_then(|c| c.parent())
+                        .filter(|p| !p.as_os_str().is_empty())
+                        .map(Path::to_path_buf),
+                    device: options.device.clone(),
+                    ..Default::default()
+                },
+            )?;
+            doc = document;
+            script_run = Some(LiveScript {
+                script,
+                run,
+                capture: options.capture.clone(),
+                captured_at: None,
+            });
+        }
+        let view = scene_view(&doc.scene);
+        let mut editor = Self {
+            settings: ViewSettings::default(),
+            panels: PanelState {
+                recent: config.recent(),
+                ..Default::default()
+            },
+            config,
+            gfx: None,
+            egui: egui::Context::default(),
+            doc: Arc::new(RwLock::new(doc)),
+            generation: 0,
+            gpu_generation: 0,
+            files,
+            view,
+            slots: Default::default(),
+            mods: Mods::default(),
+            drag: None,
+            cursor: (0.0, 0.0),
+            flying: HashSet::new(),
+            last_tick: Instant::now(),
+            moving_until: Instant::now(),
+            spp_per_frame: 1,
+            pending: None,
+            save_then: None,
+            last_autosave: Instant::now(),
+            loading_default: false,
+            pending_textures: Default::default(),
+            recovering: false,
+            quitting: false,
+            outcome: Ok(()),
+            move_event: None,
+            latency: None,
+            script: script_run,
+            options,
+        };
+        if let Some(s) = &mut editor.script {
+            editor.settings.target_spp = editor.options.capture_spp.max(1);
+            let _ = &mut s.run;
+        } else {
+            if let Some(recovery) = editor.config.pending_recovery() {
+                editor.panels.recovery = Some(recovery);
+            }
+            match editor.options.file.clone() {
+                Some(f) => editor.files.load(f, editor.options.workers),
+                None => {
+                    editor.loading_default = true;
+                    editor.files.build_default(editor.options.workers);
+                }
+            }
+        }
+        Ok(editor)
+    }
+
+    fn read(&self) -> std::sync::RwLockReadGuard<'_, Document> {
+        self.doc.read().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// The document for an edit, unless a save is reading it (then the edit is refused with
+    /// a message, never waited for).
+    fn write(&mut self) -> Option<std::sync::RwLockWriteGuard<'_, Document>> {
+        match self.doc.try_write() {
+            Ok(d) => Some(d),
+            Err(std::sync::TryLockError::Poisoned(p)) => Some(p.into_inner()),
+            Err(std::sync::TryLockError::WouldBlock) => {
+                self.panels
+                    .errors
+                    .push("a save is in progress; try again in a moment".into());
+                None
+            }
+        }
+    }
+
+    fn execute(&mut self, command: Command) {
+        let result = match self.write() {
+            Some(mut d) => d.execute(command).map(|_| ()),
+            None => return,
+        };
+        if let Err(e) = result {
+            self.panels.errors.push(format!("{e:#}"));
+        }
+        self.refresh_stats();
+    }
+
+    fn refresh_stats(&mut self) {
+        let text = scene_statistics(&self.read());
+        self.panels.stats = text;
+    }
+
+    fn replace_document(&mut self, scene: Scene, path: Option<PathBuf>) {
+        let mut doc = Document::new(scene, History::with_budget(DEFAULT_BUDGET));
+        doc.folder = path
+            .as_ref()
+            .and_then(|p| p.parent())
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from("."));
+        let is_project = path.as_ref().is_some_and(|p| {
+            crate::formats::Format::of(p).ok() == Some(crate::formats::Format::Project)
+        });
+        if let Some(p) = &path {
+            let _ = self.config.add_recent(p);
+            self.panels.recent = self.config.recent();
+        }
+        doc.path = path.filter(|_| is_project);
+        self.view = scene_view(&doc.scene);
+        self.doc = Arc::new(RwLock::new(doc));
+        self.generation += 1;
+        self.refresh_stats();
+    }
+
+    /// Runs `then` now, or asks about unsaved changes first.
+    fn guard_unsaved(&mut self, then: Pending) {
+        if self.read().dirty && self.script.is_none() {
+            self.pending = Some(then);
+            self.panels.asking_unsaved = true;
+        } else {
+            self.proceed(then);
+        }
+    }
+
+    fn proceed(&mut self, then: Pending) {
+        match then {
+            Pending::Quit => self.quit_now(),
+            Pending::Open(Some(p)) => self.files.load(p, self.options.workers),
+            Pending::Open(None) => self.files.pick(Purpose::Open, self.folder(), None),
+            Pending::New { size, terrain } => self.new_scene(size, terrain),
+        }
+    }
+
+    fn new_scene(&mut self, size: (u32, u32, u32), terrain: bool) {
+        let made = (|| -> Result<Scene> {
+            let dims = brickmap::GridDims::from_voxels(glam::UVec3::new(size.0, size.1, size.2))?;
+            let mut scene = Scene::empty(dims, self.options.workers)?;
+            scene.params = render::SceneParams::framing(dims.voxels().as_dvec3());
+            if terrain {
+                let spec = crate::editor::command::TerrainSpec {
+                    seed: 2022,
+                    scale: size.0.max(size.2) as f64 / 2.0,
+                    octaves: 5,
+                    height_range: (size.1 / 8, size.1 * 5 / 8),
+                    water_level: size.1 / 4,
+                };
+                Command::GenerateTerrain(spec).apply(&mut scene, Path::new("."))?;
+            }
+            Ok(scene)
+        })();
+        match made {
+            Ok(scene) => self.replace_document(scene, None),
+            Err(e) => self.panels.errors.push(format!("new scene: {e:#}")),
+        }
+    }
+
+    fn folder(&self) -> Option<PathBuf> {
+        self.read()
+            .path
+            .as_ref()
+            .and_then(|p| p.parent())
+            .map(Path::to_path_buf)
+    }
+
+    fn save(&mut self, as_new: bool) {
+        let path = self.read().path.clone();
+        match path.filter(|_| !as_new) {
+            Some(p) => self.files.save(&self.doc, p, false),
+            None => self
+                .files
+                .pick(Purpose::SaveAs, self.folder(), Some("scene.ron".into())),
+        }
+    }
+
+    fn quit_now(&mut self) {
+        self.config.remove_recovery();
+        self.quitting = true;
+    }
+
+    fn action(&mut self, action: Action) {
+        match action {
+            Action::Undo | Action::Redo => {
+                let result = match self.write() {
+                    Some(mut d) if action == Action::Undo => d.undo(),
+                    Some(mut d) => d.redo(),
+                    None => return,
+                };
+                if let Err(e) = result {
+                    self.panels.errors.push(format!("{e:#}"));
+                }
+                self.refresh_stats();
+            }
+            Action::New => self.panels.new_open = true,
+            Action::Open => self.guard_unsaved(Pending::Open(None)),
+            Action::Save => self.save(false),
+            Action::SaveAs => self.save(true),
+            Action::Import => self.files.pick(Purpose::Import, self.folder(), None),
+            Action::Export => {
+                self.files
+                    .pick(Purpose::Export, self.folder(), Some("scene.vox".into()))
+            }
+            Action::Frame => {
+                let (min, max) = content_bounds(&self.read().scene);
+                self.view.frame(min, max);
+                self.moved();
+            }
+            Action::StoreView(n) => self.slots[n as usize - 1] = Some(self.view.clone()),
+            Action::RecallView(n) => {
+                if let Some(v) = self.slots[n as usize - 1].clone() {
+                    self.view = v;
+                    self.moved();
+                }
+            }
+            Action::Help => self.panels.help_open = !self.panels.help_open,
+            Action::Quit => self.guard_unsaved(Pending::Quit),
+        }
+    }
+
+    fn ui_event(&mut self, e: UiEvent) {
+        match e {
+            UiEvent::Action(a) => self.action(a),
+            UiEvent::OpenRecent(p) => self.guard_unsaved(Pending::Open(Some(p))),
+            UiEvent::SetSun(s) => self.execute(Command::SetSun(s)),
+            UiEvent::SetSky(s) => self.execute(Command::SetSky(s)),
+            UiEvent::SetSettings(s) => self.execute(Command::SetSettings(s)),
+            UiEvent::UseViewAsSceneCamera => {
+                self.execute(Command::SetCamera(self.view.camera.clone()))
+            }
+            UiEvent::NewScene { size, terrain } => {
+                self.guard_unsaved(Pending::New { size, terrain })
+            }
+            UiEvent::Unsaved(answer) => {
+                self.panels.asking_unsaved = false;
+                let Some(then) = self.pending.take() else {
+                    return;
+                };
+                match answer {
+                    UnsavedAnswer::Cancel => {}
+                    UnsavedAnswer::Discard => self.proceed(then),
+                    UnsavedAnswer::Save => {
+                        self.save_then = Some(then);
+                        self.save(false);
+                    }
+                }
+            }
+            UiEvent::Recover(yes) => {
+                if let Some(p) = self.panels.recovery.take() {
+                    if yes {
+                        self.loading_default = false;
+                        self.files.load(p, self.options.workers);
+                        self.recovering = true;
+                    } else {
+                        self.config.remove_recovery();
+                    }
+                }
+            }
+        }
+    }
+
+    fn file_done(&mut self, done: Done) {
+        self.files.finished();
+        match done {
+            Done::Picked(purpose, Ok(Some(path))) => match purpose {
+                Purpose::Open => self.files.load(path, self.options.workers),
+                Purpose::SaveAs | Purpose::Export => {
+                    let path = if purpose == Purpose::SaveAs && path.extension().is_none() {
+                        path.with_extension("ron")
+                    } else {
+                        path
+                    };
+                    self.files.save(&self.doc, path, false)
+                }
+                Purpose::Import => {
+                    let command = Command::ImportVox {
+                        path: path.display().to_string(),
+                        offset: glam::IVec3::ZERO,
+                    };
+                    self.execute(command);
+                }
+            },
+            Done::Picked(_, Ok(None)) => self.save_then = None,
+            Done::Picked(_, Err(e)) => self.panels.errors.push(e),
+            Done::Loaded(path, Ok(scene)) => {
+                if self.loading_default && path.is_some() {
+                    // A file opened while the default scene was building wins.
+                    self.loading_default = false;
+                }
+                if path.is_none() && !self.loading_default {
+                    return;
+                }
+                self.loading_default = false;
+                let recovered = std::mem::take(&mut self.recovering);
+                self.replace_document(scene, path.filter(|_| !recovered));
+                if recovered {
+                    if let Ok(mut d) = self.doc.write() {
+                        d.dirty = true;
+                    }
+                    self.config.remove_recovery();
+                }
+            }
+            Done::Loaded(_, Err(e)) => {
+                self.loading_default = false;
+                self.panels.errors.push(format!("{e:#}"));
+            }
+            Done::Saved {
+                path,
+                autosave,
+                result,
+            } => match result {
+                Ok(()) if autosave => {}
+                Ok(()) => {
+                    if let Ok(mut d) = self.doc.write() {
+                        d.mark_saved(&path);
+                    }
+                    let _ = self.config.add_recent(&path);
+                    self.panels.recent = self.config.recent();
+                    if let Some(then) = self.save_then.take() {
+                        self.proceed(then);
+                    }
+                }
+                Err(e) => {
+                    self.save_then = None;
+                    self.panels.errors.push(format!("{e:#}"));
+                }
+            },
+        }
+    }
+
+    fn moved(&mut self) {
+        self.moving_until = Instant::now() + Duration::from_millis(150);
+        self.move_event.get_or_insert_with(Instant::now);
+        if let Some(g) = &self.gfx {
+            g.window.request_redraw();
+        }
+    }
+
+    fn aspect(&self) -> f64 {
+        self.gfx.as_ref().map_or(16.0 / 9.0, |g| {
+            let s = g.window.inner_size();
+            s.width.max(1) as f64 / s.height.max(1) as f64
+        })
+    }
+
+    /// Normalized device coordinates of the cursor (v up).
+    fn cursor_ndc(&self) -> (f64, f64) {
+        let Some(g) = &self.gfx else {
+            return (0.0, 0.0);
+        };
+        let s = g.window.inner_size();
+        (
+            2.0 * self.cursor.0 / s.width.max(1) as f64 - 1.0,
+            1.0 - 2.0 * self.cursor.1 / s.height.max(1) as f64,
+        )
+    }
+
+    fn zoom(&mut self, steps: f64) {
+        let aspect = self.aspect();
+        let (u, v) = self.cursor_ndc();
+        let dir = self.view.ray(u, v, aspect);
+        let ray = brickmap::Ray {
+            origin: self.view.camera.position,
+            dir,
+        };
+        // The surface under the cursor (exact CPU cast), else the pivot plane.
+        let hit = self
+            .read()
+            .scene
+            .world
+            .read()
+            .ray_cast(&ray, f64::INFINITY)
+            .ok()
+            .flatten();
+        let target = match hit {
+            Some((h, _)) => ray.origin + dir * h.t,
+            None => self.view.pivot_plane_point(u, v, aspect),
+        };
+        self.view.zoom_towards(target, 0.85f64.powf(steps));
+        self.moved();
+    }
+
+    fn tick_fly(&mut self) {
+        let now = Instant::now();
+        let dt = (now - self.last_tick).as_secs_f64().min(0.1);
+        self.last_tick = now;
+        if self.flying.is_empty() {
+            return;
+        }
+        let dir: DVec3 = self.flying.iter().filter_map(|k| input::fly_axis(*k)).sum();
+        let speed = self.view.distance.max(8.0) * if self.mods.shift { 2.0 } else { 0.5 };
+        self.view.fly(dir * speed * dt);
+        self.moved();
+    }
+
+    fn create_gfx(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        let (w, h) = self.options.size;
+        let attrs = Window::default_attributes()
+            .with_title("voxbrick")
+            .with_inner_size(winit::dpi::PhysicalSize::new(w.max(64), h.max(64)));
+        let window = Arc::new(
+            event_loop
+                .create_window(attrs)
+                .context("creating the window")?,
+        );
+        let handles = WindowHandles {
+            display: window.display_handle().context("display handle")?.as_raw(),
+            window: window.window_handle().context("window handle")?.as_raw(),
+        };
+        let ctx = GpuContext::new(&ContextOptions {
+            device: crate::gpu::device_choice(&self.options.device),
+            validation: self.options.validation,
+            window: Some(handles),
+        })
+        .context("no Vulkan device can draw this window")?;
+        let ctx = Arc::new(ctx);
+        let size = window.inner_size();
+        let presenter = Presenter::new(ctx.clone(), (size.width, size.height))?;
+        let viewport = {
+            let doc = self.read();
+            let view = doc.scene.world.read();
+            Viewport::new(ctx, &view)?
+        };
+        self.gpu_generation = self.generation;
+        let egui_state = egui_winit::State::new(
+            self.egui.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            None,
+        );
+        self.gfx = Some(Gfx {
+            presenter,
+            viewport,
+            egui_state,
+            window,
+        });
+        self.refresh_stats();
+        Ok(())
+    }
+
+    fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+        self.outcome = Err(e);
+        event_loop.exit();
+    }
+
+    /// One frame: script step, file results, egui, trace, present.
+    fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        while let Ok(done) = self.files.done.try_recv() {
+            self.file_done(done);
+        }
+        self.tick_fly();
+        self.step_script(event_loop)?;
+        self.autosave();
+        let Some(mut gfx) = self.gfx.take() else {
+            return Ok(());
+        };
+        let result = self.draw(&mut gfx, event_loop);
+        self.gfx = Some(gfx);
+        result
+    }
+
+    fn draw(&mut self, gfx: &mut Gfx, event_loop: &ActiveEventLoop) -> Result<()> {
+        if self.gpu_generation != self.generation {
+            // A new document: a new GPU world on the same device (the old one goes first).
+            let ctx = gfx.viewport.ctx().clone();
+            let next = {
+                let doc = self.read();
+                let view = doc.scene.world.read();
+                Viewport::new(ctx, &view)?
+            };
+            gfx.viewport = next;
+            self.gpu_generation = self.generation;
+        }
+        let capture_now =
+            self.script.as_ref().is_some_and(|s| {
+                s.captured_at.is_none() && s.run.steps_run() == s.script.steps.len()
+            }) && gfx.viewport.samples() >= self.settings.target_spp;
+        // The status line and the panels.
+        self.panels.busy = self.files.running.clone();
+        let samples = gfx.viewport.samples();
+        let gpu_ms = gfx.viewport.last_gpu_seconds().map_or(0.0, |s| s * 1e3);
+        let size = gfx.window.inner_size();
+        let internal = self.internal_size((size.width, size.height));
+        let paths = internal.0 as f64 * internal.1 as f64 * self.spp_per_frame as f64;
+        self.panels.status = format!(
+            "{samples}/{} spp · GPU {gpu_ms:.2} ms/frame · {:.1} Mpaths/s · internal {}x{} · {}{}",
+            self.settings.target_spp,
+            if gpu_ms > 0.0 {
+                paths / gpu_ms / 1e3
+            } else {
+                0.0
+            },
+            internal.0,
+            internal.1,
+            gfx.viewport.ctx().name,
+            self.latency.map_or_else(String::new, |l| format!(
+                " · move→photon {:.1} ms",
+                l.as_secs_f64() * 1e3
+            )),
+        );
+        gfx.window.set_title(&files::title(&self.read()));
+        let raw = gfx.egui_state.take_egui_input(&gfx.window);
+        let egui_ctx = self.egui.clone();
+        let mut events = Vec::new();
+        let output = {
+            let doc = self.doc.clone();
+            let doc = doc.read().unwrap_or_else(|p| p.into_inner());
+            egui_ctx.run_ui(raw, |ui| {
+                events = panels::draw(ui, &mut self.panels, &doc, &mut self.settings);
+            })
+        };
+        for e in events {
+            self.ui_event(e);
+        }
+        let egui::FullOutput {
+            platform_output,
+            textures_delta,
+            shapes,
+            pixels_per_point,
+            viewport_output,
+        } = output;
+        gfx.egui_state
+            .handle_platform_output(&gfx.window, platform_output);
+        // Texture changes wait here until a frame with the UI applies them.
+        self.pending_textures.append(textures_delta);
+        let primitives = egui_ctx.tessellate(shapes, pixels_per_point);
+        let moving = Instant::now() < self.moving_until;
+        let internal = if moving {
+            scaled(
+                (size.width, size.height),
+                self.settings.moving_scale.min(self.settings.internal_scale),
+            )
+        } else {
+            internal
+        };
+        let doc = self.doc.clone();
+        let doc = doc.read().unwrap_or_else(|p| p.into_inner());
+        let mut params = doc.scene.params.clone();
+        params.camera = self.view.camera.clone();
+        let request = FrameRequest {
+            params: &params,
+            internal,
+            output: (size.width, size.height),
+            spp: self.spp_per_frame,
+            target_spp: self.settings.target_spp,
+            exposure: doc.scene.params.settings.exposure + self.settings.exposure,
+            bgra: false,
+        };
+        let ui = (!capture_now).then(|| EguiFrame {
+            primitives: &primitives,
+            pixels_per_point,
+            textures: &self.pending_textures,
+        });
+        let (presented, captured) = gfx.presenter.frame(
+            &mut gfx.viewport,
+            &doc.scene.world,
+            &request,
+            ui,
+            capture_now,
+        )?;
+        drop(doc);
+        match presented {
+            Presented::Shown(status) => {
+                if !capture_now {
+                    self.pending_textures.clear();
+                }
+                if let Some(t) = self.move_event.take() {
+                    self.latency = Some(t.elapsed());
+                }
+                self.adapt_samples(gfx.viewport.last_gpu_seconds());
+                let _ = status;
+            }
+            Presented::NotReady | Presented::Recreated => gfx.window.request_redraw(),
+        }
+        if let Some(c) = captured {
+            self.finish_capture(gfx, c)?;
+        }
+        if let Some(s) = &self.script
+            && let Some(at) = s.captured_at
+            && at.elapsed() >= self.options.linger
+        {
+            let errors = gfx.viewport.ctx().validation_errors();
+            if errors > 0 {
+                anyhow::bail!("{errors} Vulkan validation errors");
+            }
+            event_loop.exit();
+        }
+        if self.quitting {
+            event_loop.exit();
+        }
+        // Keep drawing while refining, moving, running a script or waiting for files.
+        let busy = gfx.viewport.samples() < self.settings.target_spp
+            || moving
+            || !self.flying.is_empty()
+            || self.script.is_some()
+            || !self.files.running.is_empty()
+            || viewport_output.values().any(|v| v.repaint_delay.is_zero());
+        if busy {
+            gfx.window.request_redraw();
+        }
+        Ok(())
+    }
+
+    fn internal_size(&self, size: (u32, u32)) -> (u32, u32) {
+        scaled(size, self.settings.internal_scale)
+    }
+
+    /// Samples per frame follow the GPU time: about 16 ms of tracing per frame.
+    fn adapt_samples(&mut self, gpu: Option<f64>) {
+        let Some(t) = gpu else { return };
+        if t < 0.008 && self.spp_per_frame < 16 {
+            self.spp_per_frame *= 2;
+        } else if t > 0.033 && self.spp_per_frame > 1 {
+            self.spp_per_frame /= 2;
+        }
+    }
+
+    fn step_script(&mut self, _event_loop: &ActiveEventLoop) -> Result<()> {
+        let Some(mut s) = self.script.take() else {
+            return Ok(());
+        };
+        let result = {
+            let mut doc = self.doc.write().unwrap_or_else(|p| p.into_inner());
+            let camera_before = doc.scene.params.camera.clone();
+            let r = s.run.step(&s.script, &mut doc);
+            if doc.scene.params.camera != camera_before {
+                self.view = scene_view(&doc.scene);
+            }
+            r
+        };
+        let stepped = result.is_ok();
+        match result {
+            Ok(Some(line)) => println!("{line}"),
+            Ok(None) => {}
+            Err(e) => {
+                self.script = Some(s);
+                return Err(e);
+            }
+        }
+        let _ = stepped;
+        self.script = Some(s);
+        Ok(())
+    }
+
+    fn finish_capture(&mut self, gfx: &Gfx, c: render::present::Capture) -> Result<()> {
+        let Some(s) = &mut self.script else {
+            return Ok(());
+        };
+        s.captured_at = Some(Instant::now());
+        if let Some(path) = &s.capture {
+            let bytes: Vec<u8> = c.rgb.iter().flatten().copied().collect();
+            crate::atomic::write_atomic(path, |w| {
+                render::image::write_png_rgb8(w, c.width, c.height, &bytes)
+            })
+            .with_context(|| format!("writing {}", path.display()))?;
+            println!(
+                "captured {}x{} at {} spp to {}",
+                c.width,
+                c.height,
+                gfx.viewport.samples(),
+                path.display()
+            );
+        }
+        Ok(())
+    }
+
+    fn autosave(&mut self) {
+        let secs = self.settings.autosave_secs;
+        if secs == 0
+            || self.script.is_some()
+            || self.last_autosave.elapsed() < Duration::from_secs(secs)
+        {
+            return;
+        }
+        self.last_autosave = Instant::now();
+        if self.read().dirty {
+            self.files
+                .save(&self.doc, self.config.recovery_file(), true);
+        }
+    }
+}
+
+fn scaled((w, h): (u32, u32), f: f32) -> (u32, u32) {
+    let f = f.clamp(0.05, 1.0) as f64;
+    (
+        ((w as f64 * f).ceil() as u32).max(1),
+        ((h as f64 * f).ceil() as u32).max(1),
+    )
+}
+
+/// The view of a scene: its camera exactly, orbiting the grid centre's depth.
+fn scene_view(scene: &Scene) -> ViewCamera {
+    let centre = scene.world.dims().voxels().as_dvec3() * 0.5;
+    ViewCamera::for_scene(scene.params.camera.clone(), centre)
+}
+
+/// The box of the scene's solid content (the whole grid when empty).
+fn content_bounds(scene: &Scene) -> (DVec3, DVec3) {
+    let view = scene.world.read();
+    match view.occupied_bounds() {
+        Some((min, max)) => (min.as_dvec3(), max.as_dvec3()),
+        None => (DVec3::ZERO, scene.world.dims().voxels().as_dvec3()),
+    }
+}
+
+/// The statistics panel's text.
+fn scene_statistics(doc: &Document) -> String {
+    let view = doc.scene.world.read();
+    let m = view.memory();
+    let dims = doc.scene.world.dims().voxels();
+    let solid = view.solid_count();
+    let mut s = format!(
+        "size         {} x {} x {} voxels\nsolid        {solid} voxels\nbricks       {} stored, {} full cells\nmaterials    {}\n\
+         GPU memory   {:.1} MiB used\n  brick index {:.2} MiB\n  bricks      {:.2} MiB\n  coarse grid {:.2} MiB\n  materials   {:.2} MiB\n  tables      {} B\n",
+        dims.x,
+        dims.y,
+        dims.z,
+        view.brick_count(),
+        m.full_cells,
+        view.materials().len(),
+        m.gpu_used() as f64 / 1048576.0,
+        m.brick_index as f64 / 1048576.0,
+        m.bricks_used as f64 / 1048576.0,
+        m.coarse as f64 / 1048576.0,
+        m.material_used as f64 / 1048576.0,
+        m.tables
+    );
+    if solid > 0 {
+        s += &format!(
+            "per voxel    {:.4} B per solid voxel\n",
+            m.gpu_used() as f64 / solid as f64
+        );
+    }
+    s += &format!(
+        "history      {} steps ({:.1} MiB), {} oldest dropped",
+        doc.history.undo_len(),
+        doc.history.bytes() as f64 / 1048576.0,
+        doc.history.dropped()
+    );
+    s
+}
+
+impl ApplicationHandler<Wake> for Editor {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.gfx.is_none()
+            && let Err(e) = self.create_gfx(event_loop)
+        {
+            self.fail(event_loop, e);
+            return;
+        }
+        if let Some(g) = &self.gfx {
+            g.window.request_redraw();
+        }
+    }
+
+    fn user_event(&mut self, _event_loop: &ActiveEventLoop, _event: Wake) {
+        if let Some(g) = &self.gfx {
+            g.window.request_redraw();
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let Some(gfx) = &mut self.gfx else { return };
+        let response = gfx.egui_state.on_window_event(&gfx.window, &event);
+        if response.repaint {
+            gfx.window.request_redraw();
+        }
+        let consumed = response.consumed;
+        match event {
+            WindowEvent::CloseRequested => self.action(Action::Quit),
+            WindowEvent::Resized(size) => {
+                gfx.presenter.resize((size.width, size.height));
+                gfx.window.request_redraw();
+            }
+            WindowEvent::ScaleFactorChanged { .. } => gfx.window.request_redraw(),
+            WindowEvent::RedrawRequested => {
+                if let Err(e) = self.redraw(event_loop) {
+                    if self.script.is_some() {
+                        self.fail(event_loop, e);
+                    } else {
+                        self.gpu_failed(event_loop, e);
+                    }
+                }
+            }
+            WindowEvent::DroppedFile(path) => {
+                if path
+                    .extension()
+                    .is_some_and(|e| e.eq_ignore_ascii_case("vox") || e.eq_ignore_ascii_case("ron"))
+                {
+                    self.guard_unsaved(Pending::Open(Some(path)));
+                } else {
+                    self.panels
+                        .errors
+                        .push(format!("{} is not a .ron or .vox file", path.display()));
+                }
+            }
+            WindowEvent::ModifiersChanged(m) => {
+                let s = m.state();
+                self.mods = Mods {
+                    ctrl: s.control_key() || s.super_key(),
+                    shift: s.shift_key(),
+                    alt: s.alt_key(),
+                };
+            }
+            WindowEvent::KeyboardInput { event, .. } => {
+                let PhysicalKey::Code(code) = event.physical_key else {
+                    return;
+                };
+                let pressed = event.state == ElementState::Pressed;
+                if !pressed {
+                    self.flying.remove(&code);
+                    return;
+                }
+                if consumed || self.egui.egui_wants_keyboard_input() {
+                    return;
+                }
+                if let Some(a) = input::action_for_key(code, self.mods) {
+                    if !event.repeat {
+                        self.action(a);
+                    }
+                } else if !self.mods.ctrl && input::fly_axis(code).is_some() {
+                    self.last_tick = Instant::now();
+                    self.flying.insert(code);
+                    self.moved();
+                }
+            }
+            WindowEvent::MouseInput { state, button, .. } => {
+                if state == ElementState::Pressed
+                    && !consumed
+                    && !self.egui.egui_wants_pointer_input()
+                {
+                    self.drag = input::drag_for_button(button, self.mods).map(|d| (d, self.cursor));
+                } else if state == ElementState::Released {
+                    self.drag = None;
+                }
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                let previous = self.cursor;
+                self.cursor = (position.x, position.y);
+                if let Some((drag, _)) = self.drag {
+                    let h = gfx.window.inner_size().height.max(1) as f64;
+                    let (dx, dy) = (self.cursor.0 - previous.0, self.cursor.1 - previous.1);
+                    match drag {
+                        Drag::Orbit => self.view.orbit(-dx * 0.3, -dy * 0.3),
+                        Drag::Pan => {
+                            let aspect = self.aspect();
+                            self.view.pan(dx / h, -dy / h, aspect)
+                        }
+                    }
+                    self.moved();
+                }
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                if consumed || self.egui.egui_wants_pointer_input() {
+                    return;
+                }
+                let steps = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y as f64,
+                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
+                };
+                self.zoom(steps);
+            }
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        event_loop.set_control_flow(ControlFlow::Wait);
+        if self.settings.autosave_secs > 0 && self.script.is_none() {
+            event_loop.set_control_flow(ControlFlow::WaitUntil(
+                self.last_autosave + Duration::from_secs(self.settings.autosave_secs),
+            ));
+        }
+    }
+
+    fn exiting(&mut self, _event_loop: &ActiveEventLoop) {
+        // Drop the GPU objects before the window goes.
+        self.gfx = None;
+    }
+}
+
+impl Editor {
+    /// A GPU error mid-session: say so and offer to save before anything else is lost.
+    fn gpu_failed(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+        let message = format!("{e:#}");
+        eprintln!("voxbrick: the GPU failed: {message}");
+        self.gfx = None;
+        let dirty = self.read().dirty;
+        if dirty {
+            let answer = rfd::MessageDialog::new()
+                .set_level(rfd::MessageLevel::Error)
+                .set_title("voxbrick: the GPU failed")
+                .set_description(format!("{message}\n\nSave the scene before quitting?"))
+                .set_buttons(rfd::MessageButtons::YesNo)
+                .show();
+            if answer == rfd::MessageDialogResult::Yes {
+                let path = self.read().path.clone().or_else(|| {
+                    rfd::FileDialog::new()
+                        .add_filter("voxbrick project", &["ron"])
+                        .save_file()
+                });
+                // A fallback that always works: the recovery file.
+                let path = path.unwrap_or_else(|| self.config.recovery_file());
+                if let Err(e) = self.read().scene.save(&path) {
+                    eprintln!("voxbrick: saving {} failed: {e}", path.display());
+                } else {
+                    eprintln!("voxbrick: saved {}", path.display());
+                }
+            }
+        }
+        self.outcome = Err(anyhow!("the GPU failed: {message}"));
+        event_loop.exit();
+    }
+}
+
+impl Drop for Editor {
+    fn drop(&mut self) {
+        self.gfx = None;
+        self.pending_textures.clear();
+    }
+}

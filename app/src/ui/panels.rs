@@ -1,0 +1,396 @@
+//! The editor's egui panels: menu bar, status bar, render settings, sun and sky, scene
+//! statistics, the shortcut list, and the dialogs (unsaved changes, recovery, errors). They
+//! read the state and return what the user asked for as [`UiEvent`]s; the frame loop applies
+//! them (scene settings as undoable commands, view settings directly).
+
+use super::input::{Action, SHORTCUTS};
+use crate::editor::Document;
+use render::{RenderSettings, Sky, Sun};
+use std::path::PathBuf;
+
+/// View settings: not part of the scene, not in the history.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewSettings {
+    /// Samples per pixel at which the viewport stops (converged).
+    pub target_spp: u32,
+    /// Internal resolution as a fraction of the window.
+    pub internal_scale: f32,
+    /// Internal resolution while the camera moves.
+    pub moving_scale: f32,
+    /// Display exposure in stops.
+    pub exposure: f32,
+    /// Autosave period in seconds (0: off).
+    pub autosave_secs: u64,
+}
+
+impl Default for ViewSettings {
+    fn default() -> Self {
+        Self {
+            target_spp: 256,
+            internal_scale: 1.0,
+            moving_scale: 0.5,
+            exposure: 0.0,
+            autosave_secs: 180,
+        }
+    }
+}
+
+/// What the user asked for through the panels.
+#[derive(Clone, Debug)]
+pub enum UiEvent {
+    /// A shortcut's action (menus name the same actions).
+    Action(Action),
+    /// Open a recent file.
+    OpenRecent(PathBuf),
+    /// The sun changed (one undo step per drag: commands coalesce).
+    SetSun(Sun),
+    /// The sky changed.
+    SetSky(Sky),
+    /// Scene render settings changed (bounces).
+    SetSettings(RenderSettings),
+    /// Make the current view the scene's camera (undoable).
+    UseViewAsSceneCamera,
+    /// The unsaved-changes question was answered.
+    Unsaved(UnsavedAnswer),
+    /// The recovery offer was answered (true: recover).
+    Recover(bool),
+    /// New scene of this size in voxels, terrain or empty.
+    NewScene {
+        /// Voxels per axis.
+        size: (u32, u32, u32),
+        /// Generate noise terrain.
+        terrain: bool,
+    },
+}
+
+/// Answers to "save changes?".
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnsavedAnswer {
+    /// Save first, then go on.
+    Save,
+    /// Go on without saving.
+    Discard,
+    /// Stay.
+    Cancel,
+}
+
+/// What the panels show besides the document.
+#[derive(Default)]
+pub struct PanelState {
+    /// Render settings window open.
+    pub render_open: bool,
+    /// Sun and sky window open.
+    pub sun_open: bool,
+    /// Statistics window open.
+    pub stats_open: bool,
+    /// Shortcut list open.
+    pub help_open: bool,
+    /// New-scene dialog open, with its fields.
+    pub new_open: bool,
+    /// New-scene size.
+    pub new_size: (u32, u32, u32),
+    /// New scene gets terrain.
+    pub new_terrain: bool,
+    /// "Save changes?" is being asked (for what comes next).
+    pub asking_unsaved: bool,
+    /// A recovery file to offer.
+    pub recovery: Option<PathBuf>,
+    /// Errors to show (newest last).
+    pub errors: Vec<String>,
+    /// Recent files.
+    pub recent: Vec<PathBuf>,
+    /// Status line: device, samples, timings.
+    pub status: String,
+    /// Scene statistics text (refreshed when the scene changes).
+    pub stats: String,
+    /// Background jobs running.
+    pub busy: Vec<String>,
+}
+
+/// Draws the panels; returns what the user asked for.
+pub fn draw(
+    root: &mut egui::Ui,
+    state: &mut PanelState,
+    doc: &Document,
+    view: &mut ViewSettings,
+) -> Vec<UiEvent> {
+    let mut out = Vec::new();
+    let ctx = &root.ctx().clone();
+    egui::Panel::top("menu").show(root, |ui| {
+        egui::MenuBar::new().ui(ui, |ui| {
+            ui.menu_button("File", |ui| {
+                if ui.button("New…").clicked() {
+                    state.new_open = true;
+                    if state.new_size == (0, 0, 0) {
+                        state.new_size = (256, 128, 256);
+                    }
+                }
+                for (label, action) in [
+                    ("Open…  Ctrl+O", Action::Open),
+                    ("Save  Ctrl+S", Action::Save),
+                    ("Save As…  Ctrl+Shift+S", Action::SaveAs),
+                    ("Import .vox…  Ctrl+I", Action::Import),
+                    ("Export .vox…  Ctrl+E", Action::Export),
+                ] {
+                    if ui.button(label).clicked() {
+                        out.push(UiEvent::Action(action));
+                    }
+                }
+                ui.menu_button("Recent", |ui| {
+                    if state.recent.is_empty() {
+                        ui.label("(none)");
+                    }
+                    for p in &state.recent {
+                        if ui.button(p.display().to_string()).clicked() {
+                            out.push(UiEvent::OpenRecent(p.clone()));
+                        }
+                    }
+                });
+                ui.separator();
+                if ui.button("Quit  Ctrl+Q").clicked() {
+                    out.push(UiEvent::Action(Action::Quit));
+                }
+            });
+            ui.menu_button("Edit", |ui| {
+                if ui
+                    .add_enabled(
+                        doc.history.undo_len() > 0,
+                        egui::Button::new("Undo  Ctrl+Z"),
+                    )
+                    .clicked()
+                {
+                    out.push(UiEvent::Action(Action::Undo));
+                }
+                if ui
+                    .add_enabled(
+                        doc.history.redo_len() > 0,
+                        egui::Button::new("Redo  Ctrl+Y"),
+                    )
+                    .clicked()
+                {
+                    out.push(UiEvent::Action(Action::Redo));
+                }
+            });
+            ui.menu_button("View", |ui| {
+                if ui.button("Frame the scene  F").clicked() {
+                    out.push(UiEvent::Action(Action::Frame));
+                }
+                if ui.button("Use this view as the scene camera").clicked() {
+                    out.push(UiEvent::UseViewAsSceneCamera);
+                }
+                ui.checkbox(&mut state.render_open, "Render settings");
+                ui.checkbox(&mut state.sun_open, "Sun and sky");
+                ui.checkbox(&mut state.stats_open, "Scene statistics");
+                ui.checkbox(&mut state.help_open, "Shortcuts  F1");
+            });
+            if !state.busy.is_empty() {
+                ui.separator();
+                ui.add(egui::Spinner::new());
+                ui.label(state.busy.join(", "));
+            }
+        });
+    });
+    egui::Panel::bottom("status").show(root, |ui| {
+        ui.label(&state.status);
+    });
+    if state.render_open {
+        let mut open = true;
+        egui::Window::new("Render settings")
+            .open(&mut open)
+            .show(ctx, |ui| {
+                ui.add(
+                    egui::Slider::new(&mut view.target_spp, 1..=4096)
+                        .logarithmic(true)
+                        .text("target spp"),
+                );
+                ui.add(
+                    egui::Slider::new(&mut view.internal_scale, 0.125..=1.0)
+                        .text("internal resolution"),
+                );
+                ui.add(egui::Slider::new(&mut view.moving_scale, 0.125..=1.0).text("while moving"));
+                ui.add(egui::Slider::new(&mut view.exposure, -8.0..=8.0).text("exposure (stops)"));
+                let mut settings = doc.scene.params.settings.clone();
+                if ui
+                    .add(
+                        egui::Slider::new(&mut settings.max_bounces, 1..=16)
+                            .text("bounces (scene)"),
+                    )
+                    .changed()
+                {
+                    out.push(UiEvent::SetSettings(settings));
+                }
+                ui.add(
+                    egui::Slider::new(&mut view.autosave_secs, 0..=1800)
+                        .text("autosave every (s, 0 off)"),
+                );
+            });
+        state.render_open = open;
+    }
+    if state.sun_open {
+        let mut open = true;
+        egui::Window::new("Sun and sky")
+            .open(&mut open)
+            .show(ctx, |ui| {
+                sun_and_sky(ui, doc, &mut out);
+            });
+        state.sun_open = open;
+    }
+    if state.stats_open {
+        let mut open = true;
+        egui::Window::new("Scene statistics")
+            .open(&mut open)
+            .show(ctx, |ui| {
+                ui.monospace(&state.stats);
+            });
+        state.stats_open = open;
+    }
+    if state.help_open {
+        let mut open = true;
+        egui::Window::new("Shortcuts")
+            .open(&mut open)
+            .show(ctx, |ui| {
+                egui::Grid::new("keys").striped(true).show(ui, |ui| {
+                    for (keys, what) in SHORTCUTS {
+                        ui.monospace(*keys);
+                        ui.label(*what);
+                        ui.end_row();
+                    }
+                });
+            });
+        state.help_open = open;
+    }
+    if state.new_open {
+        let mut open = true;
+        egui::Window::new("New scene")
+            .open(&mut open)
+            .show(ctx, |ui| {
+                let (x, y, z) = &mut state.new_size;
+                ui.horizontal(|ui| {
+                    ui.add(egui::DragValue::new(x).range(8..=4096).prefix("x "));
+                    ui.add(egui::DragValue::new(y).range(8..=1024).prefix("y "));
+                    ui.add(egui::DragValue::new(z).range(8..=4096).prefix("z "));
+                });
+                ui.checkbox(&mut state.new_terrain, "noise terrain with water");
+                if ui.button("Create").clicked() {
+                    out.push(UiEvent::NewScene {
+                        size: state.new_size,
+                        terrain: state.new_terrain,
+                    });
+                    state.new_open = false;
+                }
+            });
+        state.new_open &= open;
+    }
+    if state.asking_unsaved {
+        modal(ctx, "Unsaved changes", |ui| {
+            ui.label("The scene has unsaved changes.");
+            ui.horizontal(|ui| {
+                for (label, a) in [
+                    ("Save", UnsavedAnswer::Save),
+                    ("Discard", UnsavedAnswer::Discard),
+                    ("Cancel", UnsavedAnswer::Cancel),
+                ] {
+                    if ui.button(label).clicked() {
+                        out.push(UiEvent::Unsaved(a));
+                    }
+                }
+            });
+        });
+    }
+    if let Some(path) = &state.recovery {
+        let text = format!(
+            "voxbrick did not exit cleanly last time. Recover the autosaved scene ({})?",
+            path.display()
+        );
+        modal(ctx, "Recover unsaved work", |ui| {
+            ui.label(text);
+            ui.horizontal(|ui| {
+                if ui.button("Recover").clicked() {
+                    out.push(UiEvent::Recover(true));
+                }
+                if ui.button("Discard").clicked() {
+                    out.push(UiEvent::Recover(false));
+                }
+            });
+        });
+    }
+    if !state.errors.is_empty() {
+        let mut dismiss = false;
+        egui::Window::new("Error")
+            .collapsible(false)
+            .show(ctx, |ui| {
+                for e in &state.errors {
+                    ui.colored_label(egui::Color32::LIGHT_RED, e);
+                }
+                dismiss = ui.button("OK").clicked();
+            });
+        if dismiss {
+            state.errors.clear();
+        }
+    }
+    out
+}
+
+fn modal(ctx: &egui::Context, title: &str, body: impl FnOnce(&mut egui::Ui)) {
+    egui::Window::new(title)
+        .collapsible(false)
+        .resizable(false)
+        .anchor(egui::Align2::CENTER_CENTER, [0.0, 0.0])
+        .show(ctx, body);
+}
+
+fn sun_and_sky(ui: &mut egui::Ui, doc: &Document, out: &mut Vec<UiEvent>) {
+    let mut sun = doc.scene.params.sun.clone();
+    let centre = doc.scene.world.dims().voxels().as_dvec3() * 0.5;
+    // Azimuth and elevation of the sun about the grid centre, at its distance.
+    let rel = sun.position - centre;
+    let distance = rel.length().max(1.0);
+    let mut elevation = (rel.y / distance).clamp(-1.0, 1.0).asin().to_degrees();
+    let mut azimuth = rel.z.atan2(rel.x).to_degrees();
+    let mut changed = ui.checkbox(&mut sun.enabled, "sun").changed();
+    changed |= ui
+        .add(egui::Slider::new(&mut azimuth, -180.0..=180.0).text("azimuth°"))
+        .changed();
+    changed |= ui
+        .add(egui::Slider::new(&mut elevation, -10.0..=90.0).text("elevation°"))
+        .changed();
+    changed |= ui
+        .add(
+            egui::Slider::new(&mut sun.radius, 1.0..=distance * 0.5)
+                .logarithmic(true)
+                .text("radius"),
+        )
+        .changed();
+    changed |= ui
+        .add(
+            egui::Slider::new(&mut sun.intensity, 0.0..=1000.0)
+                .logarithmic(true)
+                .text("intensity"),
+        )
+        .changed();
+    changed |= ui.color_edit_button_rgb(&mut sun.colour).changed();
+    changed |= ui.checkbox(&mut sun.animate, "animate").changed();
+    if changed {
+        let (a, e) = (azimuth.to_radians(), elevation.to_radians());
+        sun.position =
+            centre + glam::DVec3::new(a.cos() * e.cos(), e.sin(), a.sin() * e.cos()) * distance;
+        if sun.validate().is_ok() {
+            out.push(UiEvent::SetSun(sun));
+        }
+    }
+    ui.separator();
+    let mut sky = doc.scene.params.sky.clone();
+    let sky_changed = match &mut sky {
+        Sky::Uniform { colour } => {
+            ui.label("sky (uniform)");
+            ui.color_edit_button_rgb(colour).changed()
+        }
+        Sky::Gradient { horizon, zenith } => {
+            ui.label("sky: horizon, zenith");
+            ui.color_edit_button_rgb(horizon).changed() | ui.color_edit_button_rgb(zenith).changed()
+        }
+    };
+    if sky_changed && sky.validate().is_ok() {
+        out.push(UiEvent::SetSky(sky));
+    }
+}
