@@ -1,0 +1,287 @@
+//! The real editor binary in a real window: under Xvfb on the machine's Vulkan driver
+//! (lavapipe in CI) with the validation layer, `voxbrick --script` runs a replay script's
+//! steps through the live editor, captures the presented frame (read back from the swapchain
+//! image) and exits. The capture must equal a headless render of the saved state within
+//! sampling noise, the run must report no validation error, and a screenshot of the screen
+//! (xwd) must show a window that is not blank. Without Xvfb/xwd or a Vulkan driver the test
+//! skips, saying so, unless VOXBRICK_REQUIRE_GPU=1 (CI) makes that a failure.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+const SIZE: (u32, u32) = (160, 96);
+const SPP: u32 = 16;
+
+fn require() -> bool {
+    std::env::var("VOXBRICK_REQUIRE_GPU").as_deref() == Ok("1")
+}
+
+fn skip(why: &str) {
+    assert!(!require(), "{why}, and VOXBRICK_REQUIRE_GPU=1");
+    eprintln!("SKIPPED: {why}; VOXBRICK_REQUIRE_GPU=1 makes this a failure");
+}
+
+fn have(tool: &str) -> bool {
+    Command::new("sh")
+        .args(["-c", &format!("command -v {tool}")])
+        .stdout(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+/// An Xvfb server of our own, killed on drop.
+struct Xvfb {
+    child: Child,
+    display: String,
+}
+
+impl Xvfb {
+    fn start() -> Option<Self> {
+        for n in 0..20 {
+            let number = 90 + (std::process::id() + n) % 400;
+            if Path::new(&format!("/tmp/.X11-unix/X{number}")).exists() {
+                continue;
+            }
+            let display = format!(":{number}");
+            let child = Command::new("Xvfb")
+                .args([&display, "-screen", "0", "320x240x24", "-nolisten", "tcp"])
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+                .ok()?;
+            let mut x = Xvfb { child, display };
+            let socket = format!("/tmp/.X11-unix/X{number}");
+            let started = Instant::now();
+            while started.elapsed() < Duration::from_secs(10) {
+                if Path::new(&socket).exists() {
+                    return Some(x);
+                }
+                if let Ok(Some(_)) = x.child.try_wait() {
+                    break;
+                }
+                std::thread::sleep(Duration::from_millis(50));
+            }
+            let _ = x.child.kill();
+        }
+        None
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("voxbrick-window-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn read_png(path: &Path) -> (u32, u32, Vec<u8>) {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgb, "{}", path.display());
+    buf.truncate(info.buffer_size());
+    (info.width, info.height, buf)
+}
+
+fn rms(a: &[u8], b: &[u8]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let sum: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (*x as f64 - *y as f64).powi(2))
+        .sum();
+    (sum / a.len() as f64).sqrt()
+}
+
+/// Distinct colours of an XWD screenshot's pixels inside `w`×`h` at the top left (a
+/// 32-bit TrueColor dump, as Xvfb at depth 24 writes).
+fn xwd_colours(bytes: &[u8], w: u32, h: u32) -> usize {
+    let word = |i: usize| u32::from_be_bytes(bytes[4 * i..4 * i + 4].try_into().unwrap());
+    let (header, width, height, bpp, line, ncolours) = (
+        word(0) as usize,
+        word(4),
+        word(5),
+        word(11),
+        word(12) as usize,
+        word(19) as usize,
+    );
+    assert_eq!(bpp, 32, "32-bit pixels");
+    let start = header + 12 * ncolours;
+    let mut seen = std::collections::HashSet::new();
+    for y in 0..h.min(height) as usize {
+        for x in 0..w.min(width) as usize {
+            let p = start + y * line + 4 * x;
+            seen.insert(&bytes[p..p + 3]);
+        }
+    }
+    seen.len()
+}
+
+#[test]
+fn the_live_editor_presents_what_a_headless_render_of_the_same_state_shows() {
+    if !have("Xvfb") || !have("xwd") {
+        return skip("Xvfb or xwd is not installed (packages xvfb, x11-apps)");
+    }
+    let Some(x) = Xvfb::start() else {
+        return skip("Xvfb did not start");
+    };
+    let dir = scratch("live");
+    let script =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/scripts/editor/live_viewport.ron");
+    let capture = dir.join("capture.png");
+    let mut editor = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
+        .arg("--script")
+        .arg(&script)
+        .arg("--capture")
+        .arg(&capture)
+        .args([
+            "--capture-spp",
+            &SPP.to_string(),
+            "--window",
+            &format!("{}x{}", SIZE.0, SIZE.1),
+            "--validation",
+            "--linger-ms",
+            "4000",
+        ])
+        .env("DISPLAY", &x.display)
+        .env_remove("WAYLAND_DISPLAY")
+        .env("VOXBRICK_CONFIG_DIR", dir.join("config"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("voxbrick starts");
+    // While the window lingers after the capture, photograph the screen.
+    let started = Instant::now();
+    let mut screenshot = None;
+    while started.elapsed() < Duration::from_secs(600) {
+        if let Ok(Some(_)) = editor.try_wait() {
+            break;
+        }
+        if capture.exists() && screenshot.is_none() {
+            std::thread::sleep(Duration::from_millis(1500));
+            let shot = Command::new("xwd")
+                .args(["-root", "-silent", "-display", &x.display])
+                .output()
+                .expect("xwd runs");
+            assert!(
+                shot.status.success(),
+                "xwd: {}",
+                String::from_utf8_lossy(&shot.stderr)
+            );
+            screenshot = Some(shot.stdout);
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    let out = editor.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success()
+        && (stderr.contains("no usable Vulkan") || stderr.contains("no Vulkan device"))
+    {
+        return skip(&format!(
+            "no Vulkan device can draw a window: {}",
+            stderr.trim()
+        ));
+    }
+    assert!(
+        out.status.success(),
+        "the editor failed: {}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        stderr
+    );
+    assert!(
+        !stderr.contains("vulkan ERROR"),
+        "validation errors:\n{stderr}"
+    );
+    // The window is on screen and shows more than a flat colour.
+    let shot = screenshot.expect("a screenshot was taken while the window lingered");
+    let colours = xwd_colours(&shot, SIZE.0, SIZE.1);
+    assert!(colours > 50, "the window looks blank: {colours} colours");
+
+    // The headless render of the same state, same seed and samples, and one with another
+    // seed for the noise level.
+    let state = dir.join("state.ron");
+    assert!(
+        state.exists(),
+        "the script saved its state beside the capture"
+    );
+    let render = |seed: u64, out: &Path| {
+        let r = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
+            .arg("render")
+            .arg(&state)
+            .arg("--out")
+            .arg(out)
+            .args([
+                "--width",
+                &SIZE.0.to_string(),
+                "--height",
+                &SIZE.1.to_string(),
+                "--spp",
+                &SPP.to_string(),
+                "--seed",
+                &seed.to_string(),
+            ])
+            .output()
+            .unwrap();
+        assert!(
+            r.status.success(),
+            "render: {}",
+            String::from_utf8_lossy(&r.stderr)
+        );
+    };
+    let (same, other) = (dir.join("same.png"), dir.join("other.png"));
+    render(1, &same);
+    render(2, &other);
+    let (cw, ch, live) = read_png(&capture);
+    assert_eq!((cw, ch), SIZE, "the capture has the window's size");
+    let (_, _, headless) = read_png(&same);
+    let (_, _, noise) = read_png(&other);
+    let (diff, sampling) = (rms(&live, &headless), rms(&headless, &noise));
+    eprintln!("live vs headless RMS {diff:.3} (8-bit units); two seeds {sampling:.3}");
+    assert!(
+        sampling > 1.0,
+        "the seeds give different noise ({sampling})"
+    );
+    assert!(
+        diff < 0.25 * sampling + 1.0,
+        "the viewport differs from the headless render by more than rounding: RMS {diff:.3}, sampling noise {sampling:.3}"
+    );
+    // Red and blue in place: the capture's mean colour is the headless one's.
+    let mean = |p: &[u8], c: usize| {
+        p.iter().skip(c).step_by(3).map(|v| *v as f64).sum::<f64>() / (p.len() / 3) as f64
+    };
+    for c in 0..3 {
+        assert!(
+            (mean(&live, c) - mean(&headless, c)).abs() < 1.0,
+            "channel {c}"
+        );
+    }
+    assert!(
+        (mean(&headless, 0) - mean(&headless, 2)).abs() > 2.0,
+        "the scene is not grey"
+    );
+}
+
+#[test]
+fn without_a_display_the_editor_says_so_in_one_line() {
+    let out = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
+        .args(["--window", "160x96"])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env("VOXBRICK_CONFIG_DIR", scratch("nodisplay"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(err.contains("display"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
