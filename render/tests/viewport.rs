@@ -1,0 +1,170 @@
+//! The GPU session's interactive frames (frames in flight, cached descriptor sets, no host
+//! waits) on a real device with the validation layer: they accumulate exactly the samples a
+//! one-shot render takes, restart on an edit and on a camera change, and stop at the target.
+
+mod common;
+
+use brickmap::{EditOp, Mode, Shape};
+use glam::DVec3;
+use render::cpu::RenderJob;
+use render::viewport::{FrameRequest, Viewport};
+use render::vulkan::{ContextOptions, DeviceChoice, GpuContext, GpuError};
+use std::sync::Arc;
+
+fn context() -> Option<Arc<GpuContext>> {
+    match GpuContext::new(&ContextOptions {
+        device: DeviceChoice::Best,
+        validation: true,
+        ..Default::default()
+    }) {
+        Ok(c) => Some(Arc::new(c)),
+        Err(e @ GpuError::NoVulkan(_))
+            if std::env::var("VOXBRICK_REQUIRE_GPU").as_deref() != Ok("1") =>
+        {
+            eprintln!(
+                "SKIPPED: no Vulkan driver ({e}); VOXBRICK_REQUIRE_GPU=1 makes this a failure"
+            );
+            None
+        }
+        Err(e) => panic!("creating a Vulkan context: {e}"),
+    }
+}
+
+/// Draws frames until `done` says so (at most `limit`); returns the statuses of the frames
+/// that were recorded (a slot still in flight yields no frame and is not waited for).
+fn frames(
+    vp: &mut Viewport,
+    world: &brickmap::World,
+    req: &FrameRequest<'_>,
+    limit: usize,
+    done: impl Fn(&Viewport) -> bool,
+) -> Vec<render::viewport::FrameStatus> {
+    let mut out = Vec::new();
+    for _ in 0..limit * 1000 {
+        if done(vp) || out.len() >= limit {
+            break;
+        }
+        match vp.begin_frame().unwrap() {
+            Some(frame) => {
+                out.push(vp.trace_frame(&frame, world, req).unwrap());
+                vp.submit_frame(frame, &[], &[]).unwrap();
+            }
+            None => std::thread::sleep(std::time::Duration::from_millis(1)),
+        }
+    }
+    vp.wait_idle().unwrap();
+    out
+}
+
+#[test]
+fn interactive_frames_accumulate_the_one_shot_renders_samples() {
+    let Some(ctx) = context() else { return };
+    let (world, params) = common::showcase();
+    let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
+    let size = (40, 24);
+    let req = FrameRequest {
+        params: &params,
+        internal: size,
+        output: size,
+        spp: 3,
+        target_spp: 16,
+        exposure: 0.0,
+        bgra: false,
+    };
+    let statuses = frames(&mut vp, &world, &req, 64, |v| v.samples() >= 16);
+    assert!(statuses[0].restarted && statuses[0].samples <= 3);
+    assert_eq!(vp.samples(), 16, "stops exactly at the target");
+    // At the target, frames add nothing (the editor then waits for events).
+    let idle = frames(&mut vp, &world, &req, 3, |_| false);
+    assert!(
+        idle.iter().all(|s| s.added == 0 && !s.restarted),
+        "{idle:?}"
+    );
+    let live = vp.live_hdr().unwrap().unwrap();
+    let (once, _) = vp
+        .render(
+            &world.read(),
+            &params,
+            &RenderJob {
+                width: size.0,
+                height: size.1,
+                spp: 16,
+                seed: 1,
+            },
+        )
+        .unwrap();
+    let worst = live
+        .pixels
+        .iter()
+        .zip(&once.pixels)
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs() / b[c].abs().max(1e-3)))
+        .fold(0.0f32, f32::max);
+    assert!(
+        worst < 1e-3,
+        "interactive and one-shot samples differ: {worst}"
+    );
+    assert_eq!(ctx.validation_errors(), 0, "validation errors");
+}
+
+#[test]
+fn an_edit_or_a_camera_move_restarts_and_the_edit_is_visible_the_next_frame() {
+    let Some(ctx) = context() else { return };
+    let (world, mut params) = common::showcase();
+    let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
+    let size = (32, 24);
+    let run = |vp: &mut Viewport, params: &render::SceneParams, n| {
+        let req = FrameRequest {
+            params,
+            internal: size,
+            output: size,
+            spp: 2,
+            target_spp: 8,
+            exposure: 0.0,
+            bgra: false,
+        };
+        frames(vp, &world, &req, n, |_| false)
+    };
+    let first = run(&mut vp, &params, 4);
+    assert_eq!(first.last().unwrap().samples, 8);
+    // An edit: the next frame uploads it and starts over.
+    world
+        .apply(EditOp::Shape {
+            shape: Shape::Sphere {
+                centre: DVec3::new(24.0, 12.0, 24.0),
+                radius: 6.0,
+            },
+            mode: Mode::Add(0),
+        })
+        .unwrap();
+    let after_edit = run(&mut vp, &params, 1);
+    assert!(after_edit[0].restarted && after_edit[0].upload.uploaded_bytes > 0);
+    let (edited, _) = vp
+        .render(
+            &world.read(),
+            &params,
+            &RenderJob {
+                width: size.0,
+                height: size.1,
+                spp: 2,
+                seed: 1,
+            },
+        )
+        .unwrap();
+    let live = vp.live_hdr().unwrap().unwrap();
+    let diff: f32 = live
+        .pixels
+        .iter()
+        .zip(&edited.pixels)
+        .map(|(a, b)| (a[0] - b[0]).abs())
+        .sum();
+    assert!(
+        diff < 1e-2 * live.pixels.len() as f32,
+        "the frame after the edit shows it: {diff}"
+    );
+    // A camera move restarts too.
+    run(&mut vp, &params, 4);
+    params.camera.yaw_deg += 5.0;
+    let moved = run(&mut vp, &params, 1);
+    assert!(moved[0].restarted, "{moved:?}");
+    assert_eq!(ctx.validation_errors(), 0, "validation errors");
+}
