@@ -148,6 +148,23 @@ pub fn encode_srgb(x: f32) -> u8 {
     (s * 255.0 + 0.5) as u8
 }
 
+/// Writes 8-bit RGB pixels (rows top to bottom) as a PNG.
+pub fn write_png_rgb8(
+    out: &mut dyn Write,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+) -> std::io::Result<()> {
+    let mut encoder = png::Encoder::new(out, width, height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
+    writer
+        .write_image_data(rgb)
+        .map_err(std::io::Error::other)?;
+    writer.finish().map_err(std::io::Error::other)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -195,21 +212,4 @@ mod tests {
         assert!(out.starts_with(b"PF\n3 2\n-1.0\n"));
         assert_eq!(out.len(), 12 + 6 * 12);
     }
-}
-
-/// Writes 8-bit RGB pixels (rows top to bottom) as a PNG.
-pub fn write_png_rgb8(
-    out: &mut dyn Write,
-    width: u32,
-    height: u32,
-    rgb: &[u8],
-) -> std::io::Result<()> {
-    let mut encoder = png::Encoder::new(out, width, height);
-    encoder.set_color(png::ColorType::Rgb);
-    encoder.set_depth(png::BitDepth::Eight);
-    let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
-    writer
-        .write_image_data(rgb)
-        .map_err(std::io::Error::other)?;
-    writer.finish().map_err(std::io::Error::other)
 }

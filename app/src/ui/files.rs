@@ -101,7 +101,7 @@ pub enum Done {
     /// A file dialog closed (None: cancelled or no dialog available, with the reason).
     Picked(Purpose, Result<Option<PathBuf>, String>),
     /// A scene was loaded (or failed to) from a path, or built (the default scene: None).
-    Loaded(Option<PathBuf>, Result<Scene>),
+    Loaded(Option<PathBuf>, Box<Result<Scene>>),
     /// A save finished; `autosave` saves go to the recovery file and don't clean the document.
     Saved {
         /// Where.
@@ -174,7 +174,7 @@ impl FileWorker {
         self.spawn(format!("opening {}", path.display()), move || {
             let scene =
                 Scene::load(&path, workers).with_context(|| format!("opening {}", path.display()));
-            Done::Loaded(Some(path), scene)
+            Done::Loaded(Some(path), Box::new(scene))
         });
     }
 
@@ -182,7 +182,7 @@ impl FileWorker {
     pub fn build_default(&mut self, workers: usize) {
         self.spawn("building the default scene".into(), move || {
             let scene = crate::scene::default_scene(crate::scene::SceneSize::Full, workers);
-            Done::Loaded(None, scene)
+            Done::Loaded(None, Box::new(scene))
         });
     }
 

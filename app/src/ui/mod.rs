@@ -456,28 +456,30 @@ impl Editor {
             },
             Done::Picked(_, Ok(None)) => self.save_then = None,
             Done::Picked(_, Err(e)) => self.panels.errors.push(e),
-            Done::Loaded(path, Ok(scene)) => {
-                if self.loading_default && path.is_some() {
-                    // A file opened while the default scene was building wins.
-                    self.loading_default = false;
-                }
-                if path.is_none() && !self.loading_default {
-                    return;
-                }
-                self.loading_default = false;
-                let recovered = std::mem::take(&mut self.recovering);
-                self.replace_document(scene, path.filter(|_| !recovered));
-                if recovered {
-                    if let Ok(mut d) = self.doc.write() {
-                        d.dirty = true;
+            Done::Loaded(path, loaded) => match *loaded {
+                Ok(scene) => {
+                    if self.loading_default && path.is_some() {
+                        // A file opened while the default scene was building wins.
+                        self.loading_default = false;
                     }
-                    self.config.remove_recovery();
+                    if path.is_none() && !self.loading_default {
+                        return;
+                    }
+                    self.loading_default = false;
+                    let recovered = std::mem::take(&mut self.recovering);
+                    self.replace_document(scene, path.filter(|_| !recovered));
+                    if recovered {
+                        if let Ok(mut d) = self.doc.write() {
+                            d.dirty = true;
+                        }
+                        self.config.remove_recovery();
+                    }
                 }
-            }
-            Done::Loaded(_, Err(e)) => {
-                self.loading_default = false;
-                self.panels.errors.push(format!("{e:#}"));
-            }
+                Err(e) => {
+                    self.loading_default = false;
+                    self.panels.errors.push(format!("{e:#}"));
+                }
+            },
             Done::Saved {
                 path,
                 autosave,

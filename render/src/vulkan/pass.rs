@@ -431,11 +431,11 @@ fn write_set(ctx: &GpuContext, set: vk::DescriptorSet, buffers: &[Binding]) {
 /// are made; [`SetCache::clear`] drops them all once the slot's submission is done.
 pub struct SetCache {
     pool: vk::DescriptorPool,
-    sets: std::collections::HashMap<
-        (vk::DescriptorSetLayout, Vec<(vk::Buffer, u64, u64)>),
-        vk::DescriptorSet,
-    >,
+    sets: std::collections::HashMap<SetKey, vk::DescriptorSet>,
 }
+
+/// A set's identity: its layout and the (buffer, offset, range) of each binding.
+type SetKey = (vk::DescriptorSetLayout, Vec<(vk::Buffer, u64, u64)>);
 
 /// Sets a cache holds before it starts over.
 const CACHED_SETS: u32 = 32;
