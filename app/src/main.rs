@@ -2,6 +2,8 @@
 //! a file, or the built-in default scene); subcommands build, convert, inspect, render,
 //! replay and benchmark scenes headlessly.
 
+mod cli;
+
 use anyhow::{Context, Result, bail};
 use app::Scene;
 use app::formats::{self, Format};
@@ -192,6 +194,25 @@ enum Command {
         /// Render device for render steps: gpu or cpu.
         #[arg(long, default_value = "gpu")]
         device: String,
+    },
+    /// The editor's frame loop without a window (frames in flight, trace and display) on the
+    /// thesis scene: GPU and host time per frame, camera move to first frame.
+    BenchViewport {
+        /// Output (window) size, as WxH.
+        #[arg(long, value_parser = parse_window_size, default_value = "1920x1080")]
+        size: (u32, u32),
+        /// Internal scales, comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "0.5,1.0")]
+        scales: Vec<f32>,
+        /// Timed frames per case.
+        #[arg(long, default_value_t = 200)]
+        frames: usize,
+        /// Samples per pixel each frame adds.
+        #[arg(long, default_value_t = 1)]
+        spp: u32,
+        /// Vulkan device (part of its name).
+        #[arg(long)]
+        device: Option<String>,
     },
     /// Time the GPU path tracer on the thesis scene with Vulkan timestamp queries: medians
     /// after warm-up for the thesis's complexities 1, 2 and 3.
@@ -494,6 +515,36 @@ fn run(cli: Cli) -> Result<()> {
                 started.elapsed().as_secs_f64(),
                 doc.scene.world.read().content_hash()
             ))
+        }
+        Command::BenchViewport {
+            size,
+            scales,
+            frames,
+            spp,
+            device,
+        } => {
+            if let Some(s) = scales.iter().find(|s| !(**s > 0.0 && **s <= 1.0)) {
+                bail!("internal scale {s} is outside (0, 1]");
+            }
+            let mut scene = thesis_scene(workers)?;
+            scene.params.sun.enabled = true;
+            scene.params.settings.max_bounces = 3;
+            let session = {
+                let view = scene.world.read();
+                app::gpu::session(device.as_deref().unwrap_or("gpu"), &view)?
+            };
+            let bench = cli::bench_viewport::BenchViewport {
+                size,
+                scales,
+                frames: frames.max(1),
+                spp: spp.clamp(1, 16),
+            };
+            emit(&cli::bench_viewport::run(
+                session,
+                &scene.world,
+                &scene.params,
+                &bench,
+            )?)
         }
         Command::BenchGpu {
             width,

@@ -215,9 +215,16 @@ mod tests {
     #[test]
     fn fly_moves_eye_and_pivot_together() {
         let mut v = view();
-        let (pivot, eye) = (v.pivot(), v.camera.position);
+        let (pivot, eye, forward) = (v.pivot(), v.camera.position, v.camera.forward());
         v.fly(DVec3::new(1.0, 2.0, 3.0));
-        assert!(close(v.pivot() - pivot, v.camera.position - eye, 1e-9));
-        assert!(((v.camera.position - eye).length() - 14f64.sqrt()).abs() < 1e-9);
+        let moved = v.camera.position - eye;
+        assert!(close(v.pivot() - pivot, moved, 1e-9));
+        // Forward along the view, up along world y, right level with the ground.
+        let right = forward.cross(DVec3::Y).normalize();
+        assert!(
+            close(moved, right + DVec3::Y * 2.0 + forward * 3.0, 1e-9),
+            "{moved}"
+        );
+        assert!(right.y.abs() < 1e-12);
     }
 }

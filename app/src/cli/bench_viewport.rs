@@ -1,0 +1,175 @@
+//! `voxbrick bench-viewport`: the editor's frame loop without a window — the same
+//! [`Viewport`] frames in flight the window draws (trace, display pass; only the copy into a
+//! swapchain image and egui are absent) — at a window size and internal scales, on the thesis
+//! scene. Reports GPU time per frame (timestamp queries), host time to record and submit a
+//! frame, and camera move → first frame showing it (frames and ms, submit to completion).
+
+use anyhow::Result;
+use brickmap::World;
+use render::SceneParams;
+use render::viewport::{FrameRequest, Viewport};
+use std::time::Instant;
+
+/// What to measure.
+pub struct BenchViewport {
+    /// Output (window) size.
+    pub size: (u32, u32),
+    /// Internal scales to measure.
+    pub scales: Vec<f32>,
+    /// Timed frames per case (after warm-up).
+    pub frames: usize,
+    /// Samples per pixel each frame adds.
+    pub spp: u32,
+}
+
+fn scaled((w, h): (u32, u32), f: f32) -> (u32, u32) {
+    (
+        ((w as f64 * f as f64).ceil() as u32).max(1),
+        ((h as f64 * f as f64).ceil() as u32).max(1),
+    )
+}
+
+fn stats(mut v: Vec<f64>) -> (f64, f64, f64, f64) {
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() {
+        return (f64::NAN, f64::NAN, f64::NAN, f64::NAN);
+    }
+    let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+    (q(0.0), q(0.5), q(0.99), v[v.len() - 1])
+}
+
+/// One case: `frames` frames, each `spp` more samples (restarting each frame when `moving`).
+/// Returns (GPU seconds per frame, host seconds per frame).
+fn run_case(
+    vp: &mut Viewport,
+    world: &World,
+    params: &SceneParams,
+    req: FrameRequest<'_>,
+    frames: usize,
+    moving: bool,
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    let (mut gpu, mut host) = (Vec::new(), Vec::new());
+    let mut p = params.clone();
+    let mut submitted = 0;
+    while submitted < frames + 8 {
+        if moving {
+            p.camera.yaw_deg += 0.05;
+        }
+        let started = Instant::now();
+        let Some(frame) = vp.begin_frame()? else {
+            // Both slots in flight: the window's loop would handle events meanwhile.
+            std::thread::yield_now();
+            continue;
+        };
+        let req = FrameRequest { params: &p, ..req };
+        vp.trace_frame(&frame, world, &req)?;
+        vp.submit_frame(frame, &[], &[])?;
+        let spent = started.elapsed().as_secs_f64();
+        submitted += 1;
+        // The first frames warm up (pipelines, clocks); each slot's GPU time is read when it
+        // comes round again.
+        if submitted > 8 {
+            host.push(spent);
+            if let Some(t) = vp.last_gpu_seconds() {
+                gpu.push(t);
+            }
+        }
+    }
+    vp.wait_idle()?;
+    Ok((gpu, host))
+}
+
+/// Camera move → the first frame showing it finished on the GPU, `moves` times: (frames,
+/// milliseconds) medians.
+fn latency(
+    vp: &mut Viewport,
+    world: &World,
+    params: &SceneParams,
+    req: FrameRequest<'_>,
+    moves: usize,
+) -> Result<(f64, f64)> {
+    let mut p = params.clone();
+    let (mut frames, mut ms) = (Vec::new(), Vec::new());
+    for _ in 0..moves {
+        // A frame already in flight, as in the window's loop.
+        if let Some(f) = vp.begin_frame()? {
+            let r = FrameRequest { params: &p, ..req };
+            vp.trace_frame(&f, world, &r)?;
+            vp.submit_frame(f, &[], &[])?;
+        }
+        p.camera.pitch_deg = (p.camera.pitch_deg - 0.5).max(-80.0);
+        let event = Instant::now();
+        let mut n = 0;
+        loop {
+            let Some(f) = vp.begin_frame()? else {
+                std::thread::yield_now();
+                continue;
+            };
+            n += 1;
+            let r = FrameRequest { params: &p, ..req };
+            let status = vp.trace_frame(&f, world, &r)?;
+            vp.submit_frame(f, &[], &[])?;
+            if status.restarted {
+                break;
+            }
+        }
+        vp.wait_idle()?;
+        frames.push(n as f64);
+        ms.push(event.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok((stats(frames).1, stats(ms).1))
+}
+
+/// Runs the benchmark; returns the report.
+pub fn run(
+    mut vp: Viewport,
+    world: &World,
+    params: &SceneParams,
+    b: &BenchViewport,
+) -> Result<String> {
+    let ctx = vp.ctx().clone();
+    let mut text = format!(
+        "device       {} ({})\nscene        thesis, {} bounces, sun {}; output {}x{}, {} spp per frame\n",
+        ctx.name,
+        ctx.driver,
+        params.settings.max_bounces,
+        if params.sun.enabled { "on" } else { "off" },
+        b.size.0,
+        b.size.1,
+        b.spp
+    );
+    text += "case                          internal     GPU ms/frame min / median / p99 / max     host µs/frame median / p99\n";
+    for &scale in &b.scales {
+        let internal = scaled(b.size, scale);
+        let req = FrameRequest {
+            params,
+            internal,
+            output: b.size,
+            spp: b.spp,
+            target_spp: u32::MAX,
+            exposure: 0.0,
+            bgra: true,
+        };
+        for (label, moving) in [("refining (still camera)", false), ("camera moving", true)] {
+            let (gpu, host) = run_case(&mut vp, world, params, req, b.frames, moving)?;
+            let (g0, g50, g99, gmax) = stats(gpu);
+            let (_, h50, h99, _) = stats(host);
+            text += &format!(
+                "scale {scale:<4} {label:<24} {:>4}x{:<5}  {:.3} / {:.3} / {:.3} / {:.3}               {:.0} / {:.0}\n",
+                internal.0,
+                internal.1,
+                g0 * 1e3,
+                g50 * 1e3,
+                g99 * 1e3,
+                gmax * 1e3,
+                h50 * 1e6,
+                h99 * 1e6
+            );
+        }
+        let (frames, ms) = latency(&mut vp, world, params, req, 20)?;
+        text += &format!(
+            "scale {scale:<4} camera move → first frame showing it: {frames:.0} frame(s), {ms:.2} ms (median of 20, event to GPU completion)\n"
+        );
+    }
+    Ok(text)
+}
