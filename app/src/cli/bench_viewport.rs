@@ -39,7 +39,7 @@ fn stats(mut v: Vec<f64>) -> (f64, f64, f64, f64) {
 }
 
 /// One case: `frames` frames, each `spp` more samples (restarting each frame when `moving`).
-/// Returns (GPU seconds per frame, host seconds per frame).
+/// Returns (GPU seconds per frame, host seconds per frame: begin, record, submit).
 fn run_case(
     vp: &mut Viewport,
     world: &World,
@@ -47,7 +47,7 @@ fn run_case(
     req: FrameRequest<'_>,
     frames: usize,
     moving: bool,
-) -> Result<(Vec<f64>, Vec<f64>)> {
+) -> Result<(Vec<f64>, Vec<[f64; 3]>)> {
     let (mut gpu, mut host) = (Vec::new(), Vec::new());
     let mut p = params.clone();
     let mut submitted = 0;
@@ -62,9 +62,13 @@ fn run_case(
             continue;
         };
         let req = FrameRequest { params: &p, ..req };
+        let begun = started.elapsed().as_secs_f64();
+        let before = Instant::now();
         vp.trace_frame(&frame, world, &req)?;
+        let recorded = before.elapsed().as_secs_f64();
+        let before = Instant::now();
         vp.submit_frame(frame, &[], &[])?;
-        let spent = started.elapsed().as_secs_f64();
+        let spent = [begun, recorded, before.elapsed().as_secs_f64()];
         submitted += 1;
         // The first frames warm up (pipelines, clocks); each slot's GPU time is read when it
         // comes round again.
@@ -138,7 +142,7 @@ pub fn run(
         b.size.1,
         b.spp
     );
-    text += "case                          internal     GPU ms/frame min / median / p99 / max     host µs/frame median / p99\n";
+    text += "case                          internal     GPU ms/frame min / median / p99 / max     host µs/frame median (p99): begin, record, submit\n";
     for &scale in &b.scales {
         let internal = scaled(b.size, scale);
         let req = FrameRequest {
@@ -153,17 +157,21 @@ pub fn run(
         for (label, moving) in [("refining (still camera)", false), ("camera moving", true)] {
             let (gpu, host) = run_case(&mut vp, world, params, req, b.frames, moving)?;
             let (g0, g50, g99, gmax) = stats(gpu);
-            let (_, h50, h99, _) = stats(host);
+            let h: Vec<String> = (0..3)
+                .map(|k| {
+                    let (_, m, p, _) = stats(host.iter().map(|h| h[k]).collect());
+                    format!("{:.0} ({:.0})", m * 1e6, p * 1e6)
+                })
+                .collect();
             text += &format!(
-                "scale {scale:<4} {label:<24} {:>4}x{:<5}  {:.3} / {:.3} / {:.3} / {:.3}               {:.0} / {:.0}\n",
+                "scale {scale:<4} {label:<24} {:>4}x{:<5}  {:.3} / {:.3} / {:.3} / {:.3}               {}\n",
                 internal.0,
                 internal.1,
                 g0 * 1e3,
                 g50 * 1e3,
                 g99 * 1e3,
                 gmax * 1e3,
-                h50 * 1e6,
-                h99 * 1e6
+                h.join(", ")
             );
         }
         let (frames, ms) = latency(&mut vp, world, params, req, 20)?;

@@ -124,6 +124,8 @@ pub struct Editor {
     last_tick: Instant,
     moving_until: Instant,
     spp_per_frame: u32,
+    /// Samples per pixel the last shown frame added (0 once converged).
+    last_added: u32,
     pending: Option<Pending>,
     save_then: Option<Pending>,
     last_autosave: Instant,
@@ -201,6 +203,7 @@ impl Editor {
             last_tick: Instant::now(),
             moving_until: Instant::now(),
             spp_per_frame: 1,
+            last_added: 0,
             pending: None,
             save_then: None,
             last_autosave: Instant::now(),
@@ -659,7 +662,7 @@ impl Editor {
         let gpu_ms = gfx.viewport.last_gpu_seconds().map_or(0.0, |s| s * 1e3);
         let size = gfx.window.inner_size();
         let internal = self.internal_size((size.width, size.height));
-        let paths = internal.0 as f64 * internal.1 as f64 * self.spp_per_frame as f64;
+        let paths = internal.0 as f64 * internal.1 as f64 * self.last_added as f64;
         self.panels.status = format!(
             "{samples}/{} spp · GPU {gpu_ms:.2} ms/frame · {:.1} Mpaths/s · internal {}x{} · {}{}",
             self.settings.target_spp,
@@ -737,16 +740,16 @@ impl Editor {
             capture_now,
         )?;
         drop(doc);
-        match presented {
+        match &presented {
             Presented::Shown(status) => {
                 if !capture_now {
                     self.pending_textures.clear();
                 }
+                self.last_added = status.added;
                 if let Some(t) = self.move_event.take() {
                     self.latency = Some(t.elapsed());
                 }
                 self.adapt_samples(gfx.viewport.last_gpu_seconds());
-                let _ = status;
             }
             Presented::NotReady | Presented::Recreated => gfx.window.request_redraw(),
         }
@@ -773,6 +776,17 @@ impl Editor {
             || self.script.is_some()
             || !self.files.running.is_empty()
             || viewport_output.values().any(|v| v.repaint_delay.is_zero());
+        if std::env::var_os("VOXBRICK_DEBUG_LOOP").is_some() {
+            eprintln!(
+                "loop: {presented:?} samples {} moving {moving} files {:?} egui {:?}",
+                gfx.viewport.samples(),
+                self.files.running,
+                viewport_output
+                    .values()
+                    .map(|v| v.repaint_delay)
+                    .collect::<Vec<_>>()
+            );
+        }
         if busy {
             gfx.window.request_redraw();
         }
@@ -940,7 +954,12 @@ impl ApplicationHandler<Wake> for Editor {
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
         let Some(gfx) = &mut self.gfx else { return };
         let response = gfx.egui_state.on_window_event(&gfx.window, &event);
-        if response.repaint {
+        if std::env::var_os("VOXBRICK_DEBUG_LOOP").is_some() {
+            eprintln!("event {event:?} repaint {}", response.repaint);
+        }
+        // egui-winit asks to repaint after every RedrawRequested too; honouring that would
+        // keep a converged editor drawing forever.
+        if response.repaint && !matches!(event, WindowEvent::RedrawRequested) {
             gfx.window.request_redraw();
         }
         let consumed = response.consumed;

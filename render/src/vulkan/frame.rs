@@ -29,6 +29,9 @@ pub struct FrameSlot {
     /// Descriptor sets bound by this slot.
     pub sets: SetCache,
     queries: Option<vk::QueryPool>,
+    /// The two timestamps, copied here by the GPU at the end of the frame (reading the query
+    /// pool from the host blocks on lavapipe even after the fence; a buffer read never does).
+    times: HostBuffer,
     /// Whether the timestamps were written by the last submission.
     timed: bool,
 }
@@ -91,6 +94,7 @@ impl FrameSlot {
                     MemoryLocation::CpuToGpu,
                 )?,
                 ldr: None,
+                times: HostBuffer::new(ctx, "frame timestamps", 16, MemoryLocation::GpuToCpu)?,
                 sets: SetCache::new(ctx)?,
                 queries,
                 timed: false,
@@ -116,14 +120,9 @@ impl FrameSlot {
 
     /// GPU time of the slot's last submission (call once it is ready).
     pub fn gpu_seconds(&self, ctx: &GpuContext) -> Option<f64> {
-        let q = self.queries.filter(|_| self.timed)?;
-        let mut ticks = [0u64; 2];
-        // SAFETY: the fence signalled, so both timestamps are written.
-        unsafe {
-            ctx.device
-                .get_query_pool_results(q, 0, &mut ticks, vk::QueryResultFlags::TYPE_64)
-                .ok()?
-        };
+        self.queries.filter(|_| self.timed)?;
+        // The fence signalled, so the copy of both timestamps is done and visible.
+        let ticks: [u64; 2] = bytemuck::pod_read_unaligned(&self.times.read()[..16]);
         Some(ticks[1].wrapping_sub(ticks[0]) as f64 * ctx.timestamp_period as f64 * 1e-9)
     }
 
@@ -186,6 +185,24 @@ impl FrameSlot {
         unsafe {
             if let Some(q) = self.queries {
                 d.cmd_write_timestamp(self.cmd, vk::PipelineStageFlags::BOTTOM_OF_PIPE, q, 1);
+                d.cmd_copy_query_pool_results(
+                    self.cmd,
+                    q,
+                    0,
+                    2,
+                    self.times.raw,
+                    0,
+                    8,
+                    vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                );
+                super::barrier::barrier(
+                    ctx,
+                    self.cmd,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                    vk::PipelineStageFlags::HOST,
+                    vk::AccessFlags::HOST_READ,
+                );
                 self.timed = true;
             }
             vk_call("vkEndCommandBuffer", d.end_command_buffer(self.cmd))?;
@@ -218,6 +235,7 @@ impl FrameSlot {
             d.destroy_command_pool(self.pool, None);
         }
         self.sets.destroy(ctx);
+        self.times.destroy(ctx);
         self.uniforms.destroy(ctx);
         if let Some(l) = self.ldr {
             l.destroy(ctx);
