@@ -217,18 +217,7 @@ impl Presenter {
                 viewport.output(&frame),
                 image,
                 vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &[vk::BufferImageCopy {
-                    buffer_offset: 0,
-                    buffer_row_length: 0,
-                    buffer_image_height: 0,
-                    image_subresource: LAYER,
-                    image_offset: vk::Offset3D::default(),
-                    image_extent: vk::Extent3D {
-                        width: extent.width,
-                        height: extent.height,
-                        depth: 1,
-                    },
-                }],
+                &[whole_image(extent)],
             );
             image_barrier(
                 d,
@@ -291,18 +280,7 @@ impl Presenter {
                     image,
                     vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
                     buf.raw,
-                    &[vk::BufferImageCopy {
-                        buffer_offset: 0,
-                        buffer_row_length: 0,
-                        buffer_image_height: 0,
-                        image_subresource: LAYER,
-                        image_offset: vk::Offset3D::default(),
-                        image_extent: vk::Extent3D {
-                            width: extent.width,
-                            height: extent.height,
-                            depth: 1,
-                        },
-                    }],
+                    &[whole_image(extent)],
                 );
                 crate::vulkan::barrier::barrier(
                     &ctx,
@@ -384,6 +362,22 @@ impl Presenter {
             None => None,
         };
         Ok((Presented::Shown(status), captured))
+    }
+}
+
+/// A tightly packed copy of a whole image of `extent`.
+fn whole_image(extent: vk::Extent2D) -> vk::BufferImageCopy {
+    vk::BufferImageCopy {
+        buffer_offset: 0,
+        buffer_row_length: 0,
+        buffer_image_height: 0,
+        image_subresource: LAYER,
+        image_offset: vk::Offset3D::default(),
+        image_extent: vk::Extent3D {
+            width: extent.width,
+            height: extent.height,
+            depth: 1,
+        },
     }
 }
 

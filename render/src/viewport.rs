@@ -12,7 +12,7 @@
 use crate::cpu::RenderJob;
 use crate::image::Image;
 use crate::params::SceneParams;
-use crate::vulkan::barrier::barrier;
+use crate::vulkan::barrier::{after_earlier_passes, barrier};
 use crate::vulkan::frame::{FRAMES_IN_FLIGHT, FrameSlot};
 use crate::vulkan::progressive::Progressive;
 use crate::vulkan::tonemap::ToneMapper;
@@ -298,24 +298,7 @@ impl Viewport {
         slot.ensure_ldr(&ctx, output.0 as u64 * output.1 as u64 * 4)?;
         // SAFETY: recording; earlier frames' and the staging ring's writes (same queue,
         // earlier in submission order) come before this frame's reads and writes.
-        unsafe {
-            barrier(
-                &ctx,
-                frame.cmd,
-                vk::PipelineStageFlags::COMPUTE_SHADER
-                    | vk::PipelineStageFlags::TRANSFER
-                    | vk::PipelineStageFlags::DRAW_INDIRECT,
-                vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
-                vk::PipelineStageFlags::COMPUTE_SHADER
-                    | vk::PipelineStageFlags::TRANSFER
-                    | vk::PipelineStageFlags::DRAW_INDIRECT,
-                vk::AccessFlags::SHADER_READ
-                    | vk::AccessFlags::SHADER_WRITE
-                    | vk::AccessFlags::TRANSFER_READ
-                    | vk::AccessFlags::TRANSFER_WRITE
-                    | vk::AccessFlags::INDIRECT_COMMAND_READ,
-            );
-        }
+        unsafe { after_earlier_passes(&ctx, frame.cmd) };
         let (added, restarted) = live.record_batch(
             &ctx,
             frame.cmd,

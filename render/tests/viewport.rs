@@ -8,26 +8,11 @@ use brickmap::{EditOp, Mode, Shape};
 use glam::DVec3;
 use render::cpu::RenderJob;
 use render::viewport::{FrameRequest, Viewport};
-use render::vulkan::{ContextOptions, DeviceChoice, GpuContext, GpuError};
+use render::vulkan::{DeviceChoice, GpuContext};
 use std::sync::Arc;
 
 fn context() -> Option<Arc<GpuContext>> {
-    match GpuContext::new(&ContextOptions {
-        device: DeviceChoice::Best,
-        validation: true,
-        ..Default::default()
-    }) {
-        Ok(c) => Some(Arc::new(c)),
-        Err(e @ GpuError::NoVulkan(_))
-            if std::env::var("VOXBRICK_REQUIRE_GPU").as_deref() != Ok("1") =>
-        {
-            eprintln!(
-                "SKIPPED: no Vulkan driver ({e}); VOXBRICK_REQUIRE_GPU=1 makes this a failure"
-            );
-            None
-        }
-        Err(e) => panic!("creating a Vulkan context: {e}"),
-    }
+    common::gpu_context(DeviceChoice::Best).map(Arc::new)
 }
 
 /// Draws frames until `done` says so (at most `limit`); returns the statuses of the frames

@@ -9,22 +9,7 @@ use render::vulkan::tonemap::ToneMapper;
 use render::vulkan::{ContextOptions, DeviceChoice, GpuContext, GpuError};
 
 fn context(device: DeviceChoice) -> Option<GpuContext> {
-    match GpuContext::new(&ContextOptions {
-        device,
-        validation: true,
-        ..Default::default()
-    }) {
-        Ok(c) => Some(c),
-        Err(e @ GpuError::NoVulkan(_))
-            if std::env::var("VOXBRICK_REQUIRE_GPU").as_deref() != Ok("1") =>
-        {
-            eprintln!(
-                "SKIPPED: no Vulkan driver on this machine ({e}); VOXBRICK_REQUIRE_GPU=1 makes this a failure"
-            );
-            None
-        }
-        Err(e) => panic!("creating a Vulkan context: {e}"),
-    }
+    common::gpu_context(device)
 }
 
 #[test]

@@ -70,3 +70,29 @@ pub(crate) unsafe fn barrier(
         )
     };
 }
+
+/// Orders a frame's (or a repetition's) passes after the shader, transfer and indirect
+/// writes of everything earlier on the queue, which they read and write again.
+///
+/// # Safety
+/// `cmd` must be recording.
+pub(crate) unsafe fn after_earlier_passes(ctx: &GpuContext, cmd: vk::CommandBuffer) {
+    let stages = vk::PipelineStageFlags::COMPUTE_SHADER
+        | vk::PipelineStageFlags::TRANSFER
+        | vk::PipelineStageFlags::DRAW_INDIRECT;
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        barrier(
+            ctx,
+            cmd,
+            stages,
+            vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
+            stages,
+            vk::AccessFlags::SHADER_READ
+                | vk::AccessFlags::SHADER_WRITE
+                | vk::AccessFlags::TRANSFER_READ
+                | vk::AccessFlags::TRANSFER_WRITE
+                | vk::AccessFlags::INDIRECT_COMMAND_READ,
+        )
+    }
+}

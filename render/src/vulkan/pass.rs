@@ -1,7 +1,7 @@
 //! A compute pass: one SPIR-V module, N storage buffers in set 0 (bindings 0..N), push
 //! constants, dispatched synchronously with the results made visible to the host.
 
-use super::barrier::barrier;
+use super::barrier::{after_earlier_passes, barrier};
 use super::buffer::Binding;
 use super::{GpuContext, GpuError, vk_call};
 use ash::vk;
@@ -51,21 +51,7 @@ pub fn run_batch(
             for k in 0..count {
                 if k > 0 {
                     // The previous repetition's writes come first (same buffers).
-                    barrier(
-                        ctx,
-                        cmd,
-                        vk::PipelineStageFlags::COMPUTE_SHADER
-                            | vk::PipelineStageFlags::TRANSFER
-                            | vk::PipelineStageFlags::DRAW_INDIRECT,
-                        vk::AccessFlags::SHADER_WRITE | vk::AccessFlags::TRANSFER_WRITE,
-                        vk::PipelineStageFlags::COMPUTE_SHADER
-                            | vk::PipelineStageFlags::TRANSFER
-                            | vk::PipelineStageFlags::DRAW_INDIRECT,
-                        vk::AccessFlags::SHADER_READ
-                            | vk::AccessFlags::SHADER_WRITE
-                            | vk::AccessFlags::TRANSFER_WRITE
-                            | vk::AccessFlags::INDIRECT_COMMAND_READ,
-                    );
+                    after_earlier_passes(ctx, cmd);
                 }
                 // Start: once everything before has completed; end: once this has.
                 if let Some(q) = queries {

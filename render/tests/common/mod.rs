@@ -433,3 +433,25 @@ pub fn cpu_render(w: &World, p: &SceneParams, size: u32, spp: u32, seed: u64) ->
         seed,
     })
 }
+
+/// A context on `device` with validation on; None (and a line saying so) on a machine without
+/// any Vulkan driver unless VOXBRICK_REQUIRE_GPU=1 (CI) makes that a failure.
+pub fn gpu_context(device: render::vulkan::DeviceChoice) -> Option<render::vulkan::GpuContext> {
+    use render::vulkan::{ContextOptions, GpuContext, GpuError};
+    match GpuContext::new(&ContextOptions {
+        device,
+        validation: true,
+        ..Default::default()
+    }) {
+        Ok(c) => Some(c),
+        Err(e @ GpuError::NoVulkan(_))
+            if std::env::var("VOXBRICK_REQUIRE_GPU").as_deref() != Ok("1") =>
+        {
+            eprintln!(
+                "SKIPPED: no Vulkan driver on this machine ({e}); VOXBRICK_REQUIRE_GPU=1 makes this a failure"
+            );
+            None
+        }
+        Err(e) => panic!("creating a Vulkan context: {e}"),
+    }
+}
