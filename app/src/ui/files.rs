@@ -11,6 +11,9 @@ use crossbeam_channel::{Receiver, Sender};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, RwLock};
 
+/// What a dialog that could not open reports.
+pub const NO_DIALOG: &str = "no file dialog could be shown (is xdg-desktop-portal running?)";
+
 /// Recent files kept.
 const RECENT: usize = 10;
 
@@ -161,10 +164,16 @@ impl FileWorker {
             if let Some(n) = name {
                 d = d.set_file_name(n);
             }
+            let started = std::time::Instant::now();
             let picked = match purpose {
                 Purpose::Open | Purpose::Import => d.pick_file(),
                 Purpose::SaveAs | Purpose::Export => d.save_file(),
             };
+            // rfd answers "cancelled" at once when no dialog can be shown (no
+            // xdg-desktop-portal); nobody cancels a dialog that fast.
+            if picked.is_none() && started.elapsed() < std::time::Duration::from_millis(150) {
+                return Done::Picked(purpose, Err(NO_DIALOG.to_string()));
+            }
             Done::Picked(purpose, Ok(picked))
         });
     }
@@ -176,6 +185,14 @@ impl FileWorker {
                 Scene::load(&path, workers).with_context(|| format!("opening {}", path.display()));
             Done::Loaded(Some(path), Box::new(scene))
         });
+    }
+
+    /// Builds a new scene (`size` voxels, empty or with noise terrain) on a worker thread.
+    pub fn build_new(&mut self, size: (u32, u32, u32), terrain: bool, workers: usize) {
+        self.spawn(
+            format!("building a {}x{}x{} scene", size.0, size.1, size.2),
+            move || Done::Loaded(None, Box::new(new_scene(size, terrain, workers))),
+        );
     }
 
     /// Builds the embedded default scene on a worker thread.
@@ -214,6 +231,38 @@ impl FileWorker {
             self.running.remove(0);
         }
     }
+}
+
+/// A new scene framed by its camera: empty, or noise terrain with water.
+pub fn new_scene(size: (u32, u32, u32), terrain: bool, workers: usize) -> Result<Scene> {
+    use crate::editor::command::{Command, TerrainSpec};
+    let dims = brickmap::GridDims::from_voxels(glam::UVec3::new(size.0, size.1, size.2))?;
+    let mut scene = Scene::empty(dims, workers)?;
+    scene.params = render::SceneParams::framing(dims.voxels().as_dvec3());
+    if terrain {
+        let spec = TerrainSpec {
+            seed: 2022,
+            scale: size.0.max(size.2) as f64 / 2.0,
+            octaves: 5,
+            height_range: (size.1 / 8, size.1 * 5 / 8),
+            water_level: size.1 / 4,
+        };
+        Command::GenerateTerrain(spec).apply(&mut scene, Path::new("."))?;
+    }
+    Ok(scene)
+}
+
+/// Where a save goes when no dialog can ask: `name` in `folder`, numbered so nothing is
+/// overwritten.
+pub fn fallback_path(folder: &Path, name: &str, extension: &str) -> PathBuf {
+    let first = folder.join(format!("{name}.{extension}"));
+    if !first.exists() {
+        return first;
+    }
+    (2..)
+        .map(|n| folder.join(format!("{name}-{n}.{extension}")))
+        .find(|p| !p.exists())
+        .expect("some number is free")
 }
 
 fn save_scene(scene: &Scene, path: &Path, autosave: bool) -> Result<()> {
@@ -278,6 +327,28 @@ mod tests {
             .map(|p| p.file_name().unwrap().to_owned())
             .collect();
         assert_eq!(names, ["a.ron", "b.ron"]);
+    }
+
+    #[test]
+    fn a_save_without_a_dialog_never_overwrites() {
+        let dir = temp("fallback");
+        let first = fallback_path(&dir, "untitled", "ron");
+        assert_eq!(first, dir.join("untitled.ron"));
+        std::fs::write(&first, b"x").unwrap();
+        assert_eq!(
+            fallback_path(&dir, "untitled", "ron"),
+            dir.join("untitled-2.ron")
+        );
+    }
+
+    #[test]
+    fn new_scenes_are_empty_or_terrain_and_framed() {
+        let empty = new_scene((64, 32, 64), false, 1).unwrap();
+        assert_eq!(empty.world.read().solid_count(), 0);
+        let hills = new_scene((64, 32, 64), true, 1).unwrap();
+        assert!(hills.world.read().solid_count() > 64 * 64);
+        assert!(hills.params.validate().is_ok());
+        assert!(new_scene((0, 32, 64), false, 1).is_err());
     }
 
     #[test]

@@ -311,26 +311,9 @@ impl Editor {
     }
 
     fn new_scene(&mut self, size: (u32, u32, u32), terrain: bool) {
-        let made = (|| -> Result<Scene> {
-            let dims = brickmap::GridDims::from_voxels(glam::UVec3::new(size.0, size.1, size.2))?;
-            let mut scene = Scene::empty(dims, self.options.workers)?;
-            scene.params = render::SceneParams::framing(dims.voxels().as_dvec3());
-            if terrain {
-                let spec = crate::editor::command::TerrainSpec {
-                    seed: 2022,
-                    scale: size.0.max(size.2) as f64 / 2.0,
-                    octaves: 5,
-                    height_range: (size.1 / 8, size.1 * 5 / 8),
-                    water_level: size.1 / 4,
-                };
-                Command::GenerateTerrain(spec).apply(&mut scene, Path::new("."))?;
-            }
-            Ok(scene)
-        })();
-        match made {
-            Ok(scene) => self.replace_document(scene, None),
-            Err(e) => self.panels.errors.push(format!("new scene: {e:#}")),
-        }
+        // Built on a worker; it replaces the document like a default-scene build.
+        self.loading_default = true;
+        self.files.build_new(size, terrain, self.options.workers);
     }
 
     fn folder(&self) -> Option<PathBuf> {
@@ -458,7 +441,22 @@ impl Editor {
                 }
             },
             Done::Picked(_, Ok(None)) => self.save_then = None,
-            Done::Picked(_, Err(e)) => self.panels.errors.push(e),
+            Done::Picked(Purpose::SaveAs, Err(e)) => {
+                // Nothing is lost for want of a dialog: save beside the home folder.
+                let home =
+                    std::env::var_os("HOME").map_or_else(|| PathBuf::from("."), PathBuf::from);
+                let path = files::fallback_path(&home, "voxbrick-untitled", "ron");
+                self.panels
+                    .errors
+                    .push(format!("{e}; saving to {} instead", path.display()));
+                self.files.save(&self.doc, path, false);
+            }
+            Done::Picked(_, Err(e)) => {
+                self.save_then = None;
+                self.panels.errors.push(format!(
+                    "{e}; open a file by dropping it onto the window or naming it on the command line"
+                ));
+            }
             Done::Loaded(path, loaded) => match *loaded {
                 Ok(scene) => {
                     if self.loading_default && path.is_some() {
@@ -675,7 +673,7 @@ impl Editor {
             internal.1,
             gfx.viewport.ctx().name,
             self.latency.map_or_else(String::new, |l| format!(
-                " · move→photon {:.1} ms",
+                " · input to photon {:.1} ms",
                 l.as_secs_f64() * 1e3
             )),
         );
