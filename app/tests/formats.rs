@@ -406,16 +406,18 @@ fn rotated_and_translated_instances_land_where_magicavoxel_puts_them() {
     )
     .unwrap();
     assert_eq!(report.instances, 2);
-    // MagicaVoxel coordinates: unrotated voxel x lands at x − 1 + 10 (pivot ⌊3/2⌋ = 1);
-    // rotated (x → y): voxel x lands at (0, x − 1 + 10, 0)... in doubled form
-    // R·(2v + 1 − s) + 2t = (−0, 2x − 2 + 20, 0)/2 with s = (3,1,1).
+    // MagicaVoxel coordinates, ⌊R·(v + ½ − ⌊s/2⌋) + t⌋ with pivot ⌊(3, 1, 1)/2⌋ = (1, 0, 0):
+    // unrotated, v = (x, 0, 0) has centre (x − ½, ½, ½) and lands at (x + 9, 0, 0); rotated
+    // (rows (0, −1, 0), (1, 0, 0), (0, 0, 1)) the centre becomes (−½, x − ½, ½) and lands at
+    // (−1, x + 9, 0) — one voxel further than a pivot of s/2 put it (tests/vox_pivot.rs
+    // checks every rotation).
     let expected_vox = [
         (IVec3::new(9, 0, 0), 0u8),
         (IVec3::new(10, 0, 0), 1),
         (IVec3::new(11, 0, 0), 2),
-        (IVec3::new(0, 9, 0), 0),
-        (IVec3::new(0, 10, 0), 1),
-        (IVec3::new(0, 11, 0), 2),
+        (IVec3::new(-1, 9, 0), 0),
+        (IVec3::new(-1, 10, 0), 1),
+        (IVec3::new(-1, 11, 0), 2),
     ];
     // To voxbrick axes, then shifted so the minimum is 0 on every axis.
     let ours: Vec<(IVec3, u8)> = expected_vox

@@ -2,7 +2,9 @@
 //!
 //! Coordinates: MagicaVoxel is z-up, voxbrick y-up, both right-handed; voxel cell (vx, vy, vz)
 //! becomes (vx, vz, −vy − 1) and back. A model instance is placed MagicaVoxel's way: voxel v
-//! of a model of size s under a transform (R, t) lands at ⌊R·(v + ½ − s/2) + t⌋.
+//! of a model of size s under a transform (R, t) lands at ⌊R·(v + ½ − ⌊s/2⌋) + t⌋: the pivot
+//! is the integer point ⌊s/2⌋ (opengametools' ogt_vox.h, "explanation of model pivots"; vengi
+//! computes the same), which matters on odd axes that R negates.
 //!
 //! Import walks the scene graph (nTRN translation and packed rotation byte, nGRP, nSHP),
 //! skips hidden layers and hidden nodes unless asked, maps the palette and MATL materials,
@@ -511,8 +513,8 @@ fn place_model(model: &Model, tr: Transform, out: &mut Vec<(IVec3, u8)>) -> Resu
         model.size.z as i32,
     );
     for v in &model.voxels {
-        // ⌊R·(v + ½ − s/2) + t⌋, in doubled integers to stay exact: 2v + 1 − s.
-        let twice = IVec3::new(v.x as i32, v.y as i32, v.z as i32) * 2 + 1 - size;
+        // ⌊R·(v + ½ − ⌊s/2⌋) + t⌋, in doubled integers to stay exact: 2v + 1 − 2⌊s/2⌋.
+        let twice = IVec3::new(v.x as i32, v.y as i32, v.z as i32) * 2 + 1 - (size / 2) * 2;
         let p = tr.rot * twice + tr.t * 2;
         let vox = IVec3::new(p.x.div_euclid(2), p.y.div_euclid(2), p.z.div_euclid(2));
         out.push((IVec3::new(vox.x, vox.z, -vox.y - 1), v.i));
