@@ -412,3 +412,34 @@ fn a_rotated_multi_model_scene_survives_export_and_import_voxel_for_voxel() {
     .unwrap();
     assert_eq!(cells_of(&second.world), cells_of(&first.world));
 }
+
+#[test]
+fn an_imported_model_is_framed_whole_by_its_camera() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/vox/ogt_test_multiple_model_scene.vox");
+    let (scene, _) = vox::import_file(&path, &vox::ImportOptions::default(), 1).unwrap();
+    let c = &scene.params.camera;
+    c.validate().unwrap();
+    let d = scene.world.dims().voxels().as_dvec3();
+    let aspect = 16.0 / 9.0;
+    let (f, r, u) = c.basis(aspect);
+    // Every corner of the content (here the whole grid: it is sized to fit) is in view.
+    for k in 0..8 {
+        let p = DVec3::new(
+            if k & 1 == 0 { 0.0 } else { d.x },
+            if k & 2 == 0 { 0.0 } else { d.y },
+            if k & 4 == 0 { 0.0 } else { d.z },
+        );
+        let v = p - c.position;
+        let z = v.dot(f);
+        assert!(z > 0.0, "corner {k} behind the camera");
+        let (x, y) = (
+            v.dot(r) / r.length_squared() / z,
+            v.dot(u) / u.length_squared() / z,
+        );
+        assert!(
+            x.abs() <= 1.0 && y.abs() <= 1.0,
+            "corner {k} at ({x:.2}, {y:.2})"
+        );
+    }
+}
