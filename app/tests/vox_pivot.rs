@@ -443,3 +443,107 @@ fn an_imported_model_is_framed_whole_by_its_camera() {
         );
     }
 }
+
+fn import_err(bytes: &[u8]) -> String {
+    match vox::import_bytes(bytes, Path::new("x.vox"), &vox::ImportOptions::default(), 1) {
+        Ok(_) => panic!("imported"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn several_models_without_a_scene_graph_are_frames_and_only_the_first_is_kept() {
+    // Three frames of a 2 × 1 × 1 model, each a different voxel: stacking them would give 3.
+    let frames: Vec<Model> = (0..3u8)
+        .map(|k| Model {
+            size: Size { x: 3, y: 1, z: 1 },
+            voxels: vec![Voxel {
+                x: k,
+                y: 0,
+                z: 0,
+                i: 10 + k,
+            }],
+        })
+        .collect();
+    let data = DotVoxData {
+        version: 150,
+        index_map: DEFAULT_INDEX_MAP.to_vec(),
+        models: frames,
+        palette: DEFAULT_PALETTE.to_vec(),
+        materials: vec![],
+        scenes: vec![],
+        layers: vec![],
+    };
+    let mut bytes = Vec::new();
+    data.write_vox(&mut bytes).unwrap();
+    let (scene, report) = vox::import_bytes(
+        &bytes,
+        Path::new("anim.vox"),
+        &vox::ImportOptions::default(),
+        1,
+    )
+    .unwrap();
+    assert_eq!(scene.world.read().solid_count(), 1, "only the first frame");
+    let c = DEFAULT_PALETTE[10];
+    assert!(
+        cells_of(&scene.world)
+            .iter()
+            .all(|(_, rgb)| *rgb == [c.r, c.g, c.b])
+    );
+    assert!(
+        report
+            .dropped
+            .iter()
+            .any(|d| d.contains("animation frames after the first ignored (×2")),
+        "{:?}",
+        report.dropped
+    );
+}
+
+#[test]
+fn a_shape_whose_voxels_are_in_an_unread_chunk_names_that_chunk() {
+    // A scene graph whose second shape uses model 1, whose voxels a Teardown file keeps in
+    // a TDCZ chunk: only model 0 is a SIZE/XYZI pair.
+    let models = vec![box_model(IVec3::ONE), box_model(IVec3::ONE)];
+    let mut data = scene(&models, &[(0, ANCHOR, None), (1, ANCHOR, None)]);
+    data.models.truncate(1);
+    let mut bytes = Vec::new();
+    data.write_vox(&mut bytes).unwrap();
+    // Without any other chunk, the plain message.
+    let plain = import_err(&bytes);
+    assert!(
+        plain.contains("missing model 1") && !plain.contains("TDCZ"),
+        "{plain}"
+    );
+    // Append a TDCZ chunk to MAIN's children (its children size is at byte 16).
+    let payload = [7u8; 20];
+    bytes.extend_from_slice(b"TDCZ");
+    bytes.extend_from_slice(&(payload.len() as u32).to_le_bytes());
+    bytes.extend_from_slice(&0u32.to_le_bytes());
+    bytes.extend_from_slice(&payload);
+    let children =
+        u32::from_le_bytes(bytes[16..20].try_into().unwrap()) + 12 + payload.len() as u32;
+    bytes[16..20].copy_from_slice(&children.to_le_bytes());
+    let named = import_err(&bytes);
+    assert!(
+        named.contains("missing model 1")
+            && named.contains("TDCZ (Teardown's compressed voxel data)"),
+        "{named}"
+    );
+}
+
+#[test]
+fn a_slab6_vox_is_named_as_such() {
+    let (x, y, z) = (2u32, 3u32, 4u32);
+    let mut bytes = Vec::new();
+    for d in [x, y, z] {
+        bytes.extend_from_slice(&d.to_le_bytes());
+    }
+    bytes.extend(std::iter::repeat_n(255u8, (x * y * z) as usize));
+    bytes.extend(std::iter::repeat_n(32u8, 768));
+    let e = import_err(&bytes);
+    assert!(e.contains("SLAB6") && e.contains("2×3×4"), "{e}");
+    // One byte more or less is not SLAB6: the usual error.
+    bytes.push(0);
+    assert!(!import_err(&bytes).contains("SLAB6"));
+}

@@ -67,12 +67,33 @@ pub struct ExportReport {
     pub bytes: u64,
 }
 
+/// The start of the error for a shape whose model does not exist.
+const MISSING_MODEL: &str = "shape refers to missing model";
+
 /// Limits that keep a hostile file from exhausting memory or time.
 const MAX_DEPTH: usize = 64;
 const MAX_PLACED_VOXELS: u64 = 1 << 28;
 
+/// The dimensions of a SLAB6 `.vox`: three little-endian u32 sizes, x·y·z voxel bytes and a
+/// 768-byte palette, exactly filling the file (and no MagicaVoxel magic).
+fn slab6_dims(bytes: &[u8]) -> Option<(u64, u64, u64)> {
+    if bytes.starts_with(b"VOX ") || bytes.len() < 12 {
+        return None;
+    }
+    let d = |i: usize| u32::from_le_bytes(bytes[4 * i..4 * i + 4].try_into().unwrap()) as u64;
+    let (x, y, z) = (d(0), d(1), d(2));
+    let voxels = x.checked_mul(y)?.checked_mul(z)?;
+    (x > 0 && y > 0 && z > 0 && voxels.checked_add(12 + 768)? == bytes.len() as u64)
+        .then_some((x, y, z))
+}
+
 /// Parses `.vox` bytes; a `dot_vox` panic on malformed input is caught and reported.
 pub fn parse(bytes: &[u8]) -> Result<DotVoxData, String> {
+    if let Some((x, y, z)) = slab6_dims(bytes) {
+        return Err(format!(
+            "this is a Ken Silverman SLAB6 .vox (a plain {x}×{y}×{z} volume with a 768-byte palette, no \"VOX \" header), which voxbrick does not import; MagicaVoxel or vengi can convert it"
+        ));
+    }
     let parsed = std::panic::catch_unwind(|| dot_vox::load_bytes(bytes));
     match parsed {
         Ok(Ok(data)) => Ok(data),
@@ -196,8 +217,24 @@ fn prepare(bytes: &[u8], options: &ImportOptions) -> Result<Prepared, String> {
         models: data.models.len(),
         ..Default::default()
     };
-    report.dropped.extend(unmapped_chunks(bytes));
-    let mut placed = place_instances(&data, options, &mut report)?;
+    let unmapped = unmapped_chunks(bytes);
+    report.dropped.extend(
+        unmapped
+            .iter()
+            .map(|(id, n)| format!("unsupported chunk {id} ignored (×{n})")),
+    );
+    let mut placed = place_instances(&data, options, &mut report).map_err(|e| {
+        // A shape whose model is not in SIZE/XYZI chunks: its voxels are elsewhere.
+        if e.starts_with(MISSING_MODEL) && !unmapped.is_empty() {
+            let chunks: Vec<String> = unmapped.keys().map(|id| describe_chunk(id)).collect();
+            format!(
+                "{e}: its voxels are not in SIZE/XYZI chunks; the file also holds {}, which voxbrick does not read",
+                chunks.join(", ")
+            )
+        } else {
+            e
+        }
+    })?;
     if let Some((lo, _)) = bounds(&placed) {
         let shift = (-lo).max(IVec3::ZERO) + options.offset;
         if (lo + shift).cmplt(IVec3::ZERO).any() {
@@ -378,10 +415,17 @@ fn place_instances(
 ) -> Result<Vec<(IVec3, u8)>, String> {
     let mut out = Vec::new();
     if data.scenes.is_empty() {
-        // Files without a scene graph: every model at the origin.
-        for model in &data.models {
+        // Without a scene graph (files before MagicaVoxel 0.99), several SIZE/XYZI pairs are
+        // the frames of one animated model, as MagicaVoxel reads them: keep the first.
+        if let Some(model) = data.models.first() {
             place_model(model, Transform::IDENTITY, &mut out)?;
             report.instances += 1;
+        }
+        if data.models.len() > 1 {
+            report.dropped.push(format!(
+                "animation frames after the first ignored (×{}; a file without a scene graph holds frames of one model)",
+                data.models.len() - 1
+            ));
         }
         return Ok(out);
     }
@@ -510,7 +554,7 @@ fn walk(
                 let model = data
                     .models
                     .get(m.model_id as usize)
-                    .ok_or_else(|| format!("shape refers to missing model {}", m.model_id))?;
+                    .ok_or_else(|| format!("{MISSING_MODEL} {}", m.model_id))?;
                 place_model(model, parent, out)?;
                 report.instances += 1;
             }
@@ -690,7 +734,7 @@ fn material_from_matl(
 }
 
 /// Top-level chunks inside MAIN that `dot_vox` does not map, as report lines.
-fn unmapped_chunks(bytes: &[u8]) -> Vec<String> {
+fn unmapped_chunks(bytes: &[u8]) -> BTreeMap<String, usize> {
     const KNOWN: [&[u8; 4]; 10] = [
         b"SIZE", b"XYZI", b"RGBA", b"MATL", b"nTRN", b"nGRP", b"nSHP", b"LAYR", b"IMAP", b"PACK",
     ];
@@ -719,9 +763,15 @@ fn unmapped_chunks(bytes: &[u8]) -> Vec<String> {
         at = next;
     }
     counts
-        .into_iter()
-        .map(|(id, n)| format!("unsupported chunk {id} ignored (×{n})"))
-        .collect()
+}
+
+/// What a chunk that may hold a model's voxels is, for the error when a shape's model is
+/// missing.
+fn describe_chunk(id: &str) -> String {
+    match id {
+        "TDCZ" => "TDCZ (Teardown's compressed voxel data)".into(),
+        other => other.to_string(),
+    }
 }
 
 /// The `.vox` data of a scene: ≤ 256³ models under one group, a palette slot per used
