@@ -70,6 +70,30 @@ impl ConfigDir {
             .with_context(|| format!("writing {}", self.recent_file().display()))
     }
 
+    fn settings_file(&self) -> PathBuf {
+        self.0.join("settings.ron")
+    }
+
+    /// The saved view settings; defaults when there are none, and an error naming the file
+    /// when it cannot be read (the defaults are then used and the file is left alone).
+    pub fn settings<T: serde::de::DeserializeOwned + Default>(&self) -> Result<T> {
+        let f = self.settings_file();
+        match std::fs::read_to_string(&f) {
+            Ok(text) => ron::from_str(&text).with_context(|| format!("reading {}", f.display())),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(T::default()),
+            Err(e) => Err(e).with_context(|| format!("reading {}", f.display())),
+        }
+    }
+
+    /// Saves the view settings (atomically).
+    pub fn save_settings<T: serde::Serialize>(&self, settings: &T) -> Result<()> {
+        std::fs::create_dir_all(&self.0)
+            .with_context(|| format!("creating {}", self.0.display()))?;
+        let text = ron::ser::to_string_pretty(settings, Default::default())?;
+        crate::atomic::write_atomic(&self.settings_file(), |w| w.write_all(text.as_bytes()))
+            .with_context(|| format!("writing {}", self.settings_file().display()))
+    }
+
     /// A recovery file left by a session that did not exit cleanly.
     pub fn pending_recovery(&self) -> Option<PathBuf> {
         let f = self.recovery_file();
@@ -327,6 +351,30 @@ mod tests {
             .map(|p| p.file_name().unwrap().to_owned())
             .collect();
         assert_eq!(names, ["a.ron", "b.ron"]);
+    }
+
+    #[test]
+    fn view_settings_round_trip_and_a_broken_file_is_an_error_not_a_reset() {
+        use crate::ui::panels::ViewSettings;
+        let dir = ConfigDir(temp("settings").join("config"));
+        assert_eq!(
+            dir.settings::<ViewSettings>().unwrap(),
+            ViewSettings::default()
+        );
+        let mut s = ViewSettings::default();
+        s.target_spp = 64;
+        s.autosave_secs = 0;
+        dir.save_settings(&s).unwrap();
+        assert_eq!(dir.settings::<ViewSettings>().unwrap(), s);
+        std::fs::write(dir.0.join("settings.ron"), b"(target_spp: \"many\")").unwrap();
+        assert!(dir.settings::<ViewSettings>().is_err());
+        // Fields missing from an older file take their defaults.
+        std::fs::write(dir.0.join("settings.ron"), b"(exposure: 1.5)").unwrap();
+        let partial = dir.settings::<ViewSettings>().unwrap();
+        assert_eq!(
+            (partial.exposure, partial.target_spp),
+            (1.5, ViewSettings::default().target_spp)
+        );
     }
 
     #[test]

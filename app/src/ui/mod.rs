@@ -181,8 +181,15 @@ impl Editor {
             });
         }
         let view = scene_view(&doc.scene);
+        let (settings, settings_error) = match config.settings::<ViewSettings>() {
+            Ok(s) => (s, None),
+            Err(e) => (
+                ViewSettings::default(),
+                Some(format!("{e:#}; using the defaults")),
+            ),
+        };
         let mut editor = Self {
-            settings: ViewSettings::default(),
+            settings,
             panels: PanelState {
                 recent: config.recent(),
                 ..Default::default()
@@ -217,9 +224,13 @@ impl Editor {
             script: script_run,
             options,
         };
-        if let Some(s) = &mut editor.script {
-            editor.settings.target_spp = editor.options.capture_spp.max(1);
-            let _ = &mut s.run;
+        editor.panels.errors.extend(settings_error);
+        if editor.script.is_some() {
+            // A script run is reproducible: the defaults, whatever the user saved.
+            editor.settings = ViewSettings {
+                target_spp: editor.options.capture_spp.max(1),
+                ..ViewSettings::default()
+            };
         } else {
             if let Some(recovery) = editor.config.pending_recovery() {
                 editor.panels.recovery = Some(recovery);
@@ -336,6 +347,11 @@ impl Editor {
 
     fn quit_now(&mut self) {
         self.config.remove_recovery();
+        if self.script.is_none()
+            && let Err(e) = self.config.save_settings(&self.settings)
+        {
+            eprintln!("voxbrick: {e:#}");
+        }
         self.quitting = true;
     }
 
@@ -385,6 +401,10 @@ impl Editor {
             UiEvent::SetSun(s) => self.execute(Command::SetSun(s)),
             UiEvent::SetSky(s) => self.execute(Command::SetSky(s)),
             UiEvent::SetSettings(s) => self.execute(Command::SetSettings(s)),
+            UiEvent::Import { path, offset } => self.execute(Command::ImportVox {
+                path: path.display().to_string(),
+                offset: glam::IVec3::from_array(offset),
+            }),
             UiEvent::UseViewAsSceneCamera => {
                 self.execute(Command::SetCamera(self.view.camera.clone()))
             }
@@ -432,13 +452,8 @@ impl Editor {
                     };
                     self.files.save(&self.doc, path, false)
                 }
-                Purpose::Import => {
-                    let command = Command::ImportVox {
-                        path: path.display().to_string(),
-                        offset: glam::IVec3::ZERO,
-                    };
-                    self.execute(command);
-                }
+                // Asks for the offset first (the import dialog), then `ImportVox`.
+                Purpose::Import => self.panels.import = Some((path, [0, 0, 0])),
             },
             Done::Picked(_, Ok(None)) => self.save_then = None,
             Done::Picked(Purpose::SaveAs, Err(e)) => {

@@ -8,8 +8,9 @@ use crate::editor::Document;
 use render::{RenderSettings, Sky, Sun};
 use std::path::PathBuf;
 
-/// View settings: not part of the scene, not in the history.
-#[derive(Clone, Debug, PartialEq)]
+/// View settings: not part of the scene, not in the history; kept in the config folder.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct ViewSettings {
     /// Samples per pixel at which the viewport stops (converged).
     pub target_spp: u32,
@@ -48,6 +49,13 @@ pub enum UiEvent {
     SetSky(Sky),
     /// Scene render settings changed (bounces).
     SetSettings(RenderSettings),
+    /// Import a .vox at an offset (undoable).
+    Import {
+        /// The file.
+        path: PathBuf,
+        /// Added to its voxels after the shift into the grid.
+        offset: [i32; 3],
+    },
     /// Make the current view the scene's camera (undoable).
     UseViewAsSceneCamera,
     /// The unsaved-changes question was answered.
@@ -91,6 +99,8 @@ pub struct PanelState {
     pub new_size: (u32, u32, u32),
     /// New scene gets terrain.
     pub new_terrain: bool,
+    /// A picked .vox waiting for its import offset.
+    pub import: Option<(PathBuf, [i32; 3])>,
     /// "Save changes?" is being asked (for what comes next).
     pub asking_unsaved: bool,
     /// A recovery file to offer.
@@ -280,6 +290,37 @@ pub fn draw(
                 }
             });
         state.new_open &= open;
+    }
+    if let Some((path, offset)) = &mut state.import {
+        let mut go = None;
+        modal(ctx, "Import .vox", |ui| {
+            ui.label(path.display().to_string());
+            ui.horizontal(|ui| {
+                for (v, axis) in offset.iter_mut().zip(["x ", "y ", "z "]) {
+                    ui.add(egui::DragValue::new(v).range(-4096..=4096).prefix(axis));
+                }
+            });
+            ui.label("offset in voxels, added after the model is shifted into the grid");
+            ui.horizontal(|ui| {
+                if ui.button("Import").clicked() {
+                    go = Some(true);
+                }
+                if ui.button("Cancel").clicked() {
+                    go = Some(false);
+                }
+            });
+        });
+        match go {
+            Some(true) => {
+                out.push(UiEvent::Import {
+                    path: path.clone(),
+                    offset: *offset,
+                });
+                state.import = None;
+            }
+            Some(false) => state.import = None,
+            None => {}
+        }
     }
     if state.asking_unsaved {
         modal(ctx, "Unsaved changes", |ui| {
