@@ -361,9 +361,11 @@ mod tests {
             dir.settings::<ViewSettings>().unwrap(),
             ViewSettings::default()
         );
-        let mut s = ViewSettings::default();
-        s.target_spp = 64;
-        s.autosave_secs = 0;
+        let s = ViewSettings {
+            target_spp: 64,
+            autosave_secs: 0,
+            ..ViewSettings::default()
+        };
         dir.save_settings(&s).unwrap();
         assert_eq!(dir.settings::<ViewSettings>().unwrap(), s);
         std::fs::write(dir.0.join("settings.ron"), b"(target_spp: \"many\")").unwrap();
