@@ -1,3 +1,32 @@
-//! Subcommands of the `voxbrick` binary, one file each as they move out of main.rs.
+//! Subcommands of the `voxbrick` binary, one file each, and the helpers they share.
 
+pub mod bench_gpu;
 pub mod bench_viewport;
+pub mod render;
+pub mod stats;
+
+use anyhow::Result;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::time::Duration;
+
+/// A spinner on stderr while `work` runs (hidden when stderr is not a terminal).
+pub(crate) fn with_progress<T>(message: String, work: impl FnOnce() -> Result<T>) -> Result<T> {
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {msg} {elapsed}").expect("valid template"),
+    );
+    bar.set_message(message);
+    bar.enable_steady_tick(Duration::from_millis(100));
+    let out = work();
+    bar.finish_and_clear();
+    out
+}
+
+/// Writes to stdout; a reader that went away (`voxbrick info f | head`) ends output quietly.
+pub(crate) fn emit(text: &str) -> Result<()> {
+    use std::io::Write;
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
+}

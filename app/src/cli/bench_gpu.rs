@@ -1,0 +1,220 @@
+//! `voxbrick bench-gpu`: the thesis complexities with Vulkan timestamp queries, and image
+//! error against GPU time (`--convergence`).
+
+use super::{emit, with_progress};
+use anyhow::{Context, Result, bail};
+use app::scene::thesis_scene;
+
+/// What `bench-gpu` measures.
+pub(crate) struct BenchGpu {
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) frames: usize,
+    pub(crate) experiment: u32,
+    pub(crate) inline_shadows: bool,
+    /// Error against time with a reference of this many samples, instead of the complexities.
+    pub(crate) convergence: Option<u32>,
+    /// Invocations per pixel (None: the renderer's choice).
+    pub(crate) slices: Option<u32>,
+}
+
+pub(crate) fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<()> {
+    let BenchGpu {
+        width,
+        height,
+        frames,
+        experiment,
+        inline_shadows,
+        convergence,
+        slices,
+    } = bench;
+    use render::vulkan::trace::Variant;
+    let scene = thesis_scene(workers)?;
+    let view = scene.world.read();
+    let mut session = app::gpu::session(device.as_deref().unwrap_or("gpu"), &view)?;
+    let ctx = session.ctx().clone();
+    let mut text = format!(
+        "device       {} ({})\nscene        thesis (512x256x512, {} solid voxels), {width}x{height}\n",
+        ctx.name,
+        ctx.driver,
+        view.solid_count()
+    );
+    let mut failure = None;
+    let tracer = session.tracer();
+    tracer.set_deferred_shadows(&ctx, !inline_shadows);
+    tracer.set_sample_slices(slices);
+    text += &format!(
+        "slices       each pixel's samples split among up to {} invocations\n",
+        tracer.sample_slices(width as u64 * height as u64)
+    );
+    text += &format!(
+        "shadow rays  {}\n",
+        if tracer.deferred_shadows() {
+            "queued for the shadow pass"
+        } else {
+            "traced in place"
+        }
+    );
+    if let Some(reference_spp) = convergence {
+        let mut params = scene.params.clone();
+        params.settings.max_bounces = 3;
+        params.sun.enabled = true;
+        let result =
+            convergence_table(&mut session, &view, &params, (width, height), reference_spp);
+        return emit(&(text + &result?));
+    }
+    for (label, bounces, spp, sun) in [
+        ("complexity 1 (1 bounce, 1 spp, no sun)", 1, 1, false),
+        ("complexity 2 (1 bounce, 1 spp, sun)", 1, 1, true),
+        ("complexity 3 (3 bounces, 2 spp, sun)", 3, 2, true),
+    ] {
+        let mut params = scene.params.clone();
+        params.settings.max_bounces = bounces;
+        params.sun.enabled = sun;
+        // The scene's variant and the everything variant, alternated in rounds of
+        // back-to-back dispatches (one submission each, so the GPU stays busy and its clocks
+        // stay up) so both see the same machine state; the first two rounds of each are
+        // warm-up.
+        let scene_variant = Variant {
+            experiment,
+            ..Variant::for_scene(view.materials(), &params)
+        };
+        let variants = [scene_variant, Variant::everything(bounces)];
+        let mut times = [Vec::with_capacity(frames), Vec::with_capacity(frames)];
+        const ROUND: u32 = 10;
+        'rounds: for round in 0..frames.div_ceil(ROUND as usize) + 2 {
+            for (k, v) in variants.iter().enumerate() {
+                match session.time_repeated(&view, &params, *v, (width, height), spp, ROUND) {
+                    Ok(t) if round >= 2 => times[k].extend(t),
+                    Ok(_) => {}
+                    Err(e) => {
+                        failure = Some(e);
+                        break 'rounds;
+                    }
+                }
+            }
+        }
+        if failure.is_some() {
+            break;
+        }
+        if times[0].is_empty() {
+            text += &format!("{label}: this queue cannot take timestamps\n");
+            continue;
+        }
+        let rays = match session.render_counted(
+            &view,
+            &params,
+            &render::cpu::RenderJob {
+                width,
+                height,
+                spp,
+                seed: 0,
+            },
+            Some(scene_variant),
+        ) {
+            Ok((_, _, rays)) => rays,
+            Err(e) => {
+                failure = Some(e);
+                break;
+            }
+        };
+        let n = times[0].len();
+        let stats = session
+            .statistics(scene_variant)
+            .into_iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        if !stats.is_empty() {
+            text += &format!("{label}: pipeline statistics: {stats}\n");
+        }
+        let [(median, p10, p90), (full, _, _)] = times.map(|mut t| {
+            t.sort_by(|a, b| a.total_cmp(b));
+            (t[t.len() / 2], t[t.len() / 10], t[t.len() * 9 / 10])
+        });
+        text += &format!(
+            "{label}: median {:.3} ms (p10 {:.3}, p90 {:.3}, {} frames); everything variant {:.3} ms ({:+.1}%)\n  \
+             rays: {:.1} M primary, {:.1} M secondary, {:.1} M shadow; {:.0} Mrays/s primary, {:.0} Mrays/s secondary+shadow, {:.0} Mrays/s all\n  \
+             traversal steps per ray: {:.1} primary, {:.1} secondary, {:.1} shadow; most in one ray: {} camera or continuation, {} shadow\n",
+            median * 1e3,
+            p10 * 1e3,
+            p90 * 1e3,
+            n,
+            full * 1e3,
+            (full / median - 1.0) * 100.0,
+            rays.primary as f64 / 1e6,
+            rays.secondary as f64 / 1e6,
+            rays.shadow as f64 / 1e6,
+            rays.primary as f64 / median / 1e6,
+            (rays.secondary + rays.shadow) as f64 / median / 1e6,
+            rays.total() as f64 / median / 1e6,
+            rays.steps[0] as f64 / rays.primary.max(1) as f64,
+            rays.steps[1] as f64 / rays.secondary.max(1) as f64,
+            rays.steps[2] as f64 / rays.shadow.max(1) as f64,
+            rays.max_steps[0],
+            rays.max_steps[1],
+        );
+    }
+    if let Some(e) = failure {
+        return Err(e.into());
+    }
+    emit(&text)
+}
+
+/// Image error against GPU time (render::convergence): a reference of `reference_spp` samples,
+/// then renders of 1, 2, 4 … 256 samples with other seeds, each three times (the middle time
+/// and the mean MSE are used).
+pub(crate) fn convergence_table(
+    session: &mut render::viewport::Viewport,
+    view: &brickmap::WorldView<'_>,
+    params: &render::SceneParams,
+    (width, height): (u32, u32),
+    reference_spp: u32,
+) -> Result<String> {
+    use render::convergence::{Measurement, table};
+    let job = |spp, seed| render::cpu::RenderJob {
+        width,
+        height,
+        spp,
+        seed,
+    };
+    let (reference, reference_time) = with_progress(
+        format!("reference: {width}x{height} at {reference_spp} spp"),
+        || Ok(session.render(view, params, &job(reference_spp, 1))?),
+    )?;
+    let Some(reference_time) = reference_time else {
+        bail!("this queue cannot take timestamps");
+    };
+    let mean = reference.mean().iter().sum::<f64>() / 3.0;
+    let mut measurements = Vec::new();
+    for spp in (0..9).map(|k| 1u32 << k) {
+        let (mut times, mut mse) = (Vec::new(), 0.0);
+        for seed in 2..5 {
+            let (image, time) = session.render(view, params, &job(spp, seed))?;
+            times.push(time.unwrap_or(f64::NAN));
+            mse += image.mse(&reference).context("image sizes differ")? / 3.0;
+        }
+        times.sort_by(f64::total_cmp);
+        measurements.push(Measurement {
+            spp,
+            seconds: times[1],
+            mse,
+        });
+    }
+    let mut text = format!(
+        "convergence  3 bounces, sun; reference {reference_spp} spp in {:.1} ms (GPU), mean pixel value {mean:.4}\n  \
+         spp   GPU ms    rel. RMSE   MSE·spp/σ² (1: no bias)   MSE·time (rel. to 1 spp)\n",
+        reference_time * 1e3
+    );
+    for row in table(&measurements, reference_spp, mean) {
+        text += &format!(
+            "  {:<5} {:<9.3} {:<11.4} {:<25.3} {:.3}\n",
+            row.measured.spp,
+            row.measured.seconds * 1e3,
+            row.relative_rmse,
+            row.variance_ratio,
+            row.relative_cost
+        );
+    }
+    Ok(text)
+}

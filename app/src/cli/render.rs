@@ -1,0 +1,169 @@
+//! `voxbrick render`: a scene to an image on the GPU session or the CPU reference.
+
+use super::{emit, with_progress};
+use anyhow::{Context, Result, bail};
+use app::Scene;
+use glam::DVec3;
+use std::path::PathBuf;
+use std::time::Instant;
+
+pub(crate) struct RenderArgs {
+    pub(crate) scene: PathBuf,
+    pub(crate) out: PathBuf,
+    pub(crate) hdr: Option<PathBuf>,
+    pub(crate) spp: u32,
+    pub(crate) bounces: Option<u32>,
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) camera: Option<String>,
+    pub(crate) device: String,
+    pub(crate) seed: u64,
+    pub(crate) scale: f64,
+    pub(crate) samples_per_dispatch: Option<u32>,
+    pub(crate) slices: Option<u32>,
+    pub(crate) workers: usize,
+}
+
+pub(crate) fn render_command(a: RenderArgs) -> Result<()> {
+    if a.spp == 0 || a.width == 0 || a.height == 0 || a.width > 16384 || a.height > 16384 {
+        bail!("--spp, --width and --height must be positive (sizes at most 16384)");
+    }
+    if !(a.scale > 0.0 && a.scale <= 1.0) {
+        bail!("--scale {} is outside (0, 1]", a.scale);
+    }
+    let scene = with_progress(format!("reading {}", a.scene.display()), || {
+        Ok(Scene::load(&a.scene, a.workers)?)
+    })?;
+    let mut params = scene.params.clone();
+    if let Some(spec) = &a.camera {
+        let (eye, target) = spec
+            .split_once(':')
+            .context("--camera wants EYE:TARGET, each X,Y,Z")?;
+        let eye = parse_ivec3_f(eye)?;
+        let target = parse_ivec3_f(target)?;
+        params.camera = render::Camera::looking_at(eye, target, params.camera.fov_y_deg);
+        params.camera.validate()?;
+    }
+    if let Some(b) = a.bounces {
+        if !(1..=64).contains(&b) {
+            bail!("--bounces {b} is outside 1..=64");
+        }
+        params.settings.max_bounces = b;
+    }
+    let view = scene.world.read();
+    let internal = (
+        ((a.width as f64 * a.scale).ceil() as u32).max(1),
+        ((a.height as f64 * a.scale).ceil() as u32).max(1),
+    );
+    let job = render::cpu::RenderJob {
+        width: internal.0,
+        height: internal.1,
+        spp: a.spp,
+        seed: a.seed,
+    };
+    let (image, backend, timing) = render_on(
+        &a.device,
+        &view,
+        &params,
+        &job,
+        (a.samples_per_dispatch, a.slices),
+    )?;
+    let image = if internal == (a.width, a.height) {
+        image
+    } else {
+        image.resized_bilinear(a.width, a.height)
+    };
+    let write = |path: &PathBuf, f: &dyn Fn(&mut dyn std::io::Write) -> std::io::Result<()>| {
+        app::atomic::write_atomic(path, f).with_context(|| format!("writing {}", path.display()))
+    };
+    write(&a.out, &|w| image.write_png(w, params.settings.exposure))?;
+    if let Some(hdr) = &a.hdr {
+        write(hdr, &|w| image.write_pfm(w))?;
+    }
+    let samples = internal.0 as u64 * internal.1 as u64 * a.spp as u64;
+    emit(&format!(
+        "rendered     {samples} samples ({}x{} at {} spp, {} bounces) on {backend}, shown at {}x{}\n{timing}wrote        {}\n",
+        internal.0,
+        internal.1,
+        a.spp,
+        params.settings.max_bounces,
+        a.width,
+        a.height,
+        a.out.display()
+    ))
+}
+
+pub(crate) fn parse_ivec3_f(s: &str) -> Result<DVec3> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("{s:?} is not X,Y,Z"))?;
+    match v[..] {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(DVec3::new(x, y, z)),
+        _ => bail!("{s:?} is not three finite numbers X,Y,Z"),
+    }
+}
+
+/// Renders on a device: "cpu" (the reference), "gpu" (the best Vulkan device) or part of a
+/// device's name. Returns the image, the device's name and a timing report.
+pub(crate) fn render_on(
+    device: &str,
+    view: &brickmap::WorldView<'_>,
+    params: &render::SceneParams,
+    job: &render::cpu::RenderJob,
+    (samples_per_dispatch, slices): (Option<u32>, Option<u32>),
+) -> Result<(render::Image, String, String)> {
+    let started = Instant::now();
+    Ok(if device == "cpu" {
+        let cpu = render::cpu::CpuScene::new(view, params);
+        let image = with_progress(
+            format!(
+                "rendering {}x{} at {} spp on the CPU",
+                job.width, job.height, job.spp
+            ),
+            || Ok(cpu.render(job)),
+        )?;
+        let seconds = started.elapsed().as_secs_f64();
+        let rays = cpu.rays_traced();
+        (
+            image,
+            "the CPU".to_string(),
+            format!(
+                "time         {seconds:.2} s\nrays         {rays} ({:.2} Mrays/s)\n",
+                rays as f64 / seconds / 1e6
+            ),
+        )
+    } else {
+        let mut session = app::gpu::session(device, view)?;
+        session
+            .tracer()
+            .set_samples_per_dispatch(samples_per_dispatch);
+        session.tracer().set_sample_slices(slices);
+        let name = session.ctx().name.clone();
+        let rendered = with_progress(
+            format!(
+                "rendering {}x{} at {} spp on {name}",
+                job.width, job.height, job.spp
+            ),
+            || Ok(session.render_counted(view, params, job, None)?),
+        );
+        let (image, gpu, rays) = rendered?;
+        let timing = match gpu {
+            Some(t) => format!(
+                "gpu time     {:.3} ms (timestamp queries)\nrays         {} ({:.1} Mrays/s: {} primary, {} secondary, {} shadow)\n",
+                t * 1e3,
+                rays.total(),
+                rays.total() as f64 / t / 1e6,
+                rays.primary,
+                rays.secondary,
+                rays.shadow
+            ),
+            None => format!(
+                "time         {:.2} s (this queue cannot take timestamps)\n",
+                started.elapsed().as_secs_f64()
+            ),
+        };
+        (image, name, timing)
+    })
+}
