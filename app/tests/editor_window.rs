@@ -38,9 +38,15 @@ struct Xvfb {
 
 impl Xvfb {
     fn start() -> Option<Self> {
-        for n in 0..20 {
-            let number = 90 + (std::process::id() + n) % 400;
-            if Path::new(&format!("/tmp/.X11-unix/X{number}")).exists() {
+        // Tests of this file run in parallel: each takes its own number, and a server that
+        // lost the race for a number (it exits at once) makes it try the next.
+        static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+        for _ in 0..20 {
+            let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let number = 90 + (std::process::id() * 7 + n) % 400;
+            if Path::new(&format!("/tmp/.X11-unix/X{number}")).exists()
+                || Path::new(&format!("/tmp/.X{number}-lock")).exists()
+            {
                 continue;
             }
             let display = format!(":{number}");
@@ -55,7 +61,12 @@ impl Xvfb {
             let started = Instant::now();
             while started.elapsed() < Duration::from_secs(10) {
                 if Path::new(&socket).exists() {
-                    return Some(x);
+                    // Ours, not another one's: still running a moment later.
+                    std::thread::sleep(Duration::from_millis(200));
+                    if let Ok(None) = x.child.try_wait() {
+                        return Some(x);
+                    }
+                    break;
                 }
                 if let Ok(Some(_)) = x.child.try_wait() {
                     break;
@@ -284,4 +295,49 @@ fn without_a_display_the_editor_says_so_in_one_line() {
     assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
     assert!(err.contains("display"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn a_failing_script_step_in_the_live_editor_exits_non_zero_naming_the_step() {
+    if !have("Xvfb") {
+        return skip("Xvfb is not installed (package xvfb)");
+    }
+    let Some(x) = Xvfb::start() else {
+        return skip("Xvfb did not start");
+    };
+    let dir = scratch("failing");
+    let script = dir.join("fails.ron");
+    std::fs::write(
+        &script,
+        r#"(format_version: 1, start: New(size: (16, 16, 16)), steps: [
+            Do(Stroke((mode: Attach, shape: Cube, size: 3.0, material: 0, points: [(8.0, 8.0, 8.0)]))),
+            ExpectSolidCount(1),
+        ])"#,
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
+        .arg("--script")
+        .arg(&script)
+        .arg("--capture")
+        .arg(dir.join("never.png"))
+        .args(["--window", "96x64"])
+        .env("DISPLAY", &x.display)
+        .env_remove("WAYLAND_DISPLAY")
+        .env("VOXBRICK_CONFIG_DIR", dir.join("config"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if stderr.contains("no usable Vulkan") || stderr.contains("no Vulkan device") {
+        return skip(&format!(
+            "no Vulkan device can draw a window: {}",
+            stderr.trim()
+        ));
+    }
+    assert!(!out.status.success(), "a failed step must fail the run");
+    assert!(stderr.contains("step 2 (ExpectSolidCount)"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(
+        !dir.join("never.png").exists(),
+        "nothing captured after a failure"
+    );
 }

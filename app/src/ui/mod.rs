@@ -643,7 +643,7 @@ impl Editor {
             self.file_done(done);
         }
         self.tick_fly();
-        self.step_script(event_loop)?;
+        self.step_script()?;
         self.autosave();
         let Some(mut gfx) = self.gfx.take() else {
             return Ok(());
@@ -820,7 +820,9 @@ impl Editor {
         }
     }
 
-    fn step_script(&mut self, _event_loop: &ActiveEventLoop) -> Result<()> {
+    /// Runs the script's next step, one per frame, so the viewport shows each edit; a camera
+    /// step resets the view to the scene camera (what the capture is compared against).
+    fn step_script(&mut self) -> Result<()> {
         let Some(mut s) = self.script.take() else {
             return Ok(());
         };
@@ -833,17 +835,10 @@ impl Editor {
             }
             r
         };
-        let stepped = result.is_ok();
-        match result {
-            Ok(Some(line)) => println!("{line}"),
-            Ok(None) => {}
-            Err(e) => {
-                self.script = Some(s);
-                return Err(e);
-            }
-        }
-        let _ = stepped;
         self.script = Some(s);
+        if let Some(line) = result? {
+            println!("{line}");
+        }
         Ok(())
     }
 
