@@ -18,8 +18,18 @@ pub fn device_choice(device: &str) -> DeviceChoice {
 
 /// A headless GPU session on `device` with the world of `view` uploaded.
 pub fn session(device: &str, view: &brickmap::WorldView<'_>) -> Result<Viewport> {
+    session_with(device, view, false)
+}
+
+/// [`session`] on a context that can also draw the editor's UI offscreen (`draw_ui`).
+pub fn session_with(
+    device: &str,
+    view: &brickmap::WorldView<'_>,
+    draw_ui: bool,
+) -> Result<Viewport> {
     let ctx = GpuContext::new(&ContextOptions {
         device: device_choice(device),
+        draw_ui,
         ..Default::default()
     })
     .context("no usable Vulkan device (the CPU reference renderer runs with --device cpu)")?;

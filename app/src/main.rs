@@ -217,6 +217,10 @@ enum Command {
         /// Vulkan device (part of its name).
         #[arg(long)]
         device: Option<String>,
+        /// Also measure the window's half: the copy into an offscreen image of the window's
+        /// size and egui panels painted on it.
+        #[arg(long)]
+        ui: bool,
     },
     /// Time the GPU path tracer on the thesis scene with Vulkan timestamp queries: medians
     /// after warm-up for the thesis's complexities 1, 2 and 3.
@@ -513,6 +517,7 @@ fn run(cli: Cli) -> Result<()> {
             frames,
             spp,
             device,
+            ui,
         } => {
             if let Some(s) = scales.iter().find(|s| !(**s > 0.0 && **s <= 1.0)) {
                 bail!("internal scale {s} is outside (0, 1]");
@@ -522,13 +527,14 @@ fn run(cli: Cli) -> Result<()> {
             scene.params.settings.max_bounces = 3;
             let session = {
                 let view = scene.world.read();
-                app::gpu::session(device.as_deref().unwrap_or("gpu"), &view)?
+                app::gpu::session_with(device.as_deref().unwrap_or("gpu"), &view, ui)?
             };
             let bench = cli::bench_viewport::BenchViewport {
                 size,
                 scales,
                 frames: frames.max(1),
                 spp: spp.clamp(1, 16),
+                ui,
             };
             emit(&cli::bench_viewport::run(
                 session,

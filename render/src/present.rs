@@ -47,7 +47,7 @@ pub struct Capture {
 
 /// The window's presenter.
 pub struct Presenter {
-    swapchain: Option<Swapchain>,
+    target: Option<Target>,
     egui: Option<Renderer<GpuAllocator>>,
     upload_pool: vk::CommandPool,
     /// egui textures to free once the slot that last used them finished.
@@ -61,18 +61,35 @@ impl Presenter {
     /// A presenter for the context's window, `size` pixels.
     pub fn new(ctx: Arc<GpuContext>, size: (u32, u32)) -> Result<Self, GpuError> {
         let swapchain = Swapchain::new(ctx.clone(), size, None)?;
+        Self::with_target(ctx, Target::Window(swapchain), size)
+    }
+
+    /// A presenter drawing into an offscreen image of `size` (B8G8R8A8_UNORM, like the
+    /// window's) instead of a swapchain: the same frame as in the window, for measuring where
+    /// there is no display. The context needs `draw_ui`.
+    pub fn offscreen(ctx: Arc<GpuContext>, size: (u32, u32)) -> Result<Self, GpuError> {
+        let image = Offscreen::new(ctx.clone(), size)?;
+        Self::with_target(ctx, Target::Offscreen(image), size)
+    }
+
+    fn with_target(
+        ctx: Arc<GpuContext>,
+        target: Target,
+        size: (u32, u32),
+    ) -> Result<Self, GpuError> {
+        let format = target.format();
         let egui = Renderer::with_gpu_allocator(
             Arc::clone(&ctx.allocator),
             ctx.device.clone(),
             RenderMode::DynamicRendering(DynamicRendering {
-                color_attachment_format: swapchain.format,
+                color_attachment_format: format,
                 depth_attachment_format: None,
                 stencil_attachment_format: None,
             }),
             Options {
                 in_flight_frames: FRAMES_IN_FLIGHT,
                 srgb_framebuffer: matches!(
-                    swapchain.format,
+                    format,
                     vk::Format::B8G8R8A8_SRGB | vk::Format::R8G8B8A8_SRGB
                 ),
                 ..Default::default()
@@ -89,7 +106,7 @@ impl Presenter {
             )
         })?;
         Ok(Self {
-            swapchain: Some(swapchain),
+            target: Some(target),
             egui: Some(egui),
             upload_pool,
             to_free: Default::default(),
@@ -107,21 +124,26 @@ impl Presenter {
         }
     }
 
-    /// The swapchain's size, format and present mode.
+    /// The target's size, format and present mode.
     pub fn describe(&self) -> String {
-        self.swapchain.as_ref().map_or_else(String::new, |s| {
-            format!(
+        match &self.target {
+            Some(Target::Window(s)) => format!(
                 "{}x{} {:?} {:?}",
                 s.extent.width, s.extent.height, s.format, s.present_mode
-            )
-        })
+            ),
+            Some(Target::Offscreen(o)) => format!(
+                "{}x{} {:?} offscreen",
+                o.extent.width, o.extent.height, o.format
+            ),
+            None => String::new(),
+        }
     }
 
-    /// Current output size (the swapchain's extent).
+    /// Current output size (the target's extent).
     pub fn extent(&self) -> (u32, u32) {
-        self.swapchain
+        self.target
             .as_ref()
-            .map_or(self.size, |s| (s.extent.width, s.extent.height))
+            .map_or(self.size, |t| (t.extent().width, t.extent().height))
     }
 
     fn recreate_now(&mut self, viewport: &Viewport) -> Result<(), GpuError> {
@@ -130,8 +152,13 @@ impl Presenter {
         vk_call("vkDeviceWaitIdle", unsafe {
             self.ctx.device.device_wait_idle()
         })?;
-        let next = Swapchain::new(self.ctx.clone(), self.size, self.swapchain.as_ref())?;
-        self.swapchain = Some(next);
+        let next = match &self.target {
+            Some(Target::Window(old)) => {
+                Target::Window(Swapchain::new(self.ctx.clone(), self.size, Some(old))?)
+            }
+            _ => Target::Offscreen(Offscreen::new(self.ctx.clone(), self.size)?),
+        };
+        self.target = Some(next);
         self.recreate = false;
         Ok(())
     }
@@ -163,10 +190,16 @@ impl Presenter {
         for id in self.to_free[frame.slot()].drain(..) {
             let _ = egui.free_texture(id);
         }
-        let swapchain = self.swapchain.as_ref().expect("made in new");
-        let Some((index, suboptimal)) = swapchain.acquire(frame.acquired)? else {
-            self.recreate = true;
-            return Ok((Presented::NotReady, None));
+        let target = self.target.as_ref().expect("made in new");
+        let (index, suboptimal) = match target {
+            Target::Window(swapchain) => match swapchain.acquire(frame.acquired)? {
+                Some(acquired) => acquired,
+                None => {
+                    self.recreate = true;
+                    return Ok((Presented::NotReady, None));
+                }
+            },
+            Target::Offscreen(_) => (0, false),
         };
         if let Some(ui) = &ui {
             for (id, deltas) in &ui.textures.set {
@@ -176,14 +209,14 @@ impl Presenter {
                 }
             }
         }
-        let extent = swapchain.extent;
+        let (extent, format) = (target.extent(), target.format());
         let req = FrameRequest {
             output: (extent.width, extent.height),
-            bgra: is_bgra(swapchain.format),
+            bgra: is_bgra(format),
             ..*req
         };
         let status = viewport.trace_frame(&frame, world, &req)?;
-        let image = swapchain.images[index as usize];
+        let (image, view) = target.image(index);
         let cmd = frame.cmd;
         let capture_buffer = if capture {
             Some(HostBuffer::new(
@@ -239,7 +272,7 @@ impl Presenter {
             );
             if let Some(ui) = &ui {
                 let attachment = [vk::RenderingAttachmentInfo::default()
-                    .image_view(swapchain.views[index as usize])
+                    .image_view(view)
                     .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
                     .load_op(vk::AttachmentLoadOp::LOAD)
                     .store_op(vk::AttachmentStoreOp::STORE)];
@@ -250,7 +283,10 @@ impl Presenter {
                     })
                     .layer_count(1)
                     .color_attachments(&attachment);
-                let rendering = &ctx.presentation.as_ref().expect("window").dynamic_rendering;
+                let rendering = ctx
+                    .ui_rendering
+                    .as_ref()
+                    .expect("made for a window or draw_ui");
                 rendering.cmd_begin_rendering(cmd, &info);
                 egui.cmd_draw(cmd, extent, ui.pixels_per_point, ui.primitives)
                     .map_err(|e| GpuError::NoDevice(format!("egui draw: {e}")))?;
@@ -260,6 +296,11 @@ impl Presenter {
                 vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT,
                 vk::AccessFlags::COLOR_ATTACHMENT_WRITE,
             );
+            // A window's image goes to the presentation engine; an offscreen one stays put.
+            let final_layout = match target {
+                Target::Window(_) => vk::ImageLayout::PRESENT_SRC_KHR,
+                Target::Offscreen(_) => vk::ImageLayout::GENERAL,
+            };
             if let Some(buf) = &capture_buffer {
                 image_barrier(
                     d,
@@ -294,10 +335,7 @@ impl Presenter {
                     d,
                     cmd,
                     image,
-                    (
-                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                        vk::ImageLayout::PRESENT_SRC_KHR,
-                    ),
+                    (vk::ImageLayout::TRANSFER_SRC_OPTIMAL, final_layout),
                     (vk::PipelineStageFlags::TRANSFER, vk::AccessFlags::empty()),
                     (
                         vk::PipelineStageFlags::BOTTOM_OF_PIPE,
@@ -309,10 +347,7 @@ impl Presenter {
                     d,
                     cmd,
                     image,
-                    (
-                        vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                        vk::ImageLayout::PRESENT_SRC_KHR,
-                    ),
+                    (vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, final_layout),
                     last,
                     (
                         vk::PipelineStageFlags::BOTTOM_OF_PIPE,
@@ -322,24 +357,30 @@ impl Presenter {
             }
         }
         let slot = frame.slot();
-        viewport.submit_frame(
-            frame,
-            &[(
-                frame.acquired,
-                vk::PipelineStageFlags::TRANSFER | vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT,
-            )],
-            &[swapchain.render_finished[index as usize]],
-        )?;
+        match target {
+            Target::Window(swapchain) => {
+                viewport.submit_frame(
+                    frame,
+                    &[(
+                        frame.acquired,
+                        vk::PipelineStageFlags::TRANSFER
+                            | vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT,
+                    )],
+                    &[swapchain.render_finished[index as usize]],
+                )?;
+                if swapchain.present(index)? || suboptimal {
+                    self.recreate = true;
+                }
+            }
+            Target::Offscreen(_) => viewport.submit_frame(frame, &[], &[])?,
+        }
         if let Some(ui) = &ui {
             self.to_free[slot].extend(ui.textures.free.iter().copied());
-        }
-        if swapchain.present(index)? || suboptimal {
-            self.recreate = true;
         }
         let captured = match capture_buffer {
             Some(buf) => {
                 let waited = viewport.wait_idle();
-                let bgra = is_bgra(swapchain.format);
+                let bgra = is_bgra(format);
                 let rgb = buf
                     .read()
                     .chunks_exact(4)
@@ -378,6 +419,132 @@ fn whole_image(extent: vk::Extent2D) -> vk::BufferImageCopy {
             height: extent.height,
             depth: 1,
         },
+    }
+}
+
+/// Where frames go: a window's swapchain or an offscreen image.
+enum Target {
+    Window(Swapchain),
+    Offscreen(Offscreen),
+}
+
+impl Target {
+    fn format(&self) -> vk::Format {
+        match self {
+            Target::Window(s) => s.format,
+            Target::Offscreen(o) => o.format,
+        }
+    }
+
+    fn extent(&self) -> vk::Extent2D {
+        match self {
+            Target::Window(s) => s.extent,
+            Target::Offscreen(o) => o.extent,
+        }
+    }
+
+    /// Image `index` and its view.
+    fn image(&self, index: u32) -> (vk::Image, vk::ImageView) {
+        match self {
+            Target::Window(s) => (s.images[index as usize], s.views[index as usize]),
+            Target::Offscreen(o) => (o.image, o.view),
+        }
+    }
+}
+
+/// A device-local image of the window's size and format, for headless frames.
+struct Offscreen {
+    image: vk::Image,
+    view: vk::ImageView,
+    allocation: Option<gpu_allocator::vulkan::Allocation>,
+    extent: vk::Extent2D,
+    format: vk::Format,
+    ctx: Arc<GpuContext>,
+}
+
+impl Offscreen {
+    fn new(ctx: Arc<GpuContext>, (w, h): (u32, u32)) -> Result<Self, GpuError> {
+        let format = vk::Format::B8G8R8A8_UNORM;
+        let extent = vk::Extent2D {
+            width: w.max(1),
+            height: h.max(1),
+        };
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(format)
+            .extent(vk::Extent3D {
+                width: extent.width,
+                height: extent.height,
+                depth: 1,
+            })
+            .mip_levels(1)
+            .array_layers(1)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(
+                vk::ImageUsageFlags::COLOR_ATTACHMENT
+                    | vk::ImageUsageFlags::TRANSFER_DST
+                    | vk::ImageUsageFlags::TRANSFER_SRC,
+            )
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        // SAFETY: the create info outlives the call; destroyed in Drop.
+        let image = vk_call("vkCreateImage", unsafe {
+            ctx.device.create_image(&info, None)
+        })?;
+        let mut me = Self {
+            image,
+            view: vk::ImageView::null(),
+            allocation: None,
+            extent,
+            format,
+            ctx: ctx.clone(),
+        };
+        // SAFETY: plain query on a live image.
+        let requirements = unsafe { ctx.device.get_image_memory_requirements(image) };
+        let allocation = ctx.allocator.lock().expect("allocator lock").allocate(
+            &gpu_allocator::vulkan::AllocationCreateDesc {
+                name: "offscreen target",
+                requirements,
+                location: MemoryLocation::GpuOnly,
+                linear: false,
+                allocation_scheme: gpu_allocator::vulkan::AllocationScheme::GpuAllocatorManaged,
+            },
+        )?;
+        // SAFETY: the allocation satisfies the image's requirements.
+        let bound = unsafe {
+            ctx.device
+                .bind_image_memory(image, allocation.memory(), allocation.offset())
+        };
+        me.allocation = Some(allocation);
+        vk_call("vkBindImageMemory", bound)?;
+        let view = vk::ImageViewCreateInfo::default()
+            .image(image)
+            .view_type(vk::ImageViewType::TYPE_2D)
+            .format(format)
+            .subresource_range(COLOUR);
+        // SAFETY: as above.
+        me.view = vk_call("vkCreateImageView", unsafe {
+            ctx.device.create_image_view(&view, None)
+        })?;
+        Ok(me)
+    }
+}
+
+impl Drop for Offscreen {
+    fn drop(&mut self) {
+        // SAFETY: the device is idle after the wait; view, image, then its memory.
+        unsafe {
+            let _ = self.ctx.device.device_wait_idle();
+            if self.view != vk::ImageView::null() {
+                self.ctx.device.destroy_image_view(self.view, None);
+            }
+            self.ctx.device.destroy_image(self.image, None);
+        }
+        if let Some(a) = self.allocation.take()
+            && let Ok(mut allocator) = self.ctx.allocator.lock()
+        {
+            let _ = allocator.free(a);
+        }
     }
 }
 
@@ -427,12 +594,12 @@ unsafe fn image_barrier(
 impl Drop for Presenter {
     fn drop(&mut self) {
         // SAFETY: the device is idle after the wait; egui's objects, then the pool, then the
-        // swapchain (its own Drop).
+        // target (its own Drop).
         unsafe {
             let _ = self.ctx.device.device_wait_idle();
             drop(self.egui.take());
             self.ctx.device.destroy_command_pool(self.upload_pool, None);
         }
-        drop(self.swapchain.take());
+        drop(self.target.take());
     }
 }

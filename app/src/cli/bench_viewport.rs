@@ -7,6 +7,7 @@
 use anyhow::Result;
 use brickmap::World;
 use render::SceneParams;
+use render::present::{EguiFrame, Presented, Presenter};
 use render::viewport::{FrameRequest, Viewport};
 use std::time::Instant;
 
@@ -20,6 +21,9 @@ pub struct BenchViewport {
     pub frames: usize,
     /// Samples per pixel each frame adds.
     pub spp: u32,
+    /// Also the window's half: the copy into an offscreen image of the window's size and
+    /// egui panels painted on it (the context must be made with `draw_ui`).
+    pub ui: bool,
 }
 
 fn scaled((w, h): (u32, u32), f: f32) -> (u32, u32) {
@@ -91,6 +95,89 @@ fn run_case(
     Ok((gpu, host, wall))
 }
 
+/// [`run_case`] through the presenter into an offscreen image, with egui panels like the
+/// editor's (menu bar, status line, a settings window) built, tessellated and painted each
+/// frame; host time is the whole frame (egui included).
+fn run_case_ui(
+    vp: &mut Viewport,
+    presenter: &mut Presenter,
+    world: &World,
+    params: &SceneParams,
+    req: FrameRequest<'_>,
+    frames: usize,
+    moving: bool,
+) -> Result<(Vec<f64>, Vec<f64>, f64)> {
+    let egui_ctx = egui::Context::default();
+    let mut pending = egui::TexturesDelta::default();
+    let (mut gpu, mut host) = (Vec::new(), Vec::new());
+    let mut p = params.clone();
+    let (mut drawn, mut timed_from) = (0, None);
+    let mut value = 0.5f32;
+    let result = (|| -> Result<()> {
+        while drawn < frames + 8 {
+            let started = Instant::now();
+            let input = egui::RawInput {
+                screen_rect: Some(egui::Rect::from_min_size(
+                    egui::Pos2::ZERO,
+                    egui::vec2(req.output.0 as f32, req.output.1 as f32),
+                )),
+                ..Default::default()
+            };
+            let out = egui_ctx.run_ui(input, |ui| {
+                egui::Panel::top("menu").show(ui, |ui| {
+                    egui::MenuBar::new().ui(ui, |ui| {
+                        for m in ["File", "Edit", "View"] {
+                            ui.menu_button(m, |_| {});
+                        }
+                    });
+                });
+                egui::Panel::bottom("status").show(ui, |ui| {
+                    ui.label(format!("{drawn} frames · GPU {:?}", vp.last_gpu_seconds()));
+                });
+                egui::Window::new("Render settings").show(ui.ctx(), |ui| {
+                    ui.add(egui::Slider::new(&mut value, 0.0..=1.0).text("internal resolution"));
+                    ui.label("target spp, exposure, autosave …");
+                });
+            });
+            pending.append(out.textures_delta);
+            let primitives = egui_ctx.tessellate(out.shapes, out.pixels_per_point);
+            let ui = EguiFrame {
+                primitives: &primitives,
+                pixels_per_point: out.pixels_per_point,
+                textures: &pending,
+            };
+            let r = FrameRequest { params: &p, ..req };
+            let (shown, _) = presenter.frame(vp, world, &r, Some(ui), false)?;
+            if !matches!(shown, Presented::Shown(_)) {
+                std::thread::yield_now();
+                continue;
+            }
+            pending.clear();
+            drawn += 1;
+            if moving {
+                p.camera.yaw_deg += 0.05;
+            }
+            let spent = started.elapsed().as_secs_f64();
+            if drawn == 8 {
+                vp.wait_idle()?;
+                timed_from = Some(Instant::now());
+            }
+            if drawn > 8 {
+                host.push(spent);
+                if let Some(t) = vp.last_gpu_seconds() {
+                    gpu.push(t);
+                }
+            }
+        }
+        vp.wait_idle()?;
+        Ok(())
+    })();
+    pending.clear();
+    result?;
+    let wall = timed_from.map_or(f64::NAN, |t| t.elapsed().as_secs_f64() / frames as f64);
+    Ok((gpu, host, wall))
+}
+
 /// Camera move → the first frame showing it finished on the GPU, `moves` times: (frames,
 /// milliseconds) medians.
 fn latency(
@@ -151,6 +238,11 @@ pub fn run(
         b.spp
     );
     text += "case                          internal     GPU ms/frame min / median / p99 / max   wall ms/frame   host µs/frame median (p99): begin, record, submit\n";
+    let mut presenter = if b.ui {
+        Some(Presenter::offscreen(ctx.clone(), b.size)?)
+    } else {
+        None
+    };
     for &scale in &b.scales {
         let internal = scaled(b.size, scale);
         let req = FrameRequest {
@@ -164,6 +256,25 @@ pub fn run(
         };
         for (label, moving) in [("refining (still camera)", false), ("camera moving", true)] {
             let (gpu, host, wall) = run_case(&mut vp, world, params, req, b.frames, moving)?;
+            if let Some(presenter) = &mut presenter {
+                let (gpu, host, wall) =
+                    run_case_ui(&mut vp, presenter, world, params, req, b.frames, moving)?;
+                let (g0, g50, g99, gmax) = stats(gpu);
+                let (_, h50, h99, _) = stats(host);
+                text += &format!(
+                    "scale {scale:<4} {:<24} {:>4}x{:<5}  {:.3} / {:.3} / {:.3} / {:.3}   {:.3}           whole frame {:.0} ({:.0})\n",
+                    format!("{label} + copy + egui"),
+                    internal.0,
+                    internal.1,
+                    g0 * 1e3,
+                    g50 * 1e3,
+                    g99 * 1e3,
+                    gmax * 1e3,
+                    wall * 1e3,
+                    h50 * 1e6,
+                    h99 * 1e6
+                );
+            }
             let (g0, g50, g99, gmax) = stats(gpu);
             let h: Vec<String> = (0..3)
                 .map(|k| {

@@ -603,6 +603,7 @@ impl Editor {
             device: crate::gpu::device_choice(&self.options.device),
             validation: self.options.validation,
             window: Some(handles),
+            draw_ui: true,
         })
         .context("no Vulkan device can draw this window")?;
         let ctx = Arc::new(ctx);

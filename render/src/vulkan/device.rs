@@ -34,6 +34,9 @@ pub struct ContextOptions {
     /// A window to present to: the context then creates its surface, picks a device and
     /// queue that can present to it and enables swapchains and dynamic rendering.
     pub window: Option<WindowHandles>,
+    /// Draw the editor's UI without a window (an offscreen target: headless measurement):
+    /// a graphics + compute queue and dynamic rendering, as for a window.
+    pub draw_ui: bool,
 }
 
 /// What presenting to a window needs from the device.
@@ -42,8 +45,6 @@ pub struct Presentation {
     pub surface: Surface,
     /// VK_KHR_swapchain entry points.
     pub swapchain: ash::khr::swapchain::Device,
-    /// VK_KHR_dynamic_rendering entry points (egui draws with dynamic rendering).
-    pub dynamic_rendering: ash::khr::dynamic_rendering::Device,
     /// The queue that presents (the compute queue when its family can).
     pub queue: vk::Queue,
     /// Its family.
@@ -77,6 +78,9 @@ pub struct GpuContext {
     pub shadow_queue: bool,
     /// Presentation, for a context made with a window.
     pub presentation: Option<Presentation>,
+    /// VK_KHR_dynamic_rendering entry points (egui draws with dynamic rendering), for a
+    /// context made with a window or `draw_ui`.
+    pub ui_rendering: Option<ash::khr::dynamic_rendering::Device>,
     /// Declared last: dropped after the device and the surface.
     pub instance: Instance,
 }
@@ -84,6 +88,8 @@ pub struct GpuContext {
 /// Device extensions a window needs.
 const PRESENT_EXTENSIONS: [&CStr; 2] =
     [ash::khr::swapchain::NAME, ash::khr::dynamic_rendering::NAME];
+/// Device extensions drawing the UI offscreen needs.
+const UI_EXTENSIONS: [&CStr; 1] = [ash::khr::dynamic_rendering::NAME];
 
 impl GpuContext {
     /// Creates a context on the chosen device.
@@ -95,6 +101,7 @@ impl GpuContext {
             None => &[],
         };
         let instance = Instance::new(validation, surface_extensions)?;
+        let ui = options.window.is_some() || options.draw_ui;
         // SAFETY: the caller's window outlives the context (the editor drops it first).
         let surface = match options.window {
             Some(w) => Some(unsafe { Surface::new(&instance, w) }?),
@@ -113,7 +120,7 @@ impl GpuContext {
         }
         let described: Vec<Candidate> = devices
             .iter()
-            .map(|&d| Candidate::new(raw, d, surface.as_ref()))
+            .map(|&d| Candidate::new(raw, d, surface.as_ref(), ui))
             .collect();
         let presentable = |c: &&Candidate| surface.is_none() || c.present_family.is_some();
         let chosen = match &options.device {
@@ -157,9 +164,12 @@ impl GpuContext {
                 .iter()
                 .any(|e| e.extension_name_as_c_str() == Ok(name))
         };
-        if surface.is_some()
-            && let Some(missing) = PRESENT_EXTENSIONS.iter().find(|e| !has(e))
-        {
+        let ui_extensions: &[&CStr] = match (surface.is_some(), ui) {
+            (true, _) => &PRESENT_EXTENSIONS,
+            (false, true) => &UI_EXTENSIONS,
+            _ => &[],
+        };
+        if let Some(missing) = ui_extensions.iter().find(|e| !has(e)) {
             return Err(GpuError::NoDevice(format!(
                 "{name} (it lacks {}, which the editor's window needs)",
                 missing.to_string_lossy()
@@ -212,9 +222,7 @@ impl GpuContext {
         if shadow_queue {
             extensions.push(ash::ext::shader_atomic_float::NAME.as_ptr());
         }
-        if surface.is_some() {
-            extensions.extend(PRESENT_EXTENSIONS.map(CStr::as_ptr));
-        }
+        extensions.extend(ui_extensions.iter().map(|e| e.as_ptr()));
         let priorities = [1.0];
         let mut queues = vec![
             vk::DeviceQueueCreateInfo::default()
@@ -244,7 +252,7 @@ impl GpuContext {
         if shadow_queue {
             info = info.push_next(&mut float_feature);
         }
-        if surface.is_some() {
+        if ui {
             info = info.push_next(&mut rendering_feature);
         }
         // SAFETY: the create info outlives the call.
@@ -260,12 +268,12 @@ impl GpuContext {
             Presentation {
                 surface,
                 swapchain: ash::khr::swapchain::Device::new(raw, &device),
-                dynamic_rendering: ash::khr::dynamic_rendering::Device::new(raw, &device),
                 // SAFETY: as above, for the present family.
                 queue: unsafe { device.get_device_queue(family, 0) },
                 queue_family: family,
             }
         });
+        let ui_rendering = ui.then(|| ash::khr::dynamic_rendering::Device::new(raw, &device));
         let allocator = Allocator::new(&gpu_allocator::vulkan::AllocatorCreateDesc {
             instance: raw.clone(),
             device: device.clone(),
@@ -303,6 +311,7 @@ impl GpuContext {
             storage_alignment: limits.min_storage_buffer_offset_alignment.max(4),
             pipeline_stats,
             presentation,
+            ui_rendering,
             instance,
         })
     }
@@ -376,6 +385,7 @@ impl Candidate {
         instance: &ash::Instance,
         physical: vk::PhysicalDevice,
         surface: Option<&Surface>,
+        ui: bool,
     ) -> Self {
         // SAFETY: plain queries on a live instance.
         let (p, families) = unsafe {
@@ -385,7 +395,7 @@ impl Candidate {
             )
         };
         // A window's frames also draw egui: its queue needs graphics too.
-        let flags = if surface.is_some() {
+        let flags = if ui {
             vk::QueueFlags::COMPUTE | vk::QueueFlags::GRAPHICS
         } else {
             vk::QueueFlags::COMPUTE
