@@ -42,6 +42,51 @@ fn stats(mut v: Vec<f64>) -> (f64, f64, f64, f64) {
     (q(0.0), q(0.5), q(0.99), v[v.len() - 1])
 }
 
+/// Frames before timing starts (pipelines, clocks).
+const WARM_UP: usize = 8;
+
+/// Per-frame figures after the warm-up: GPU seconds (each slot's timestamps, read when the
+/// slot comes round again), host time, and the wall clock from the end of the warm-up.
+struct Timing<T> {
+    gpu: Vec<f64>,
+    host: Vec<T>,
+    timed_from: Option<Instant>,
+}
+
+impl<T> Timing<T> {
+    fn new() -> Self {
+        Self {
+            gpu: Vec::new(),
+            host: Vec::new(),
+            timed_from: None,
+        }
+    }
+
+    /// Frame number `n` (from 1) was submitted, having taken `spent` on the host.
+    fn frame(&mut self, vp: &Viewport, n: usize, spent: T) -> Result<()> {
+        if n == WARM_UP {
+            vp.wait_idle()?;
+            self.timed_from = Some(Instant::now());
+        }
+        if n > WARM_UP {
+            self.host.push(spent);
+            if let Some(t) = vp.last_gpu_seconds() {
+                self.gpu.push(t);
+            }
+        }
+        Ok(())
+    }
+
+    /// (GPU seconds, host times, wall seconds per frame) after `frames` timed frames.
+    fn finish(self, vp: &Viewport, frames: usize) -> Result<(Vec<f64>, Vec<T>, f64)> {
+        vp.wait_idle()?;
+        let wall = self
+            .timed_from
+            .map_or(f64::NAN, |t| t.elapsed().as_secs_f64() / frames as f64);
+        Ok((self.gpu, self.host, wall))
+    }
+}
+
 /// One case: `frames` frames, each `spp` more samples (restarting each frame when `moving`).
 /// Returns (GPU seconds per frame, host seconds per frame: begin, record, submit, and wall
 /// seconds per frame of the whole loop: throughput, the GPU kept busy).
@@ -53,11 +98,10 @@ fn run_case(
     frames: usize,
     moving: bool,
 ) -> Result<(Vec<f64>, Vec<[f64; 3]>, f64)> {
-    let (mut gpu, mut host) = (Vec::new(), Vec::new());
+    let mut timing = Timing::new();
     let mut p = params.clone();
     let mut submitted = 0;
-    let mut timed_from = None;
-    while submitted < frames + 8 {
+    while submitted < frames + WARM_UP {
         let started = Instant::now();
         let Some(frame) = vp.begin_frame()? else {
             // Both slots in flight: the window's loop would handle events meanwhile.
@@ -77,22 +121,9 @@ fn run_case(
         vp.submit_frame(frame, &[], &[])?;
         let spent = [begun, recorded, before.elapsed().as_secs_f64()];
         submitted += 1;
-        // The first frames warm up (pipelines, clocks); each slot's GPU time is read when it
-        // comes round again.
-        if submitted == 8 {
-            vp.wait_idle()?;
-            timed_from = Some(Instant::now());
-        }
-        if submitted > 8 {
-            host.push(spent);
-            if let Some(t) = vp.last_gpu_seconds() {
-                gpu.push(t);
-            }
-        }
+        timing.frame(vp, submitted, spent)?;
     }
-    vp.wait_idle()?;
-    let wall = timed_from.map_or(f64::NAN, |t| t.elapsed().as_secs_f64() / frames as f64);
-    Ok((gpu, host, wall))
+    timing.finish(vp, frames)
 }
 
 /// [`run_case`] through the presenter into an offscreen image, with egui panels like the
@@ -109,12 +140,12 @@ fn run_case_ui(
 ) -> Result<(Vec<f64>, Vec<f64>, f64)> {
     let egui_ctx = egui::Context::default();
     let mut pending = egui::TexturesDelta::default();
-    let (mut gpu, mut host) = (Vec::new(), Vec::new());
+    let mut timing = Timing::new();
     let mut p = params.clone();
-    let (mut drawn, mut timed_from) = (0, None);
+    let mut drawn = 0;
     let mut value = 0.5f32;
     let result = (|| -> Result<()> {
-        while drawn < frames + 8 {
+        while drawn < frames + WARM_UP {
             let started = Instant::now();
             let input = egui::RawInput {
                 screen_rect: Some(egui::Rect::from_min_size(
@@ -157,25 +188,13 @@ fn run_case_ui(
             if moving {
                 p.camera.yaw_deg += 0.05;
             }
-            let spent = started.elapsed().as_secs_f64();
-            if drawn == 8 {
-                vp.wait_idle()?;
-                timed_from = Some(Instant::now());
-            }
-            if drawn > 8 {
-                host.push(spent);
-                if let Some(t) = vp.last_gpu_seconds() {
-                    gpu.push(t);
-                }
-            }
+            timing.frame(vp, drawn, started.elapsed().as_secs_f64())?;
         }
-        vp.wait_idle()?;
         Ok(())
     })();
     pending.clear();
     result?;
-    let wall = timed_from.map_or(f64::NAN, |t| t.elapsed().as_secs_f64() / frames as f64);
-    Ok((gpu, host, wall))
+    timing.finish(vp, frames)
 }
 
 /// Camera move → the first frame showing it finished on the GPU, `moves` times: (frames,
