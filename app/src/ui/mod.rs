@@ -401,10 +401,14 @@ impl Editor {
             UiEvent::SetSun(s) => self.execute(Command::SetSun(s)),
             UiEvent::SetSky(s) => self.execute(Command::SetSky(s)),
             UiEvent::SetSettings(s) => self.execute(Command::SetSettings(s)),
-            UiEvent::Import { path, offset } => self.execute(Command::ImportVox {
-                path: path.display().to_string(),
-                offset: glam::IVec3::from_array(offset),
-            }),
+            // Reading and merging a file can take a while: on the worker.
+            UiEvent::Import { path, offset } => self.files.execute(
+                &self.doc,
+                Command::ImportVox {
+                    path: path.display().to_string(),
+                    offset: glam::IVec3::from_array(offset),
+                },
+            ),
             UiEvent::UseViewAsSceneCamera => {
                 self.execute(Command::SetCamera(self.view.camera.clone()))
             }
@@ -496,6 +500,12 @@ impl Editor {
                     self.panels.errors.push(format!("{e:#}"));
                 }
             },
+            Done::Executed(label, result) => {
+                if let Err(e) = result {
+                    self.panels.errors.push(format!("{label}: {e:#}"));
+                }
+                self.refresh_stats();
+            }
             Done::Saved {
                 path,
                 autosave,
@@ -638,8 +648,13 @@ impl Editor {
         event_loop.exit();
     }
 
-    /// One frame: script step, file results, egui, trace, present.
+    /// One frame: script step, file results, egui, trace, present. Skipped (not waited
+    /// for) while a command runs on the worker; its completion wakes the loop.
     fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        let gate = self.files.gate.clone();
+        let Ok(_frame) = gate.try_lock() else {
+            return Ok(());
+        };
         while let Ok(done) = self.files.done.try_recv() {
             self.file_done(done);
         }
@@ -790,17 +805,6 @@ impl Editor {
             || self.script.is_some()
             || !self.files.running.is_empty()
             || viewport_output.values().any(|v| v.repaint_delay.is_zero());
-        if std::env::var_os("VOXBRICK_DEBUG_LOOP").is_some() {
-            eprintln!(
-                "loop: {presented:?} samples {} moving {moving} files {:?} egui {:?}",
-                gfx.viewport.samples(),
-                self.files.running,
-                viewport_output
-                    .values()
-                    .map(|v| v.repaint_delay)
-                    .collect::<Vec<_>>()
-            );
-        }
         if busy {
             gfx.window.request_redraw();
         }
@@ -961,11 +965,18 @@ impl ApplicationHandler<Wake> for Editor {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        // While a command runs on the worker, input that would read the document is
+        // dropped rather than waited for; redraws skip themselves (see `redraw`).
+        let gate = self.files.gate.clone();
+        let _between_frames = match &event {
+            WindowEvent::RedrawRequested | WindowEvent::Resized(_) => None,
+            _ => match gate.try_lock() {
+                Ok(g) => Some(g),
+                Err(_) => return,
+            },
+        };
         let Some(gfx) = &mut self.gfx else { return };
         let response = gfx.egui_state.on_window_event(&gfx.window, &event);
-        if std::env::var_os("VOXBRICK_DEBUG_LOOP").is_some() {
-            eprintln!("event {event:?} repaint {}", response.repaint);
-        }
         // egui-winit asks to repaint after every RedrawRequested too; honouring that would
         // keep a converged editor drawing forever.
         if response.repaint && !matches!(event, WindowEvent::RedrawRequested) {
