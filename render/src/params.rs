@@ -76,6 +76,21 @@ impl Camera {
         (forward, right * tan * aspect, up * tan)
     }
 
+    /// The same orientation, moved back from the centre of the box [`min`, `max`) until the
+    /// box's bounding sphere fits the vertical field of view; also returns the distance from
+    /// the eye to that centre. The editor's "frame the scene" and a `.vox` import's camera.
+    pub fn framing(&self, min: DVec3, max: DVec3) -> (Camera, f64) {
+        let centre = (min + max) * 0.5;
+        let radius = ((max - min).length() * 0.5).max(1.0);
+        let half = (self.fov_y_deg.to_radians() * 0.5).sin().max(1e-3);
+        let distance = radius / half;
+        let camera = Camera {
+            position: centre - self.forward() * distance,
+            ..self.clone()
+        };
+        (camera, distance)
+    }
+
     /// A camera at `position` looking at `target`.
     pub fn looking_at(position: DVec3, target: DVec3, fov_y_deg: f64) -> Self {
         let d = (target - position).normalize_or(DVec3::NEG_Z);

@@ -124,28 +124,6 @@ impl Presenter {
         }
     }
 
-    /// The target's size, format and present mode.
-    pub fn describe(&self) -> String {
-        match &self.target {
-            Some(Target::Window(s)) => format!(
-                "{}x{} {:?} {:?}",
-                s.extent.width, s.extent.height, s.format, s.present_mode
-            ),
-            Some(Target::Offscreen(o)) => format!(
-                "{}x{} {:?} offscreen",
-                o.extent.width, o.extent.height, o.format
-            ),
-            None => String::new(),
-        }
-    }
-
-    /// Current output size (the target's extent).
-    pub fn extent(&self) -> (u32, u32) {
-        self.target
-            .as_ref()
-            .map_or(self.size, |t| (t.extent().width, t.extent().height))
-    }
-
     fn recreate_now(&mut self, viewport: &Viewport) -> Result<(), GpuError> {
         viewport.wait_idle()?;
         // SAFETY: plain wait; the old swapchain's images must be idle before it goes.

@@ -130,21 +130,6 @@ impl Viewport {
         &mut self.tracer
     }
 
-    /// The world's GPU mirror.
-    pub fn gpu_world(&self) -> &GpuWorld {
-        &self.world
-    }
-
-    /// Uploads what the world changed since the last update (one staging flush).
-    pub fn update(&mut self, world: &World) -> Result<UploadReport, GpuError> {
-        self.world.update(&self.ctx, world)
-    }
-
-    /// Uploads everything the world changed and waits for the copies.
-    pub fn sync(&mut self, world: &World) -> Result<UploadReport, GpuError> {
-        self.world.sync(&self.ctx, world)
-    }
-
     /// Renders `job` with the scene's variant and waits: the linear image and GPU time.
     pub fn render(
         &mut self,
@@ -214,13 +199,6 @@ impl Viewport {
     /// GPU time of the last interactive frame that finished (timestamp queries).
     pub fn last_gpu_seconds(&self) -> Option<f64> {
         self.last_gpu_seconds
-    }
-
-    /// Drops the interactive samples; the next frame starts over.
-    pub fn restart(&mut self) {
-        if let Some(l) = &mut self.live {
-            l.restart();
-        }
     }
 
     /// The linear mean of the interactive accumulation (waits for the GPU; tests).

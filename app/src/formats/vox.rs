@@ -130,8 +130,12 @@ pub fn import_bytes(
     })?;
     let mut scene = Scene::empty(dims, workers).map_err(|e| FormatError::world(path, e))?;
     if let Some((lo, hi)) = bounds(&placed) {
-        scene.params.camera =
-            framing_camera(&scene.params.camera, lo.as_dvec3(), (hi + 1).as_dvec3());
+        // Framed whole (the default camera's direction), as the editor's "frame the scene".
+        scene.params.camera = scene
+            .params
+            .camera
+            .framing(lo.as_dvec3(), (hi + 1).as_dvec3())
+            .0;
     }
     // A new scene takes the file's palette as its colour table, index for index.
     let palette = palette_of(&data);
@@ -143,20 +147,6 @@ pub fn import_bytes(
         .map_err(|e| FormatError::world(path, e))?;
     scene.world.take_dirty();
     Ok((scene, report))
-}
-
-/// The default camera's direction, backed off from the centre of the box [lo, hi) until the
-/// box's bounding sphere fits its vertical field of view (so a wide model is seen whole, as
-/// the editor's "frame the scene" shows it).
-fn framing_camera(default: &render::Camera, lo: glam::DVec3, hi: glam::DVec3) -> render::Camera {
-    let centre = (lo + hi) * 0.5;
-    let radius = ((hi - lo).length() * 0.5).max(1.0);
-    let distance = radius / (default.fov_y_deg.to_radians() * 0.5).sin();
-    render::Camera::looking_at(
-        centre - default.forward() * distance,
-        centre,
-        default.fov_y_deg,
-    )
 }
 
 /// Imports `.vox` bytes into an existing world. With `material`, every voxel gets that

@@ -95,11 +95,8 @@ impl ViewCamera {
     /// Frames a box: keeps the orientation, pivots on its centre and backs off until its
     /// bounding sphere fits the vertical field of view.
     pub fn frame(&mut self, min: DVec3, max: DVec3) {
-        let centre = (min + max) * 0.5;
-        let radius = ((max - min).length() * 0.5).max(1.0);
-        let half = (self.camera.fov_y_deg.to_radians() * 0.5).sin().max(1e-3);
-        self.distance = (radius / half).max(MIN_DISTANCE);
-        self.camera.position = centre - self.camera.forward() * self.distance;
+        let (camera, distance) = self.camera.framing(min, max);
+        *self = Self::from_camera(camera, distance);
     }
 
     /// Where a world point appears, in normalized device coordinates (None behind the eye).

@@ -130,8 +130,12 @@ pub struct Editor {
     save_then: Option<Pending>,
     last_autosave: Instant,
     script: Option<LiveScript>,
-    loading_default: bool,
+    /// A built scene (the default one, or New) is on its way: a `Loaded` without a path replaces
+    /// the document only then.
+    awaiting_built_scene: bool,
     pending_textures: egui::TexturesDelta,
+    /// The window title last set.
+    title: String,
     recovering: bool,
     quitting: bool,
     outcome: Result<()>,
@@ -214,8 +218,9 @@ impl Editor {
             pending: None,
             save_then: None,
             last_autosave: Instant::now(),
-            loading_default: false,
+            awaiting_built_scene: false,
             pending_textures: Default::default(),
+            title: String::new(),
             recovering: false,
             quitting: false,
             outcome: Ok(()),
@@ -238,7 +243,7 @@ impl Editor {
             match editor.options.file.clone() {
                 Some(f) => editor.files.load(f, editor.options.workers),
                 None => {
-                    editor.loading_default = true;
+                    editor.awaiting_built_scene = true;
                     editor.files.build_default(editor.options.workers);
                 }
             }
@@ -323,7 +328,7 @@ impl Editor {
 
     fn new_scene(&mut self, size: (u32, u32, u32), terrain: bool) {
         // Built on a worker; it replaces the document like a default-scene build.
-        self.loading_default = true;
+        self.awaiting_built_scene = true;
         self.files.build_new(size, terrain, self.options.workers);
     }
 
@@ -432,7 +437,7 @@ impl Editor {
             UiEvent::Recover(yes) => {
                 if let Some(p) = self.panels.recovery.take() {
                     if yes {
-                        self.loading_default = false;
+                        self.awaiting_built_scene = false;
                         self.files.load(p, self.options.workers);
                         self.recovering = true;
                     } else {
@@ -478,14 +483,14 @@ impl Editor {
             }
             Done::Loaded(path, loaded) => match *loaded {
                 Ok(scene) => {
-                    if self.loading_default && path.is_some() {
+                    if self.awaiting_built_scene && path.is_some() {
                         // A file opened while the default scene was building wins.
-                        self.loading_default = false;
+                        self.awaiting_built_scene = false;
                     }
-                    if path.is_none() && !self.loading_default {
+                    if path.is_none() && !self.awaiting_built_scene {
                         return;
                     }
-                    self.loading_default = false;
+                    self.awaiting_built_scene = false;
                     let recovered = std::mem::take(&mut self.recovering);
                     self.replace_document(scene, path.filter(|_| !recovered));
                     if recovered {
@@ -496,7 +501,7 @@ impl Editor {
                     }
                 }
                 Err(e) => {
-                    self.loading_default = false;
+                    self.awaiting_built_scene = false;
                     self.panels.errors.push(format!("{e:#}"));
                 }
             },
@@ -708,7 +713,12 @@ impl Editor {
                 l.as_secs_f64() * 1e3
             )),
         );
-        gfx.window.set_title(&files::title(&self.read()));
+        // The title only when it changes (each set is a round trip to the window system).
+        let title = files::title(&self.read());
+        if title != self.title {
+            gfx.window.set_title(&title);
+            self.title = title;
+        }
         let raw = gfx.egui_state.take_egui_input(&gfx.window);
         let egui_ctx = self.egui.clone();
         let mut events = Vec::new();

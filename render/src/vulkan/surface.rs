@@ -16,10 +16,6 @@ pub struct WindowHandles {
     pub window: RawWindowHandle,
 }
 
-// SAFETY: the handles are plain identifiers; they are only used on the creating thread
-// while the window is alive (the caller's guarantee in `GpuContext::new`).
-unsafe impl Send for WindowHandles {}
-
 /// A surface and its loader; destroyed on drop (after the swapchains made from it).
 pub struct Surface {
     /// VK_KHR_surface entry points.

@@ -23,6 +23,17 @@ struct Push {
 }
 const _: () = assert!(std::mem::size_of::<Push>() == 24);
 
+impl Push {
+    fn new(src: (u32, u32), dst: (u32, u32), exposure: f32, bgra: bool) -> Self {
+        Self {
+            src: [src.0, src.1],
+            dst: [dst.0, dst.1],
+            scale: 2f32.powf(exposure),
+            bgra: bgra as u32,
+        }
+    }
+}
+
 /// The display pipeline.
 pub struct ToneMapper(ComputePass);
 
@@ -49,12 +60,7 @@ impl ToneMapper {
     ) -> Result<Vec<[u8; 3]>, GpuError> {
         let pixels = dst.0 as u64 * dst.1 as u64;
         let ldr = HostBuffer::new(ctx, "ldr", pixels * 4, MemoryLocation::GpuToCpu)?;
-        let push = Push {
-            src: [src.0, src.1],
-            dst: [dst.0, dst.1],
-            scale: 2f32.powf(exposure),
-            bgra: 0,
-        };
+        let push = Push::new(src, dst, exposure, false);
         let result = self.0.run(
             ctx,
             &[hdr, ldr.binding()],
@@ -85,12 +91,7 @@ impl ToneMapper {
         exposure: f32,
         bgra: bool,
     ) -> Result<(), GpuError> {
-        let push = Push {
-            src: [src.0, src.1],
-            dst: [dst.0, dst.1],
-            scale: 2f32.powf(exposure),
-            bgra: bgra as u32,
-        };
+        let push = Push::new(src, dst, exposure, bgra);
         let set = sets.get(ctx, &self.0, &[hdr, ldr])?;
         self.0.record(
             ctx,
