@@ -240,15 +240,31 @@ vec3 shadow_d;
 float shadow_t;
 vec3 shadow_l;
 
+// The dielectric a camera ray starts in (AIR outside them): the same for every ray of a
+// perspective camera (found on the host), per ray for an orthographic one.
+int camera_medium(vec3 o) {
+    if (p.cam_pos.w < 0.5) return int(p.seed.y) - 1;
+    ivec3 c = ivec3(floor(o));
+    if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(p.grid.xyz) * 8))) return AIR;
+    int m = material_at(c);
+    return (m >= 0 && material(m).kind == DIELECTRIC) ? m : AIR;
+}
+
 void begin_path(uvec2 px, uint index, uint s) {
     rng = hash(p.seed.x ^ hash(index * 9781u + (p.seed.z + s) * 6271u + 1u));
     float u = (2.0 * (float(px.x) + rand()) / float(p.image.x) - 1.0);
     float v = (1.0 - 2.0 * (float(px.y) + rand()) / float(p.image.y));
-    path_d = normalize(p.cam_forward.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v);
-    path_o = p.cam_pos.xyz;
+    if (p.cam_pos.w > 0.5) {
+        // Orthographic: parallel rays from the image plane through the camera's position.
+        path_o = p.cam_pos.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v;
+        path_d = p.cam_forward.xyz;
+    } else {
+        path_o = p.cam_pos.xyz;
+        path_d = normalize(p.cam_forward.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v);
+    }
     path_beta = vec3(1.0);
     path_start = ivec3(0);
-    path_medium = HAS_DIELECTRIC ? int(p.seed.y) - 1 : AIR;
+    path_medium = HAS_DIELECTRIC ? camera_medium(path_o) : AIR;
     path_pdf = -1.0;
     path_camera = true;
     path_vertex = 1u;

@@ -161,6 +161,9 @@ enum Command {
         /// .vox, framing the whole scene).
         #[arg(long)]
         camera: Option<String>,
+        /// An orthographic view H voxels tall (parallel rays from the plane through the eye).
+        #[arg(long, value_name = "H")]
+        orthographic: Option<f64>,
         /// gpu (the Vulkan path tracer on the best device), cpu (the reference path tracer), or
         /// part of a Vulkan device's name.
         #[arg(long, default_value = "gpu")]
@@ -445,6 +448,7 @@ fn run(cli: Cli) -> Result<()> {
             width,
             height,
             camera,
+            orthographic,
             device,
             seed,
             scale,
@@ -459,6 +463,7 @@ fn run(cli: Cli) -> Result<()> {
             width,
             height,
             camera,
+            orthographic,
             device,
             seed,
             scale,
@@ -574,12 +579,17 @@ fn run(cli: Cli) -> Result<()> {
             let p = &scene.params;
             let mut text = format!("file         {}\n", file.display());
             text += &stats_text(&scene.world, started.elapsed().as_secs_f64());
+            let lens = match p.camera.projection {
+                render::Projection::Perspective => format!("fov {:.1}", p.camera.fov_y_deg),
+                render::Projection::Orthographic { height } => {
+                    format!("orthographic {height:.1} voxels tall")
+                }
+            };
             text += &format!(
-                "camera       at {} yaw {:.1} pitch {:.1} fov {:.1}\nrender       {} spp, {} bounces, {}x{}\n",
+                "camera       at {} yaw {:.1} pitch {:.1} {lens}\nrender       {} spp, {} bounces, {}x{}\n",
                 p.camera.position,
                 p.camera.yaw_deg,
                 p.camera.pitch_deg,
-                p.camera.fov_y_deg,
                 p.settings.samples_per_pixel,
                 p.settings.max_bounces,
                 p.settings.internal_resolution.0,

@@ -165,22 +165,14 @@ fn render_on_the_cpu_writes_png_and_pfm() {
     let d = scratch("render");
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/vox/mmmm_chr_robot.vox");
     let (png, pfm) = (d.join("robot.png"), d.join("robot.pfm"));
-    let text = ok(&[
-        "render",
-        s(&scene),
-        "--out",
-        s(&png),
-        "--hdr",
-        s(&pfm),
-        "--device",
-        "cpu",
-        "--spp",
-        "2",
-        "--width",
-        "40",
-        "--height",
-        "30",
-    ]);
+    let small = |png: &Path, pfm: &Path, extra: &[&str]| {
+        let mut args = vec!["render", s(&scene), "--out", s(png), "--hdr", s(pfm)];
+        args.extend([
+            "--device", "cpu", "--spp", "2", "--width", "40", "--height", "30",
+        ]);
+        ok(&[&args[..], extra].concat())
+    };
+    let text = small(&png, &pfm, &[]);
     assert!(field(&text, "rendered").contains("2400 samples"), "{text}");
     assert!(field(&text, "rays").contains("Mrays/s"));
     let png_bytes = std::fs::read(&png).unwrap();
@@ -212,4 +204,20 @@ fn render_on_the_cpu_writes_png_and_pfm() {
         ])
         .contains("X,Y,Z")
     );
+    // An orthographic render is a different image; a bad height is refused by name.
+    let ortho = d.join("ortho.pfm");
+    small(&d.join("ortho.png"), &ortho, &["--orthographic", "40"]);
+    assert_ne!(std::fs::read(&ortho).unwrap(), pfm_bytes);
+    let err = fails(&[
+        "render",
+        s(&scene),
+        "--out",
+        s(&d.join("y.png")),
+        "--device",
+        "cpu",
+        "--orthographic",
+        "0",
+    ]);
+    assert!(err.contains("orthographic height"), "{err}");
+    assert!(!d.join("y.png").exists());
 }

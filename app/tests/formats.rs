@@ -73,8 +73,25 @@ fn project_round_trips_everything() {
         project::to_string(&loaded),
         std::fs::read_to_string(&path).unwrap()
     );
-    // The non-voxel part is readable RON.
+    // A perspective camera is written without a projection (files stay as before); an
+    // orthographic one round-trips, and a bad height is refused by name.
     let text = std::fs::read_to_string(&path).unwrap();
+    assert!(!text.contains("projection"));
+    let mut ortho = Scene::load(&path, 2).unwrap();
+    ortho.params.camera.projection = render::Projection::Orthographic { height: 37.5 };
+    let ortho_path = d.join("ortho.ron");
+    ortho.save(&ortho_path).unwrap();
+    let ortho_text = std::fs::read_to_string(&ortho_path).unwrap();
+    assert!(ortho_text.contains("projection: Orthographic(height: 37.5)"));
+    assert_eq!(Scene::load(&ortho_path, 2).unwrap().params, ortho.params);
+    std::fs::write(
+        &ortho_path,
+        ortho_text.replace("height: 37.5", "height: -1.0"),
+    )
+    .unwrap();
+    let err = Scene::load(&ortho_path, 2).unwrap_err().to_string();
+    assert!(err.contains("orthographic height"), "{err}");
+    // The non-voxel part is readable RON.
     assert!(
         text.contains("format_version: 1")
             && text.contains("kind: Metal")

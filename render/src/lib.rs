@@ -11,4 +11,4 @@ pub mod viewport;
 pub mod vulkan;
 
 pub use image::Image;
-pub use params::{Camera, ParamError, RenderSettings, SceneParams, Sky, Sun, SunDisc};
+pub use params::{Camera, ParamError, Projection, RenderSettings, SceneParams, Sky, Sun, SunDisc};

@@ -42,7 +42,27 @@ fn colour_ok(c: [f32; 3]) -> bool {
     c.iter().all(|v| v.is_finite() && *v >= 0.0)
 }
 
-/// A pinhole camera: position, orientation as yaw and pitch, vertical field of view.
+/// How camera rays leave the image plane.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum Projection {
+    /// A pinhole at the camera's position with its vertical field of view.
+    #[default]
+    Perspective,
+    /// Parallel rays along the view direction from the plane through the camera's position
+    /// (nothing behind that plane is seen); the image is `height` voxels tall.
+    Orthographic {
+        /// Height of the view in voxels, > 0.
+        height: f64,
+    },
+}
+
+impl Projection {
+    fn is_perspective(&self) -> bool {
+        *self == Projection::Perspective
+    }
+}
+
+/// A camera: position, orientation as yaw and pitch, vertical field of view, projection.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Camera {
     /// Eye position, in voxel units.
@@ -51,8 +71,13 @@ pub struct Camera {
     pub yaw_deg: f64,
     /// Elevation in degrees, −89..=89; positive looks up.
     pub pitch_deg: f64,
-    /// Vertical field of view in degrees, in (0, 180).
+    /// Vertical field of view in degrees, in (0, 180) (kept while orthographic, for
+    /// switching back).
     pub fov_y_deg: f64,
+    /// Perspective (the default; files without the field are perspective, and a perspective
+    /// camera is written without it) or orthographic.
+    #[serde(default, skip_serializing_if = "Projection::is_perspective")]
+    pub projection: Projection,
 }
 
 impl Camera {
@@ -66,26 +91,64 @@ impl Camera {
         )
     }
     /// The image-plane basis for an aspect ratio (width / height): (forward, right, up), with
-    /// right and up scaled so that pixel (u, v) in [−1, 1]² looks along
-    /// forward + right·u + up·v. Both renderers derive camera rays from this.
+    /// right and up scaled so that image position (u, v) in [−1, 1]² (v up) looks along
+    /// forward + right·u + up·v from the eye (perspective: scaled by tan(fov/2)), or along
+    /// forward from position + right·u + up·v (orthographic: scaled by height/2). Both
+    /// renderers derive camera rays from this ([`Camera::ray`]).
     pub fn basis(&self, aspect: f64) -> (DVec3, DVec3, DVec3) {
         let forward = self.forward();
         let right = forward.cross(DVec3::Y).normalize();
         let up = right.cross(forward);
-        let tan = (self.fov_y_deg.to_radians() * 0.5).tan();
-        (forward, right * tan * aspect, up * tan)
+        let half = match self.projection {
+            Projection::Perspective => (self.fov_y_deg.to_radians() * 0.5).tan(),
+            Projection::Orthographic { height } => height * 0.5,
+        };
+        (forward, right * half * aspect, up * half)
+    }
+
+    /// Whether camera rays are parallel.
+    pub fn is_orthographic(&self) -> bool {
+        matches!(self.projection, Projection::Orthographic { .. })
+    }
+
+    /// The camera ray (origin, unit direction) through image position (u, v) ∈ [−1, 1]²,
+    /// v up: what the CPU reference traces and trace.comp's `begin_path` computes in f32.
+    pub fn ray(&self, u: f64, v: f64, aspect: f64) -> (DVec3, DVec3) {
+        let (forward, right, up) = self.basis(aspect);
+        match self.projection {
+            Projection::Perspective => (self.position, (forward + right * u + up * v).normalize()),
+            Projection::Orthographic { .. } => (self.position + right * u + up * v, forward),
+        }
+    }
+
+    /// The view height at `distance` ahead: what a perspective view shows there, and an
+    /// orthographic one everywhere.
+    pub fn view_height_at(&self, distance: f64) -> f64 {
+        match self.projection {
+            Projection::Perspective => 2.0 * distance * (self.fov_y_deg.to_radians() * 0.5).tan(),
+            Projection::Orthographic { height } => height,
+        }
     }
 
     /// The same orientation, moved back from the centre of the box [`min`, `max`) until the
-    /// box's bounding sphere fits the vertical field of view; also returns the distance from
-    /// the eye to that centre. The editor's "frame the scene" and a `.vox` import's camera.
+    /// box's bounding sphere fits the vertical field of view (orthographic: the view is the
+    /// sphere's diameter tall and its plane behind the sphere); also returns the distance
+    /// from the eye to that centre. The editor's "frame the scene" and a `.vox` import's
+    /// camera.
     pub fn framing(&self, min: DVec3, max: DVec3) -> (Camera, f64) {
         let centre = (min + max) * 0.5;
         let radius = ((max - min).length() * 0.5).max(1.0);
         let half = (self.fov_y_deg.to_radians() * 0.5).sin().max(1e-3);
         let distance = radius / half;
+        let projection = match self.projection {
+            Projection::Perspective => Projection::Perspective,
+            Projection::Orthographic { .. } => Projection::Orthographic {
+                height: 2.0 * radius,
+            },
+        };
         let camera = Camera {
             position: centre - self.forward() * distance,
+            projection,
             ..self.clone()
         };
         (camera, distance)
@@ -101,6 +164,7 @@ impl Camera {
             yaw_deg: yaw,
             pitch_deg: pitch,
             fov_y_deg,
+            projection: Projection::Perspective,
         }
     }
     /// Checks every field.
@@ -128,7 +192,16 @@ impl Camera {
             "camera fov",
             self.fov_y_deg,
             "(0, 180) degrees",
-        )
+        )?;
+        match self.projection {
+            Projection::Perspective => Ok(()),
+            Projection::Orthographic { height } => check(
+                height.is_finite() && height > 0.0 && height < 1e9,
+                "camera orthographic height",
+                height,
+                "(0, 1e9) voxels",
+            ),
+        }
     }
 }
 

@@ -152,27 +152,29 @@ fn radiance_inside_glass_is_eta_squared_times_outside() {
     // outside furnace cannot (it cancels on the way in and out). Near-normal directions
     // only: in a cube, directions with every |dᵢ| below cos θc are trapped by total internal
     // reflection forever, and a wide view would include them.
-    let w = world((4, 4, 4));
-    let glass = add_material(&w, MaterialKind::Dielectric, 0, [255, 255, 255]); // IOR 1.5
-    w.apply(EditOp::Shape {
-        shape: Shape::Box {
-            min: IVec3::splat(2),
-            max: IVec3::splat(29),
-        },
-        mode: Mode::Add(glass),
-    })
-    .unwrap();
-    let cam = looking_at(
-        DVec3::new(15.3, 14.7, 16.1),
-        DVec3::new(30.0, 14.7, 16.1),
-        2.0,
-    );
-    let p = params(cam, Sky::Uniform { colour: SKY }, None, 64);
-    let img = render(&w, &p, 20, 64, 21);
-    let (mean, se) = mean_and_error(&img);
-    let expected = 1.5 * 1.5 * SKY[0] as f64;
-    assert!(
-        (mean - expected).abs() < 4.0 * se + 2e-3 * expected,
-        "{mean} ± {se}, expected {expected}"
-    );
+    for (what, orthographic) in [("perspective", false), ("orthographic", true)] {
+        let (w, p, expected) = common::inside_glass(orthographic);
+        let img = render(&w, &p, 20, 64, 21);
+        let (mean, se) = mean_and_error(&img);
+        assert!(
+            (mean - expected).abs() < 4.0 * se + 2e-3 * expected,
+            "{what}: {mean} ± {se}, expected {expected}"
+        );
+    }
+}
+
+#[test]
+fn an_orthographic_camera_sees_parallel_projections_from_its_plane() {
+    let (w, mut p, lit) = common::orthographic_walls();
+    common::assert_orthographic_walls(&render(&w, &p, 32, 4, 3), &lit, "orthographic");
+    // The check can fail: the same view in perspective shows the rectangles elsewhere.
+    p.camera.projection = render::Projection::Perspective;
+    let img = render(&w, &p, 32, 4, 3);
+    let wrong = img
+        .pixels
+        .iter()
+        .zip(&lit)
+        .filter(|(px, l)| (px[0] > 0.0) != **l)
+        .count();
+    assert!(wrong > 50, "{wrong} pixels differ");
 }

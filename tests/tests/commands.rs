@@ -140,6 +140,7 @@ fn every_command() -> Vec<Command> {
             yaw_deg: 30.0,
             pitch_deg: -40.0,
             fov_y_deg: 70.0,
+            projection: render::Projection::Orthographic { height: 40.0 },
         }),
         Command::SetSettings(RenderSettings {
             samples_per_pixel: 4,
@@ -256,6 +257,7 @@ fn failed_commands_change_nothing() {
             yaw_deg: 0.0,
             pitch_deg: 0.0,
             fov_y_deg: 0.0,
+            projection: render::Projection::Perspective,
         }),
         Command::GenerateTerrain(TerrainSpec {
             seed: 1,

@@ -16,6 +16,7 @@ pub(crate) struct RenderArgs {
     pub(crate) width: u32,
     pub(crate) height: u32,
     pub(crate) camera: Option<String>,
+    pub(crate) orthographic: Option<f64>,
     pub(crate) device: String,
     pub(crate) seed: u64,
     pub(crate) scale: f64,
@@ -41,9 +42,18 @@ pub(crate) fn render_command(a: RenderArgs) -> Result<()> {
             .context("--camera wants EYE:TARGET, each X,Y,Z")?;
         let eye = parse_ivec3_f(eye)?;
         let target = parse_ivec3_f(target)?;
-        params.camera = render::Camera::looking_at(eye, target, params.camera.fov_y_deg);
-        params.camera.validate()?;
+        params.camera = render::Camera {
+            projection: params.camera.projection,
+            ..render::Camera::looking_at(eye, target, params.camera.fov_y_deg)
+        };
     }
+    if let Some(height) = a.orthographic {
+        params.camera.projection = render::Projection::Orthographic { height };
+    }
+    params
+        .camera
+        .validate()
+        .context("--camera / --orthographic")?;
     if let Some(b) = a.bounces {
         if !(1..=64).contains(&b) {
             bail!("--bounces {b} is outside 1..=64");

@@ -5,7 +5,7 @@
 //! (
 //!     format_version: 1,
 //!     grid_bricks: (64, 32, 64),
-//!     camera: (position: (..), yaw_deg: .., pitch_deg: .., fov_y_deg: ..),
+//!     camera: (position: (..), yaw_deg: .., pitch_deg: .., fov_y_deg: .., [projection: Orthographic(height: ..)]),
 //!     sun: (enabled: true, position: (..), radius: .., colour: (..), intensity: .., ..),
 //!     sky: Gradient(horizon: (..), zenith: (..)),
 //!     settings: (samples_per_pixel: 1, max_bounces: 3, internal_resolution: (1024, 576), exposure: 0.0),

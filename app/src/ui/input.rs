@@ -38,6 +38,8 @@ pub enum Action {
     Export,
     /// Frame the scene's content.
     Frame,
+    /// Switch between perspective and orthographic.
+    ToggleProjection,
     /// Store the view in camera slot n (1..=9).
     StoreView(u8),
     /// Recall camera slot n.
@@ -81,6 +83,7 @@ pub fn action_for_key(key: KeyCode, m: Mods) -> Option<Action> {
         (KeyE, true, false) => Action::Export,
         (KeyQ, true, false) => Action::Quit,
         (KeyF, false, false) => Action::Frame,
+        (KeyO, false, false) | (Numpad5, false, false) => Action::ToggleProjection,
         (F1, false, false) => Action::Help,
         _ => return None,
     })
@@ -125,6 +128,7 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Wheel", "zoom to the cursor"),
     ("W A S D, Q / E", "fly (Shift: faster)"),
     ("F", "frame the scene"),
+    ("O, Numpad 5", "perspective / orthographic"),
     ("Ctrl + 1..9 / 1..9", "store / recall a camera slot"),
     ("Ctrl + Z", "undo"),
     ("Ctrl + Shift + Z, Ctrl + Y", "redo"),

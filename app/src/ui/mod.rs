@@ -387,6 +387,11 @@ impl Editor {
                 self.view.frame(min, max);
                 self.moved();
             }
+            Action::ToggleProjection => {
+                let size = self.read().scene.world.dims().voxels().as_dvec3();
+                self.view.toggle_projection(DVec3::ZERO, size);
+                self.moved();
+            }
             Action::StoreView(n) => self.slots[n as usize - 1] = Some(self.view.clone()),
             Action::RecallView(n) => {
                 if let Some(v) = self.slots[n as usize - 1].clone() {
@@ -565,11 +570,8 @@ impl Editor {
     fn zoom(&mut self, steps: f64) {
         let aspect = self.aspect();
         let (u, v) = self.cursor_ndc();
-        let dir = self.view.ray(u, v, aspect);
-        let ray = brickmap::Ray {
-            origin: self.view.camera.position,
-            dir,
-        };
+        let (origin, dir) = self.view.ray(u, v, aspect);
+        let ray = brickmap::Ray { origin, dir };
         // The surface under the cursor (exact CPU cast), else the pivot plane.
         let hit = self
             .read()
@@ -698,7 +700,7 @@ impl Editor {
         let internal = self.internal_size((size.width, size.height));
         let paths = internal.0 as f64 * internal.1 as f64 * self.last_added as f64;
         self.panels.status = format!(
-            "{samples}/{} spp · GPU {gpu_ms:.2} ms/frame · {:.1} Mpaths/s · internal {}x{} · {}{}",
+            "{samples}/{} spp · GPU {gpu_ms:.2} ms/frame · {:.1} Mpaths/s · internal {}x{}{} · {}{}",
             self.settings.target_spp,
             if gpu_ms > 0.0 {
                 paths / gpu_ms / 1e3
@@ -707,6 +709,11 @@ impl Editor {
             },
             internal.0,
             internal.1,
+            if self.view.camera.is_orthographic() {
+                " · orthographic"
+            } else {
+                ""
+            },
             gfx.viewport.ctx().name,
             self.latency.map_or_else(String::new, |l| format!(
                 " · input to photon {:.1} ms",

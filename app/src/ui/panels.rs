@@ -185,6 +185,9 @@ pub fn draw(
                 if ui.button("Frame the scene  F").clicked() {
                     out.push(UiEvent::Action(Action::Frame));
                 }
+                if ui.button("Perspective / orthographic  O").clicked() {
+                    out.push(UiEvent::Action(Action::ToggleProjection));
+                }
                 if ui.button("Use this view as the scene camera").clicked() {
                     out.push(UiEvent::UseViewAsSceneCamera);
                 }

@@ -220,13 +220,9 @@ impl<'a, 'w> CpuScene<'a, 'w> {
     /// The camera ray through image position (x, y) in pixels (fractional: the box filter
     /// comes from jittering within the pixel).
     pub fn camera_ray(&self, x: f64, y: f64, width: u32, height: u32) -> (DVec3, DVec3) {
-        let (forward, right, up) = self.camera.basis(width as f64 / height as f64);
         let u = 2.0 * x / width as f64 - 1.0;
         let v = 1.0 - 2.0 * y / height as f64;
-        (
-            self.camera.position,
-            (forward + right * u + up * v).normalize(),
-        )
+        self.camera.ray(u, v, width as f64 / height as f64)
     }
 
     /// One sample of the radiance arriving at `origin` from direction `−dir` (unit `dir`).

@@ -96,7 +96,9 @@ impl TraceParams {
         let dims = view.dims();
         let centre = dims.voxels().as_dvec3() * 0.5;
         let mut p = TraceParams {
-            cam_pos: v4(c.position, 0.0),
+            // w: 1 for an orthographic camera (rays from the image plane; trace.comp then
+            // finds each ray's medium itself).
+            cam_pos: v4(c.position, if c.is_orthographic() { 1.0 } else { 0.0 }),
             cam_forward: v4(forward, 0.0),
             cam_right: v4(right, 0.0),
             cam_up: v4(up, 0.0),
@@ -123,9 +125,8 @@ impl TraceParams {
                 p.sky_zenith = [zenith[0], zenith[1], zenith[2], 1.0];
             }
         }
-        let medium = view
-            .voxel(c.position.floor().as_ivec3())
-            .ok()
+        let medium = (!c.is_orthographic())
+            .then(|| view.voxel(c.position.floor().as_ivec3()).ok().flatten())
             .flatten()
             .filter(|&m| {
                 view.materials()

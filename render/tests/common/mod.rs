@@ -117,6 +117,7 @@ pub fn sun_floor() -> (World, SceneParams, f64) {
         yaw_deg: 0.0,
         pitch_deg: -89.0,
         fov_y_deg: 0.5,
+        projection: render::Projection::Perspective,
     };
     let albedo = render::cpu::srgb_to_linear(200);
     let expected = albedo * l * r * r / (r * r + d * d);
@@ -454,4 +455,98 @@ pub fn gpu_context(device: render::vulkan::DeviceChoice) -> Option<render::vulka
         }
         Err(e) => panic!("creating a Vulkan context: {e}"),
     }
+}
+
+/// Two emissive rectangles at different depths seen by an orthographic camera looking along
+/// −z with one pixel per voxel, and a wall behind the image plane that must not be seen:
+/// each pixel is exactly the lamp's radiance where its voxel column meets a rectangle, else
+/// black (1 bounce, black sky: zero variance). A perspective camera would show the farther
+/// rectangle smaller. Returns the world, the parameters (32 × 32 pixels) and which pixels
+/// are lit, row by row from the top.
+pub fn orthographic_walls() -> (World, SceneParams, Vec<bool>) {
+    let w = world((4, 4, 4));
+    let lamp = add_material(&w, MaterialKind::Emissive, 0, [255, 255, 255]);
+    let rects = [
+        (IVec3::new(4, 4, 10), IVec3::new(11, 11, 10)),
+        (IVec3::new(20, 16, 20), IVec3::new(27, 23, 20)),
+    ];
+    for (min, max) in rects
+        .into_iter()
+        .chain([(IVec3::new(0, 0, 28), IVec3::new(31, 31, 28))])
+    {
+        w.apply(EditOp::Shape {
+            shape: Shape::Box { min, max },
+            mode: Mode::Add(lamp),
+        })
+        .unwrap();
+    }
+    let cam = Camera {
+        position: DVec3::new(16.0, 16.0, 25.5),
+        yaw_deg: 0.0,
+        pitch_deg: 0.0,
+        fov_y_deg: 50.0,
+        projection: render::Projection::Orthographic { height: 32.0 },
+    };
+    let lit = (0..32 * 32)
+        .map(|i| {
+            let (x, y) = (i % 32, 31 - i / 32);
+            rects
+                .iter()
+                .any(|(min, max)| (min.x..=max.x).contains(&x) && (min.y..=max.y).contains(&y))
+        })
+        .collect();
+    (
+        w,
+        params(cam, Sky::Uniform { colour: [0.0; 3] }, None, 1),
+        lit,
+    )
+}
+
+/// Asserts an image of [`orthographic_walls`]: lit pixels all equal and positive, the rest
+/// black.
+pub fn assert_orthographic_walls(img: &Image, lit: &[bool], what: &str) {
+    assert_eq!(img.pixels.len(), lit.len());
+    let want = img.pixels[lit.iter().position(|l| *l).unwrap()];
+    assert!(want[0] > 0.0, "{what}: {want:?}");
+    for (i, (px, l)) in img.pixels.iter().zip(lit).enumerate() {
+        for c in 0..3 {
+            let expect = if *l { want[c] } else { 0.0 };
+            assert!(
+                (px[c] - expect).abs() <= 1e-5 * want[c],
+                "{what}: pixel ({}, {}) is {px:?}, expected {}",
+                i % 32,
+                i / 32,
+                if *l { "lit" } else { "black" }
+            );
+        }
+    }
+}
+
+/// A camera inside a clear glass cube (IOR 1.5) looking out through a face at the uniform
+/// [`SKY`], along near-normal directions only (in a cube, directions with every |dᵢ| below
+/// cos θc are trapped by total internal reflection forever): the radiance seen is η²·L
+/// (L/η² is invariant across the interface), which checks the (η_i/η_t)² factor and the
+/// camera's medium. Orthographic: the image plane (4 voxels tall) lies inside the glass, so
+/// every ray must start in it. Returns the expected value of channel 0.
+pub fn inside_glass(orthographic: bool) -> (World, SceneParams, f64) {
+    let w = world((4, 4, 4));
+    let glass = add_material(&w, MaterialKind::Dielectric, 0, [255, 255, 255]);
+    w.apply(EditOp::Shape {
+        shape: Shape::Box {
+            min: IVec3::splat(2),
+            max: IVec3::splat(29),
+        },
+        mode: Mode::Add(glass),
+    })
+    .unwrap();
+    let mut cam = Camera::looking_at(
+        DVec3::new(15.3, 14.7, 16.1),
+        DVec3::new(30.0, 14.7, 16.1),
+        2.0,
+    );
+    if orthographic {
+        cam.projection = render::Projection::Orthographic { height: 4.0 };
+    }
+    let p = params(cam, Sky::Uniform { colour: SKY }, None, 64);
+    (w, p, 1.5 * 1.5 * SKY[0] as f64)
 }
