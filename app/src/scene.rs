@@ -160,13 +160,13 @@ pub fn thesis_terrain(materials: terrain::TerrainMaterials, height: u32) -> terr
 
 /// Adds the terrain palette to a world: grass, dirt, rock with colour variants, sand, snow,
 /// and water (a blue-tinted dielectric, IOR 1.333).
-pub fn terrain_materials(world: &World) -> Result<terrain::TerrainMaterials> {
+pub fn terrain_materials(world: &World) -> brickmap::Result<terrain::TerrainMaterials> {
     // Colours are taken from the top of the table down; a fresh table's placeholder
     // material 0 is replaced by the first terrain material.
     let fresh = world.read().solid_count() == 0 && world.materials().len() == 1;
     let mut next_colour = 255u8;
     let mut first = fresh;
-    let mut add = |rgb: [u8; 3], kind: MaterialKind, param: u8| -> Result<u8> {
+    let mut add = |rgb: [u8; 3], kind: MaterialKind, param: u8| -> brickmap::Result<u8> {
         let colour = next_colour;
         next_colour -= 1;
         world.set_colour(colour, rgb);
@@ -179,7 +179,7 @@ pub fn terrain_materials(world: &World) -> Result<terrain::TerrainMaterials> {
             world.set_material(0, m)?;
             return Ok(0);
         }
-        Ok(world.push_material(m)?)
+        world.push_material(m)
     };
     let l = MaterialKind::Lambertian;
     let grass = vec![

@@ -3,7 +3,8 @@
 //! branch; consecutive edits of one property coalesce into one step; when the steps' bytes
 //! exceed the budget the oldest are dropped, and the history counts them.
 
-use super::command::{Command, Inverse};
+use super::command::Command;
+use super::inverse::Inverse;
 use std::collections::VecDeque;
 
 /// Default memory budget: 512 MiB.

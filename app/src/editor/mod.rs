@@ -1,12 +1,17 @@
 //! The editor's engine, without a window: a document (scene, file, dirty flag, history) and
 //! the commands that change it. The interactive editor and script replay drive it alike.
 
+mod brush;
 pub mod command;
+mod error;
+mod fill;
 pub mod history;
+mod inverse;
 pub mod script;
 
+pub use error::{EditError, Result};
+
 use crate::scene::Scene;
-use anyhow::{Result, bail};
 use command::Command;
 use history::History;
 use std::path::{Path, PathBuf};
@@ -29,6 +34,9 @@ pub struct Document {
     pub path: Option<PathBuf>,
     /// Changed since it was loaded or saved.
     pub dirty: bool,
+    /// Counts changes (commands, undos, redos): a save made off the UI thread records the
+    /// revision it wrote, so a change made meanwhile keeps the document dirty.
+    pub revision: u64,
     /// Undo and redo.
     pub history: History,
     /// Folder that relative paths in commands (imports) are resolved against.
@@ -44,6 +52,7 @@ impl Document {
             scene,
             path: None,
             dirty: false,
+            revision: 0,
             history,
             folder: PathBuf::from("."),
             recorder: None,
@@ -54,6 +63,7 @@ impl Document {
     pub fn execute(&mut self, command: Command) -> Result<Executed> {
         let applied = command.apply(&mut self.scene, &self.folder)?;
         self.dirty = true;
+        self.revision += 1;
         if let Some(r) = &mut self.recorder {
             r.record(script::Step::Do(command.clone()));
         }
@@ -67,12 +77,13 @@ impl Document {
     /// Undoes the latest step; the label of what was undone.
     pub fn undo(&mut self) -> Result<String> {
         let Some(step) = self.history.take_undo() else {
-            bail!("nothing to undo")
+            return Err(EditError::NothingToUndo);
         };
         let (label, command, inverse) = step.into_parts();
         let redo = inverse.apply(&mut self.scene)?;
         self.history.push_redo(label.clone(), command, redo);
         self.dirty = true;
+        self.revision += 1;
         if let Some(r) = &mut self.recorder {
             r.record(script::Step::Undo);
         }
@@ -82,12 +93,13 @@ impl Document {
     /// Redoes the latest undone step; its label.
     pub fn redo(&mut self) -> Result<String> {
         let Some(step) = self.history.take_redo() else {
-            bail!("nothing to redo")
+            return Err(EditError::NothingToRedo);
         };
         let (label, command, inverse) = step.into_parts();
         let undo = inverse.apply(&mut self.scene)?;
         self.history.push_undone(label.clone(), command, undo);
         self.dirty = true;
+        self.revision += 1;
         if let Some(r) = &mut self.recorder {
             r.record(script::Step::Redo);
         }
@@ -95,21 +107,22 @@ impl Document {
     }
 
     /// Saves (project or .vox by extension) atomically; a project save clears the dirty flag.
-    pub fn save(&mut self, path: &Path) -> Result<()> {
+    pub fn save(&mut self, path: &Path) -> Result<(), crate::formats::FormatError> {
         self.scene.save(path)?;
-        self.mark_saved(path);
+        self.mark_saved(path, self.revision);
         Ok(())
     }
 
-    /// The bookkeeping of a save that succeeded (the editor writes off the UI thread, then
-    /// calls this): recorded, and a project save becomes the document's file, clean.
-    pub fn mark_saved(&mut self, path: &Path) {
+    /// The bookkeeping of a save of `revision` that succeeded (the editor writes off the UI
+    /// thread, then calls this): recorded, and a project save becomes the document's file,
+    /// clean unless it changed since that revision.
+    pub fn mark_saved(&mut self, path: &Path, revision: u64) {
         if let Some(r) = &mut self.recorder {
             r.record(script::Step::Save(path.display().to_string()));
         }
         if crate::formats::Format::of(path).ok() == Some(crate::formats::Format::Project) {
             self.path = Some(path.to_path_buf());
-            self.dirty = false;
+            self.dirty = self.revision != revision;
         }
     }
 }

@@ -6,7 +6,6 @@
 
 use crate::Scene;
 use crate::editor::Document;
-use crate::editor::command::Command;
 use anyhow::{Context, Result};
 use crossbeam_channel::{Receiver, Sender};
 use std::path::{Path, PathBuf};
@@ -130,14 +129,14 @@ pub enum Done {
     Picked(Purpose, Result<Option<PathBuf>, String>),
     /// A scene was loaded (or failed to) from a path, or built (the default scene: None).
     Loaded(Option<PathBuf>, Box<Result<Scene>>),
-    /// A command run on the worker finished (its label, the outcome).
-    Executed(String, Result<()>),
     /// A save finished; `autosave` saves go to the recovery file and don't clean the document.
     Saved {
         /// Where.
         path: PathBuf,
         /// Recovery autosave (the document stays dirty).
         autosave: bool,
+        /// The document's revision that was written.
+        revision: u64,
         /// The outcome.
         result: Result<()>,
     },
@@ -151,10 +150,6 @@ pub struct FileWorker {
     /// Jobs running (for the progress indicator).
     pub running: Vec<String>,
     wake: Arc<dyn Fn() + Send + Sync>,
-    /// Held by the UI thread for a whole frame (taken with `try_lock`: a frame is skipped,
-    /// never waited for, while a command runs) and by a command on the worker for as long
-    /// as it writes the document — so the UI never meets a held write lock mid-frame.
-    pub gate: Arc<std::sync::Mutex<()>>,
 }
 
 impl FileWorker {
@@ -166,32 +161,7 @@ impl FileWorker {
             done,
             running: Vec::new(),
             wake,
-            gate: Arc::new(std::sync::Mutex::new(())),
         }
-    }
-
-    /// Executes a slow command (an import) on a worker thread: it waits for the UI to be
-    /// between frames (the gate), then for the document (other readers, e.g. a save, finish
-    /// first; `try_write` in a loop, so it never queues as a writer the UI's reads would
-    /// wait behind), and reports through [`Done::Executed`]. On error nothing changed.
-    pub fn execute(&mut self, doc: &SharedDocument, command: Command) {
-        let (doc, gate) = (doc.clone(), self.gate.clone());
-        let label = command.label();
-        self.spawn(label.clone(), move || {
-            let _between_frames = gate.lock().unwrap_or_else(|p| p.into_inner());
-            let result = loop {
-                match doc.try_write() {
-                    Ok(mut d) => break d.execute(command),
-                    Err(std::sync::TryLockError::Poisoned(p)) => {
-                        break p.into_inner().execute(command);
-                    }
-                    Err(std::sync::TryLockError::WouldBlock) => {
-                        std::thread::sleep(std::time::Duration::from_millis(2))
-                    }
-                }
-            };
-            Done::Executed(label, result.map(|_| ()))
-        });
     }
 
     fn spawn(&mut self, what: String, job: impl FnOnce() -> Done + Send + 'static) {
@@ -269,13 +239,14 @@ impl FileWorker {
             format!("saving {}", path.display())
         };
         self.spawn(what, move || {
-            let result = match doc.read() {
-                Ok(d) => save_scene(&d.scene, &path, autosave),
-                Err(_) => Err(anyhow::anyhow!("the document is unavailable")),
+            let (result, revision) = match doc.read() {
+                Ok(d) => (save_scene(&d.scene, &path, autosave), d.revision),
+                Err(_) => (Err(anyhow::anyhow!("the document is unavailable")), 0),
             };
             Done::Saved {
                 path,
                 autosave,
+                revision,
                 result,
             }
         });
@@ -412,66 +383,6 @@ mod tests {
     }
 
     #[test]
-    fn a_command_on_the_worker_waits_for_the_frame_and_a_failure_changes_nothing() {
-        let d = doc();
-        let mut w = FileWorker::new(Arc::new(|| {}));
-        let hash = |d: &SharedDocument| d.read().unwrap().scene.world.read().content_hash();
-        let before = hash(&d);
-        // A frame in progress holds the gate: the command does not start.
-        let frame = w.gate.clone();
-        let guard = frame.lock().unwrap();
-        w.execute(
-            &d,
-            Command::ImportVox {
-                path: "/no/such/file.vox".into(),
-                offset: glam::IVec3::ZERO,
-            },
-        );
-        assert!(
-            w.done
-                .recv_timeout(std::time::Duration::from_millis(300))
-                .is_err()
-        );
-        drop(guard);
-        let Done::Executed(label, result) = wait(&mut w) else {
-            panic!()
-        };
-        assert!(label.contains("Import"), "{label}");
-        assert!(result.is_err());
-        assert_eq!(hash(&d), before);
-        assert_eq!(d.read().unwrap().history.undo_len(), 0);
-        assert!(!d.read().unwrap().dirty);
-        // A command that works changes the document and is one undo step.
-        let dir = temp("import");
-        let vox = dir.join("one.vox");
-        let mut scene = Scene::empty(GridDims::new(1, 1, 1).unwrap(), 1).unwrap();
-        Command::Stroke(crate::editor::command::Stroke {
-            mode: crate::editor::command::BrushMode::Attach,
-            shape: crate::editor::command::BrushShape::Voxel,
-            size: 1.0,
-            material: 0,
-            mirror: Default::default(),
-            points: vec![glam::DVec3::new(1.0, 1.0, 1.0)],
-        })
-        .apply(&mut scene, &dir)
-        .unwrap();
-        scene.save(&vox).unwrap();
-        w.execute(
-            &d,
-            Command::ImportVox {
-                path: vox.display().to_string(),
-                offset: glam::IVec3::new(3, 3, 3),
-            },
-        );
-        let Done::Executed(_, result) = wait(&mut w) else {
-            panic!()
-        };
-        result.unwrap();
-        assert_ne!(hash(&d), before);
-        assert_eq!(d.read().unwrap().history.undo_len(), 1);
-    }
-
-    #[test]
     fn a_save_without_a_dialog_never_overwrites() {
         let dir = temp("fallback");
         let first = fallback_path(&dir, "untitled", "ron");
@@ -534,11 +445,22 @@ mod tests {
         // A real save, once finished, makes the file the document's and cleans it.
         let target = dir.0.join("scene.ron");
         w.save(&d, target.clone(), false);
-        let Done::Saved { result, path, .. } = wait(&mut w) else {
+        let Done::Saved {
+            result,
+            path,
+            revision,
+            ..
+        } = wait(&mut w)
+        else {
             panic!()
         };
         result.unwrap();
-        d.write().unwrap().mark_saved(&path);
+        // A change made after the save read the document keeps it dirty.
+        d.write().unwrap().execute(Command::Clear).unwrap();
+        d.write().unwrap().mark_saved(&path, revision);
+        assert!(d.read().unwrap().dirty);
+        let now = d.read().unwrap().revision;
+        d.write().unwrap().mark_saved(&path, now);
         assert!(!d.read().unwrap().dirty);
         assert_eq!(d.read().unwrap().path.as_deref(), Some(target.as_path()));
     }

@@ -7,6 +7,7 @@
 pub mod camera;
 pub mod files;
 pub mod input;
+pub mod jobs;
 pub mod panels;
 
 use crate::Scene;
@@ -19,6 +20,7 @@ use camera::ViewCamera;
 use files::{ConfigDir, Done, FileWorker, Purpose, SharedDocument};
 use glam::DVec3;
 use input::{Action, Drag, Mods};
+use jobs::{Edit, EditQueue, Edited};
 use panels::{PanelState, UiEvent, UnsavedAnswer, ViewSettings};
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use render::present::{EguiFrame, Presented, Presenter};
@@ -85,8 +87,11 @@ struct Gfx {
 
 /// A script run through the live editor.
 struct LiveScript {
-    script: Script,
-    run: ScriptRun,
+    script: Arc<Script>,
+    /// None while its next step runs on the edit thread.
+    run: Option<Box<ScriptRun>>,
+    /// Every step ran.
+    finished: bool,
     capture: Option<PathBuf>,
     captured_at: Option<Instant>,
 }
@@ -113,6 +118,14 @@ pub struct Editor {
     generation: u64,
     gpu_generation: u64,
     files: FileWorker,
+    edits: EditQueue,
+    /// Input that arrived while an edit held the frame gate, handled (in order) once it is
+    /// free: a keystroke during a long undo is late, never lost.
+    backlog: Vec<WindowEvent>,
+    /// Saves asked for while edits were queued: they start once those are applied.
+    saves_waiting: Vec<(PathBuf, bool)>,
+    /// Finished saves (file, revision written) whose bookkeeping is not yet on the document.
+    saved: Vec<(PathBuf, u64)>,
     view: ViewCamera,
     slots: [Option<ViewCamera>; 9],
     settings: ViewSettings,
@@ -148,9 +161,11 @@ pub struct Editor {
 impl Editor {
     fn new(options: EditorOptions, proxy: EventLoopProxy<Wake>) -> Result<Self> {
         let wake_proxy = proxy.clone();
-        let files = FileWorker::new(Arc::new(move || {
+        let wake: Arc<dyn Fn() + Send + Sync> = Arc::new(move || {
             let _ = wake_proxy.send_event(Wake);
-        }));
+        });
+        let files = FileWorker::new(wake.clone());
+        let edits = EditQueue::new(wake);
         let config = ConfigDir::from_env();
         // Until the first real scene arrives the editor shows an empty one-brick grid.
         let placeholder = Scene::empty(brickmap::GridDims::new(1, 1, 1)?, 1)?;
@@ -178,8 +193,9 @@ impl Editor {
             )?;
             doc = document;
             script_run = Some(LiveScript {
-                script,
-                run,
+                script: Arc::new(script),
+                run: Some(Box::new(run)),
+                finished: false,
                 capture: options.capture.clone(),
                 captured_at: None,
             });
@@ -205,6 +221,10 @@ impl Editor {
             generation: 0,
             gpu_generation: 0,
             files,
+            edits,
+            backlog: Vec::new(),
+            saves_waiting: Vec::new(),
+            saved: Vec::new(),
             view,
             slots: Default::default(),
             mods: Mods::default(),
@@ -255,30 +275,71 @@ impl Editor {
         self.doc.read().unwrap_or_else(|p| p.into_inner())
     }
 
-    /// The document for an edit, unless a save is reading it (then the edit is refused with
-    /// a message, never waited for).
-    fn write(&mut self) -> Option<std::sync::RwLockWriteGuard<'_, Document>> {
-        match self.doc.try_write() {
-            Ok(d) => Some(d),
-            Err(std::sync::TryLockError::Poisoned(p)) => Some(p.into_inner()),
-            Err(std::sync::TryLockError::WouldBlock) => {
-                self.panels
-                    .errors
-                    .push("a save is in progress; try again in a moment".into());
-                None
-            }
+    /// Saves on the file worker once the edits asked for before are applied (Ctrl+Z then
+    /// Ctrl+S saves the undone scene).
+    fn save_to(&mut self, path: PathBuf, autosave: bool) {
+        if self.edits.busy() {
+            self.saves_waiting.push((path, autosave));
+        } else {
+            self.files.save(&self.doc, path, autosave);
         }
     }
 
-    fn execute(&mut self, command: Command) {
-        let result = match self.write() {
-            Some(mut d) => d.execute(command).map(|_| ()),
-            None => return,
+    /// Applies finished saves' bookkeeping (file, clean flag) to the document, unless
+    /// another save is reading it right now (then next frame: the UI never waits).
+    fn mark_saved(&mut self) {
+        if self.saved.is_empty() {
+            return;
+        }
+        let mut d = match self.doc.try_write() {
+            Ok(d) => d,
+            Err(std::sync::TryLockError::Poisoned(p)) => p.into_inner(),
+            Err(std::sync::TryLockError::WouldBlock) => return,
         };
-        if let Err(e) = result {
-            self.panels.errors.push(format!("{e:#}"));
+        for (path, revision) in self.saved.drain(..) {
+            d.mark_saved(&path, revision);
+        }
+    }
+
+    /// Queues a command on the edit thread (the UI never waits for the world's workers).
+    fn execute(&mut self, command: Command) {
+        self.edits.submit(&self.doc, Edit::Command(command));
+    }
+
+    /// What an edit on the edit thread did.
+    fn edited(&mut self, edited: Edited) -> Result<()> {
+        self.edits.finished();
+        match edited {
+            Edited::Command(label, result) => {
+                if let Err(e) = result {
+                    self.panels.errors.push(format!("{label}: {e}"));
+                }
+            }
+            Edited::Undo(result) | Edited::Redo(result) => {
+                if let Err(e) = result {
+                    self.panels.errors.push(e.to_string());
+                }
+            }
+            Edited::ScriptStep {
+                run,
+                result,
+                camera_changed,
+            } => {
+                if camera_changed {
+                    let view = scene_view(&self.read().scene);
+                    self.view = view;
+                }
+                if let Some(s) = &mut self.script {
+                    s.run = Some(run);
+                    match result? {
+                        Some(line) => println!("{line}"),
+                        None => s.finished = true,
+                    }
+                }
+            }
         }
         self.refresh_stats();
+        Ok(())
     }
 
     fn refresh_stats(&mut self) {
@@ -343,7 +404,7 @@ impl Editor {
     fn save(&mut self, as_new: bool) {
         let path = self.read().path.clone();
         match path.filter(|_| !as_new) {
-            Some(p) => self.files.save(&self.doc, p, false),
+            Some(p) => self.save_to(p, false),
             None => self
                 .files
                 .pick(Purpose::SaveAs, self.folder(), Some("scene.ron".into())),
@@ -362,17 +423,8 @@ impl Editor {
 
     fn action(&mut self, action: Action) {
         match action {
-            Action::Undo | Action::Redo => {
-                let result = match self.write() {
-                    Some(mut d) if action == Action::Undo => d.undo(),
-                    Some(mut d) => d.redo(),
-                    None => return,
-                };
-                if let Err(e) = result {
-                    self.panels.errors.push(format!("{e:#}"));
-                }
-                self.refresh_stats();
-            }
+            Action::Undo => self.edits.submit(&self.doc, Edit::Undo),
+            Action::Redo => self.edits.submit(&self.doc, Edit::Redo),
             Action::New => self.panels.new_open = true,
             Action::Open => self.guard_unsaved(Pending::Open(None)),
             Action::Save => self.save(false),
@@ -412,13 +464,10 @@ impl Editor {
             UiEvent::SetSky(s) => self.execute(Command::SetSky(s)),
             UiEvent::SetSettings(s) => self.execute(Command::SetSettings(s)),
             // Reading and merging a file can take a while: on the worker.
-            UiEvent::Import { path, offset } => self.files.execute(
-                &self.doc,
-                Command::ImportVox {
-                    path: path.display().to_string(),
-                    offset: glam::IVec3::from_array(offset),
-                },
-            ),
+            UiEvent::Import { path, offset } => self.execute(Command::ImportVox {
+                path: path.display().to_string(),
+                offset: glam::IVec3::from_array(offset),
+            }),
             UiEvent::UseViewAsSceneCamera => {
                 self.execute(Command::SetCamera(self.view.camera.clone()))
             }
@@ -464,7 +513,7 @@ impl Editor {
                     } else {
                         path
                     };
-                    self.files.save(&self.doc, path, false)
+                    self.save_to(path, false)
                 }
                 // Asks for the offset first (the import dialog), then `ImportVox`.
                 Purpose::Import => self.panels.import = Some((path, [0, 0, 0])),
@@ -478,7 +527,7 @@ impl Editor {
                 self.panels
                     .errors
                     .push(format!("{e}; saving to {} instead", path.display()));
-                self.files.save(&self.doc, path, false);
+                self.save_to(path, false);
             }
             Done::Picked(_, Err(e)) => {
                 self.save_then = None;
@@ -510,22 +559,16 @@ impl Editor {
                     self.panels.errors.push(format!("{e:#}"));
                 }
             },
-            Done::Executed(label, result) => {
-                if let Err(e) = result {
-                    self.panels.errors.push(format!("{label}: {e:#}"));
-                }
-                self.refresh_stats();
-            }
             Done::Saved {
                 path,
                 autosave,
+                revision,
                 result,
             } => match result {
                 Ok(()) if autosave => {}
                 Ok(()) => {
-                    if let Ok(mut d) = self.doc.write() {
-                        d.mark_saved(&path);
-                    }
+                    self.saved.push((path.clone(), revision));
+                    self.mark_saved();
                     let _ = self.config.add_recent(&path);
                     self.panels.recent = self.config.recent();
                     if let Some(then) = self.save_then.take() {
@@ -658,15 +701,27 @@ impl Editor {
     /// One frame: script step, file results, egui, trace, present. Skipped (not waited
     /// for) while a command runs on the worker; its completion wakes the loop.
     fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
-        let gate = self.files.gate.clone();
+        let gate = self.edits.gate.clone();
         let Ok(_frame) = gate.try_lock() else {
             return Ok(());
         };
         while let Ok(done) = self.files.done.try_recv() {
             self.file_done(done);
         }
+        while let Ok(edited) = self.edits.done.try_recv() {
+            self.edited(edited)?;
+        }
+        if !self.edits.busy() {
+            for (path, autosave) in std::mem::take(&mut self.saves_waiting) {
+                self.files.save(&self.doc, path, autosave);
+            }
+        }
+        self.mark_saved();
+        for event in std::mem::take(&mut self.backlog) {
+            self.handle_window_event(event_loop, event);
+        }
         self.tick_fly();
-        self.step_script()?;
+        self.step_script();
         self.autosave();
         let Some(mut gfx) = self.gfx.take() else {
             return Ok(());
@@ -688,12 +743,14 @@ impl Editor {
             gfx.viewport = next;
             self.gpu_generation = self.generation;
         }
-        let capture_now =
-            self.script.as_ref().is_some_and(|s| {
-                s.captured_at.is_none() && s.run.steps_run() == s.script.steps.len()
-            }) && gfx.viewport.samples() >= self.settings.target_spp;
+        let capture_now = self
+            .script
+            .as_ref()
+            .is_some_and(|s| s.captured_at.is_none() && s.finished)
+            && gfx.viewport.samples() >= self.settings.target_spp;
         // The status line and the panels.
         self.panels.busy = self.files.running.clone();
+        self.panels.busy.extend(self.edits.pending.iter().cloned());
         let samples = gfx.viewport.samples();
         let gpu_ms = gfx.viewport.last_gpu_seconds().map_or(0.0, |s| s * 1e3);
         let size = gfx.window.inner_size();
@@ -821,6 +878,9 @@ impl Editor {
             || !self.flying.is_empty()
             || self.script.is_some()
             || !self.files.running.is_empty()
+            || self.edits.busy()
+            || !self.saves_waiting.is_empty()
+            || !self.saved.is_empty()
             || viewport_output.values().any(|v| v.repaint_delay.is_zero());
         if busy {
             gfx.window.request_redraw();
@@ -844,24 +904,19 @@ impl Editor {
 
     /// Runs the script's next step, one per frame, so the viewport shows each edit; a camera
     /// step resets the view to the scene camera (what the capture is compared against).
-    fn step_script(&mut self) -> Result<()> {
-        let Some(mut s) = self.script.take() else {
-            return Ok(());
+    /// Queues the script's next step on the edit thread (the same path as the UI's own
+    /// edits), one at a time: the frame after a step shows it.
+    fn step_script(&mut self) {
+        let Some(s) = &mut self.script else {
+            return;
         };
-        let result = {
-            let mut doc = self.doc.write().unwrap_or_else(|p| p.into_inner());
-            let camera_before = doc.scene.params.camera.clone();
-            let r = s.run.step(&s.script, &mut doc);
-            if doc.scene.params.camera != camera_before {
-                self.view = scene_view(&doc.scene);
-            }
-            r
-        };
-        self.script = Some(s);
-        if let Some(line) = result? {
-            println!("{line}");
+        if s.finished {
+            return;
         }
-        Ok(())
+        if let Some(run) = s.run.take() {
+            self.edits
+                .submit(&self.doc, Edit::ScriptStep(s.script.clone(), run));
+        }
     }
 
     fn finish_capture(&mut self, gfx: &Gfx, c: render::present::Capture) -> Result<()> {
@@ -896,8 +951,8 @@ impl Editor {
         }
         self.last_autosave = Instant::now();
         if self.read().dirty {
-            self.files
-                .save(&self.doc, self.config.recovery_file(), true);
+            let recovery = self.config.recovery_file();
+            self.save_to(recovery, true);
         }
     }
 }
@@ -982,16 +1037,44 @@ impl ApplicationHandler<Wake> for Editor {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
-        // While a command runs on the worker, input that would read the document is
-        // dropped rather than waited for; redraws skip themselves (see `redraw`).
-        let gate = self.files.gate.clone();
+        // While an edit holds the frame gate, input (which may read the document) waits in
+        // the backlog, in order, for the next frame; redraws skip themselves (see `redraw`).
+        let gate = self.edits.gate.clone();
         let _between_frames = match &event {
             WindowEvent::RedrawRequested | WindowEvent::Resized(_) => None,
             _ => match gate.try_lock() {
                 Ok(g) => Some(g),
-                Err(_) => return,
+                Err(_) => {
+                    self.backlog.push(event);
+                    return;
+                }
             },
         };
+        if _between_frames.is_some() {
+            for earlier in std::mem::take(&mut self.backlog) {
+                self.handle_window_event(event_loop, earlier);
+            }
+        }
+        self.handle_window_event(event_loop, event);
+    }
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        event_loop.set_control_flow(ControlFlow::Wait);
+        if self.settings.autosave_secs > 0 && self.script.is_none() {
+            event_loop.set_control_flow(ControlFlow::WaitUntil(
+                self.last_autosave + Duration::from_secs(self.settings.autosave_secs),
+            ));
+        }
+    }
+
+    fn exiting(&mut self, _event_loop: &ActiveEventLoop) {
+        // Drop the GPU objects before the window goes.
+        self.gfx = None;
+    }
+}
+
+impl Editor {
+    /// One window event, the frame gate held (or not needed: redraw, resize).
+    fn handle_window_event(&mut self, event_loop: &ActiveEventLoop, event: WindowEvent) {
         let Some(gfx) = &mut self.gfx else { return };
         let response = gfx.egui_state.on_window_event(&gfx.window, &event);
         // egui-winit asks to repaint after every RedrawRequested too; honouring that would
@@ -1098,22 +1181,6 @@ impl ApplicationHandler<Wake> for Editor {
         }
     }
 
-    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        event_loop.set_control_flow(ControlFlow::Wait);
-        if self.settings.autosave_secs > 0 && self.script.is_none() {
-            event_loop.set_control_flow(ControlFlow::WaitUntil(
-                self.last_autosave + Duration::from_secs(self.settings.autosave_secs),
-            ));
-        }
-    }
-
-    fn exiting(&mut self, _event_loop: &ActiveEventLoop) {
-        // Drop the GPU objects before the window goes.
-        self.gfx = None;
-    }
-}
-
-impl Editor {
     /// A GPU error mid-session: say so and offer to save before anything else is lost.
     fn gpu_failed(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
         let message = format!("{e:#}");

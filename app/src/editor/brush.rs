@@ -1,0 +1,156 @@
+//! Brush strokes: modes, shapes, mirror symmetry, and the world edits a stroke makes.
+
+use super::error::{EditError, Result, invalid};
+use brickmap::{EditOp, Mode, Shape};
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// What a brush does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum BrushMode {
+    /// Add solid voxels with the material.
+    Attach,
+    /// Remove voxels.
+    Erase,
+    /// Repaint solid voxels, keeping the shape.
+    Paint,
+}
+
+/// The brush's shape at each stroke point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum BrushShape {
+    /// The voxel under the point.
+    Voxel,
+    /// A ball of radius `size`.
+    Sphere,
+    /// A cube of half-size `size` (edge 2·size + 1 voxels) centred on the point's voxel.
+    Cube,
+    /// An upright cylinder of radius and half-height `size`.
+    Cylinder,
+    /// Capsules of radius `size` along the stroke's points.
+    Line,
+    /// The box spanned by the stroke's first and last points.
+    Box,
+}
+
+/// Mirror symmetry about planes through `centre`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Mirror {
+    /// Mirror across x = centre.x.
+    pub x: bool,
+    /// Mirror across y = centre.y.
+    pub y: bool,
+    /// Mirror across z = centre.z.
+    pub z: bool,
+    /// The point the mirror planes go through.
+    pub centre: DVec3,
+}
+
+/// A brush stroke: one undo step however many points it has.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Stroke {
+    /// Attach, erase or paint.
+    pub mode: BrushMode,
+    /// Shape at each point.
+    pub shape: BrushShape,
+    /// Radius or half-size, > 0 (ignored for Voxel and Box).
+    pub size: f64,
+    /// Material for attach and paint.
+    pub material: u8,
+    /// Symmetry.
+    #[serde(default)]
+    pub mirror: Mirror,
+    /// Points, in voxel coordinates.
+    pub points: Vec<DVec3>,
+}
+
+/// The world edits of a stroke, mirror images included, validated before any is applied.
+pub fn stroke_edits(s: &Stroke) -> Result<Vec<EditOp>> {
+    if s.points.is_empty() {
+        return Err(invalid("a stroke needs at least one point"));
+    }
+    if !s.points.iter().all(|p| p.is_finite()) {
+        return Err(invalid("stroke points must be finite"));
+    }
+    let sized = !matches!(s.shape, BrushShape::Voxel | BrushShape::Box);
+    if sized && !(s.size.is_finite() && s.size > 0.0) {
+        return Err(invalid(format!("brush size {} must be positive", s.size)));
+    }
+    let mode = match s.mode {
+        BrushMode::Attach => Mode::Add(s.material),
+        BrushMode::Erase => Mode::Remove,
+        BrushMode::Paint => Mode::Paint(s.material),
+    };
+    // Every combination of reflections across the enabled mirror planes (up to 8 images).
+    let m = &s.mirror;
+    let axes: Vec<usize> = [(0, m.x), (1, m.y), (2, m.z)]
+        .into_iter()
+        .filter(|a| a.1)
+        .map(|a| a.0)
+        .collect();
+    let reflect = |p: DVec3, combo: usize| {
+        let mut q = p;
+        for (k, &axis) in axes.iter().enumerate() {
+            if combo >> k & 1 == 1 {
+                q[axis] = 2.0 * m.centre[axis] - q[axis];
+            }
+        }
+        q
+    };
+    let mut edits = Vec::new();
+    for combo in 0..1usize << axes.len() {
+        let pts: Vec<DVec3> = s.points.iter().map(|p| reflect(*p, combo)).collect();
+        let shapes: Vec<Shape> = match s.shape {
+            BrushShape::Line => vec![Shape::Line {
+                points: pts,
+                radius: s.size,
+            }],
+            BrushShape::Box => {
+                let (a, b) = (
+                    pts[0].floor().as_ivec3(),
+                    pts[pts.len() - 1].floor().as_ivec3(),
+                );
+                vec![Shape::Box {
+                    min: a.min(b),
+                    max: a.max(b),
+                }]
+            }
+            BrushShape::Voxel => pts
+                .iter()
+                .map(|p| Shape::Voxel(p.floor().as_ivec3()))
+                .collect(),
+            BrushShape::Sphere => pts
+                .iter()
+                .map(|p| Shape::Sphere {
+                    centre: *p,
+                    radius: s.size,
+                })
+                .collect(),
+            BrushShape::Cube => {
+                let h = s.size.round().max(0.0) as i32;
+                pts.iter()
+                    .map(|p| {
+                        let c = p.floor().as_ivec3();
+                        Shape::Box {
+                            min: c - h,
+                            max: c + h,
+                        }
+                    })
+                    .collect()
+            }
+            BrushShape::Cylinder => pts
+                .iter()
+                .map(|p| Shape::Cylinder {
+                    a: *p - DVec3::Y * s.size,
+                    b: *p + DVec3::Y * s.size,
+                    radius: s.size,
+                })
+                .collect(),
+        };
+        for shape in shapes {
+            shape.validate().map_err(EditError::World)?;
+            edits.push(EditOp::Shape { shape, mode });
+        }
+    }
+    Ok(edits)
+}

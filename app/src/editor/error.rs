@@ -1,0 +1,38 @@
+//! The editor engine's one error type: what a command, an undo or a redo can fail with. The
+//! UI tells them apart (a refused edit is shown and forgotten; a file error names the file);
+//! whenever one is returned, the scene and the history are as they were.
+
+use crate::formats::FormatError;
+use brickmap::BrickmapError;
+
+/// Why a command, undo or redo did not happen.
+#[derive(Debug, thiserror::Error)]
+pub enum EditError {
+    /// The command's own parameters are wrong (a stroke without points, a fill that starts
+    /// in empty space).
+    #[error("{0}")]
+    Invalid(String),
+    /// The world refused (outside the grid, no such material, over the memory budget).
+    #[error(transparent)]
+    World(#[from] BrickmapError),
+    /// A scene setting outside its range.
+    #[error(transparent)]
+    Param(#[from] render::ParamError),
+    /// A file the command reads (an import) could not be read or is not valid.
+    #[error(transparent)]
+    File(#[from] FormatError),
+    /// Undo with an empty undo list.
+    #[error("nothing to undo")]
+    NothingToUndo,
+    /// Redo with an empty redo list.
+    #[error("nothing to redo")]
+    NothingToRedo,
+}
+
+/// The engine's result.
+pub type Result<T, E = EditError> = std::result::Result<T, E>;
+
+/// An [`EditError::Invalid`].
+pub(crate) fn invalid(message: impl Into<String>) -> EditError {
+    EditError::Invalid(message.into())
+}

@@ -1,0 +1,123 @@
+//! How commands are undone: sparse world inverses for voxels (never snapshots), the previous
+//! table (about 2 KB) for table edits, the previous value for properties; and the helpers
+//! that apply edits all-or-nothing.
+
+use super::error::Result;
+use crate::scene::Scene;
+use brickmap::{EditInverse, EditOp, MaterialTable};
+use render::{Camera, RenderSettings, Sky, Sun};
+
+/// How to undo a command.
+#[derive(Debug)]
+pub enum Inverse {
+    /// Voxel edits to restore in reverse order, then (if any) the material table.
+    Voxels(Vec<EditInverse>, Option<Box<MaterialTable>>),
+    /// The previous material table.
+    Table(Box<MaterialTable>),
+    /// The previous sun.
+    Sun(Sun),
+    /// The previous sky.
+    Sky(Sky),
+    /// The previous camera.
+    Camera(Camera),
+    /// The previous settings.
+    Settings(RenderSettings),
+}
+
+impl Inverse {
+    /// Heap and inline bytes this inverse holds (what the history pays for it).
+    pub fn bytes(&self) -> usize {
+        let table = std::mem::size_of::<MaterialTable>();
+        std::mem::size_of::<Self>()
+            + match self {
+                Inverse::Voxels(v, t) => {
+                    v.iter().map(|i| i.heap_bytes()).sum::<usize>()
+                        + t.as_ref().map_or(0, |_| table)
+                }
+                Inverse::Table(_) => table,
+                _ => 0,
+            }
+    }
+
+    /// Applies the inverse, returning the inverse of that (redo after undo, and back).
+    pub fn apply(self, scene: &mut Scene) -> Result<Inverse> {
+        Ok(match self {
+            Inverse::Voxels(list, table) => {
+                // A table that grows goes in before the voxels that use it; one that shrinks
+                // after the voxels that used the dropped entries are gone.
+                let grows = table
+                    .as_ref()
+                    .is_some_and(|t| t.len() >= scene.world.materials().len());
+                let mut old = None;
+                if grows && let Some(t) = table.as_ref() {
+                    old = Some(Box::new(scene.world.replace_materials((**t).clone())?));
+                }
+                let mut back = Vec::with_capacity(list.len());
+                for inv in list.into_iter().rev() {
+                    back.push(scene.world.apply(EditOp::Restore(inv))?.inverse);
+                }
+                if !grows && let Some(t) = table {
+                    old = Some(Box::new(scene.world.replace_materials(*t)?));
+                }
+                Inverse::Voxels(back, old)
+            }
+            Inverse::Table(t) => Inverse::Table(Box::new(scene.world.replace_materials(*t)?)),
+            Inverse::Sun(v) => Inverse::Sun(std::mem::replace(&mut scene.params.sun, v)),
+            Inverse::Sky(v) => Inverse::Sky(std::mem::replace(&mut scene.params.sky, v)),
+            Inverse::Camera(v) => Inverse::Camera(std::mem::replace(&mut scene.params.camera, v)),
+            Inverse::Settings(v) => {
+                Inverse::Settings(std::mem::replace(&mut scene.params.settings, v))
+            }
+        })
+    }
+}
+
+/// An executed command: how to undo it, and how many voxels it changed (for an import, how
+/// many it wrote).
+#[derive(Debug)]
+pub struct Applied {
+    /// The undo.
+    pub inverse: Inverse,
+    /// Voxels whose occupancy or material changed.
+    pub changed_voxels: u64,
+}
+
+/// Runs a table edit, keeping the previous table as the inverse (and putting it back on error).
+pub(super) fn with_table(
+    scene: &Scene,
+    edit: impl FnOnce(&brickmap::World) -> brickmap::Result<()>,
+) -> Result<Applied> {
+    let before = scene.world.materials().clone();
+    if let Err(e) = edit(&scene.world) {
+        scene.world.replace_materials(before)?;
+        return Err(e.into());
+    }
+    Ok(Applied {
+        inverse: Inverse::Table(Box::new(before)),
+        changed_voxels: 0,
+    })
+}
+
+/// Applies edits in order; if one fails, the ones applied are undone and the error returned.
+pub(super) fn apply_all(scene: &Scene, edits: Vec<EditOp>) -> Result<Applied> {
+    let mut done: Vec<EditInverse> = Vec::with_capacity(edits.len());
+    let mut changed = 0;
+    for edit in edits {
+        match scene.world.apply(edit) {
+            Ok(out) => {
+                changed += out.changed_voxels;
+                done.push(out.inverse);
+            }
+            Err(e) => {
+                for inv in done.into_iter().rev() {
+                    scene.world.apply(EditOp::Restore(inv))?;
+                }
+                return Err(e.into());
+            }
+        }
+    }
+    Ok(Applied {
+        inverse: Inverse::Voxels(done, None),
+        changed_voxels: changed,
+    })
+}
