@@ -341,3 +341,64 @@ fn a_failing_script_step_in_the_live_editor_exits_non_zero_naming_the_step() {
         "nothing captured after a failure"
     );
 }
+
+#[test]
+fn a_gpu_failure_mid_session_keeps_the_unsaved_work_in_the_recovery_file() {
+    if !have("Xvfb") {
+        return skip("Xvfb is not installed (package xvfb)");
+    }
+    let Some(x) = Xvfb::start() else {
+        return skip("Xvfb did not start");
+    };
+    let dir = scratch("gpu-failure");
+    let script = dir.join("edits.ron");
+    let last = r#"Stroke((mode: Attach, shape: Sphere, size: 4.0, material: 0, points: [(8.0, 10.0, 8.0)]))"#;
+    std::fs::write(
+        &script,
+        format!(
+            r#"(format_version: 1, start: New(size: (16, 16, 16)), steps: [
+            Do(Stroke((mode: Attach, shape: Box, size: 1.0, material: 0, points: [(0.0, 0.0, 0.0), (15.0, 2.0, 15.0)]))),
+            Save("saved.ron"),
+            Do({last}),
+        ])"#
+        ),
+    )
+    .unwrap();
+    // The steps run in the first frames; the device is "lost" at frame 40, long before the
+    // (unreachable) capture.
+    let out = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
+        .arg("--script")
+        .arg(&script)
+        .arg("--capture")
+        .arg(dir.join("never.png"))
+        .args(["--capture-spp", "100000", "--window", "96x64"])
+        .env("DISPLAY", &x.display)
+        .env_remove("WAYLAND_DISPLAY")
+        .env("VOXBRICK_CONFIG_DIR", dir.join("config"))
+        .env("VOXBRICK_TEST_GPU_FAILURE_AT_FRAME", "40")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if stderr.contains("no usable Vulkan") || stderr.contains("no Vulkan device") {
+        return skip(&format!(
+            "no Vulkan device can draw a window: {}",
+            stderr.trim()
+        ));
+    }
+    assert!(!out.status.success(), "a GPU failure fails the run");
+    assert!(
+        stderr.contains("the GPU failed") && stderr.contains("device has been lost"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    // The recovery file holds the edit made after the save, exactly.
+    let recovery = dir.join("config").join("recovery.ron");
+    assert!(recovery.exists(), "{stderr}");
+    let recovered = app::Scene::load(&recovery, 1).unwrap();
+    let mut expected = app::Scene::load(&dir.join("saved.ron"), 1).unwrap();
+    let hash = |s: &app::Scene| s.world.read().content_hash();
+    assert_ne!(hash(&recovered), hash(&expected));
+    let command: app::editor::command::Command = ron::from_str(last).unwrap();
+    command.apply(&mut expected, &dir).unwrap();
+    assert_eq!(hash(&recovered), hash(&expected));
+}

@@ -156,6 +156,11 @@ pub struct Editor {
     move_event: Option<Instant>,
     /// Frames and time of the latest move's first frame (for the status line).
     latency: Option<Duration>,
+    /// Frames drawn.
+    frames: u64,
+    /// Tests only: the frame that fails as if the device were lost
+    /// (`VOXBRICK_TEST_GPU_FAILURE_AT_FRAME`), to check nothing is lost when the GPU fails.
+    fail_at_frame: Option<u64>,
 }
 
 impl Editor {
@@ -246,6 +251,10 @@ impl Editor {
             outcome: Ok(()),
             move_event: None,
             latency: None,
+            frames: 0,
+            fail_at_frame: std::env::var("VOXBRICK_TEST_GPU_FAILURE_AT_FRAME")
+                .ok()
+                .and_then(|v| v.parse().ok()),
             script: script_run,
             options,
         };
@@ -306,8 +315,9 @@ impl Editor {
         self.edits.submit(&self.doc, Edit::Command(command));
     }
 
-    /// What an edit on the edit thread did.
-    fn edited(&mut self, edited: Edited) -> Result<()> {
+    /// What an edit on the edit thread did. A failed script step ends the run (non-zero,
+    /// naming the step).
+    fn edited(&mut self, edited: Edited) {
         self.edits.finished();
         match edited {
             Edited::Command(label, result) => {
@@ -331,15 +341,19 @@ impl Editor {
                 }
                 if let Some(s) = &mut self.script {
                     s.run = Some(run);
-                    match result? {
-                        Some(line) => println!("{line}"),
-                        None => s.finished = true,
+                    match result {
+                        Ok(Some(line)) => println!("{line}"),
+                        Ok(None) => s.finished = true,
+                        Err(e) => {
+                            s.finished = true;
+                            self.outcome = Err(e);
+                            self.quitting = true;
+                        }
                     }
                 }
             }
         }
         self.refresh_stats();
-        Ok(())
     }
 
     fn refresh_stats(&mut self) {
@@ -709,7 +723,7 @@ impl Editor {
             self.file_done(done);
         }
         while let Ok(edited) = self.edits.done.try_recv() {
-            self.edited(edited)?;
+            self.edited(edited);
         }
         if !self.edits.busy() {
             for (path, autosave) in std::mem::take(&mut self.saves_waiting) {
@@ -732,6 +746,14 @@ impl Editor {
     }
 
     fn draw(&mut self, gfx: &mut Gfx, event_loop: &ActiveEventLoop) -> Result<()> {
+        self.frames += 1;
+        if self.fail_at_frame == Some(self.frames) {
+            return Err(render::vulkan::GpuError::Vk {
+                call: "vkQueueSubmit (simulated: VOXBRICK_TEST_GPU_FAILURE_AT_FRAME)",
+                result: ash::vk::Result::ERROR_DEVICE_LOST,
+            }
+            .into());
+        }
         if self.gpu_generation != self.generation {
             // A new document: a new GPU world on the same device (the old one goes first).
             let ctx = gfx.viewport.ctx().clone();
@@ -1092,11 +1114,7 @@ impl Editor {
             WindowEvent::ScaleFactorChanged { .. } => gfx.window.request_redraw(),
             WindowEvent::RedrawRequested => {
                 if let Err(e) = self.redraw(event_loop) {
-                    if self.script.is_some() {
-                        self.fail(event_loop, e);
-                    } else {
-                        self.gpu_failed(event_loop, e);
-                    }
+                    self.gpu_failed(event_loop, e);
                 }
             }
             WindowEvent::DroppedFile(path) => {
@@ -1181,36 +1199,64 @@ impl Editor {
         }
     }
 
-    /// A GPU error mid-session: say so and offer to save before anything else is lost.
+    /// A GPU error mid-session: say so; unsaved work goes to the recovery file at once
+    /// (offered on the next start), then a dialog offers to save it as a project too (not
+    /// in a script run: nobody is there to answer).
     fn gpu_failed(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+        // The message itself is the run's error, printed once at exit.
         let message = format!("{e:#}");
-        eprintln!("voxbrick: the GPU failed: {message}");
         self.gfx = None;
-        let dirty = self.read().dirty;
-        if dirty {
-            let answer = rfd::MessageDialog::new()
+        if self.read().dirty {
+            let recovery = self.config.recovery_file();
+            match std::fs::create_dir_all(self.config.0.as_path())
+                .map_err(anyhow::Error::from)
+                .and_then(|()| Ok(self.read().scene.save(&recovery)?))
+            {
+                Ok(()) => eprintln!(
+                    "voxbrick: unsaved work is in {} (offered on the next start)",
+                    recovery.display()
+                ),
+                Err(e) => eprintln!("voxbrick: writing {} failed: {e:#}", recovery.display()),
+            }
+            if self.script.is_none() {
+                self.offer_save(&message);
+            }
+        } else if self.script.is_none() {
+            rfd::MessageDialog::new()
                 .set_level(rfd::MessageLevel::Error)
                 .set_title("voxbrick: the GPU failed")
-                .set_description(format!("{message}\n\nSave the scene before quitting?"))
-                .set_buttons(rfd::MessageButtons::YesNo)
+                .set_description(format!("{message}\n\nThe scene has no unsaved changes."))
+                .set_buttons(rfd::MessageButtons::Ok)
                 .show();
-            if answer == rfd::MessageDialogResult::Yes {
-                let path = self.read().path.clone().or_else(|| {
-                    rfd::FileDialog::new()
-                        .add_filter("voxbrick project", &["ron"])
-                        .save_file()
-                });
-                // A fallback that always works: the recovery file.
-                let path = path.unwrap_or_else(|| self.config.recovery_file());
-                if let Err(e) = self.read().scene.save(&path) {
-                    eprintln!("voxbrick: saving {} failed: {e}", path.display());
-                } else {
-                    eprintln!("voxbrick: saved {}", path.display());
-                }
-            }
         }
         self.outcome = Err(anyhow!("the GPU failed: {message}"));
         event_loop.exit();
+    }
+
+    /// After a GPU failure: "save the scene?", to its file or one the user picks.
+    fn offer_save(&mut self, message: &str) {
+        let answer = rfd::MessageDialog::new()
+            .set_level(rfd::MessageLevel::Error)
+            .set_title("voxbrick: the GPU failed")
+            .set_description(format!(
+                "{message}\n\nYour work is in the recovery file. Save the scene as well?"
+            ))
+            .set_buttons(rfd::MessageButtons::YesNo)
+            .show();
+        if answer != rfd::MessageDialogResult::Yes {
+            return;
+        }
+        let path = self.read().path.clone().or_else(|| {
+            rfd::FileDialog::new()
+                .add_filter("voxbrick project", &["ron"])
+                .save_file()
+        });
+        if let Some(path) = path {
+            match self.read().scene.save(&path) {
+                Ok(()) => eprintln!("voxbrick: saved {}", path.display()),
+                Err(e) => eprintln!("voxbrick: saving {} failed: {e}", path.display()),
+            }
+        }
     }
 }
 

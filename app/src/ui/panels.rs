@@ -262,12 +262,15 @@ pub fn draw(
         egui::Window::new("Shortcuts")
             .open(&mut open)
             .show(ctx, |ui| {
-                egui::Grid::new("keys").striped(true).show(ui, |ui| {
-                    for (keys, what) in SHORTCUTS {
-                        ui.monospace(*keys);
-                        ui.label(*what);
-                        ui.end_row();
-                    }
+                // Scrolls when the window is small (or the UI scale large).
+                egui::ScrollArea::both().show(ui, |ui| {
+                    egui::Grid::new("keys").striped(true).show(ui, |ui| {
+                        for (keys, what) in SHORTCUTS {
+                            ui.monospace(*keys);
+                            ui.label(*what);
+                            ui.end_row();
+                        }
+                    });
                 });
             });
         state.help_open = open;

@@ -400,15 +400,11 @@ impl Candidate {
         } else {
             vk::QueueFlags::COMPUTE
         };
-        let compute_family = families
-            .iter()
-            .position(|f| f.queue_flags.contains(flags))
-            .map(|f| f as u32);
-        let present_family = surface.and_then(|s| {
-            compute_family
-                .filter(|&c| s.supports(physical, c))
-                .or_else(|| (0..families.len() as u32).find(|&f| s.supports(physical, f)))
-        });
+        let flags_of: Vec<vk::QueueFlags> = families.iter().map(|f| f.queue_flags).collect();
+        let (compute_family, present_family) = match surface {
+            Some(s) => choose_families(&flags_of, flags, |f| s.supports(physical, f)),
+            None => (choose_families(&flags_of, flags, |_| false).0, None),
+        };
         Self {
             physical,
             name: p
@@ -420,6 +416,25 @@ impl Candidate {
             present_family,
         }
     }
+}
+
+/// The queue families a context uses, from each family's flags: the first family with
+/// `needed` (compute, plus graphics for a window's egui), and a family that presents
+/// (`presents`): that same family when it can, else the first one that can (the swapchain's
+/// images are then shared concurrently between the two). None where no family qualifies.
+fn choose_families(
+    families: &[vk::QueueFlags],
+    needed: vk::QueueFlags,
+    presents: impl Fn(u32) -> bool,
+) -> (Option<u32>, Option<u32>) {
+    let compute = families
+        .iter()
+        .position(|f| f.contains(needed))
+        .map(|f| f as u32);
+    let present = compute
+        .filter(|&c| presents(c))
+        .or_else(|| (0..families.len() as u32).find(|&f| presents(f)));
+    (compute, present)
 }
 
 impl Drop for GpuContext {
@@ -437,5 +452,37 @@ impl Drop for GpuContext {
             }
             self.device.destroy_device(None);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GC: vk::QueueFlags = vk::QueueFlags::from_raw(
+        vk::QueueFlags::GRAPHICS.as_raw() | vk::QueueFlags::COMPUTE.as_raw(),
+    );
+    const C: vk::QueueFlags = vk::QueueFlags::COMPUTE;
+    const T: vk::QueueFlags = vk::QueueFlags::TRANSFER;
+
+    #[test]
+    fn the_compute_queue_presents_when_it_can_else_another_family_does() {
+        // One family that does everything (lavapipe, most desktop GPUs).
+        assert_eq!(choose_families(&[GC], GC, |_| true), (Some(0), Some(0)));
+        // Presenting from the compute family is preferred over an earlier one.
+        assert_eq!(
+            choose_families(&[T, GC, GC], GC, |f| f != 0),
+            (Some(1), Some(1))
+        );
+        // The graphics + compute family cannot present: a separate present family.
+        assert_eq!(
+            choose_families(&[GC, C, T], GC, |f| f == 2),
+            (Some(0), Some(2))
+        );
+        // Compute-only work takes the first compute family.
+        assert_eq!(choose_families(&[T, C, GC], C, |_| false), (Some(1), None));
+        // Nothing presents, or nothing computes: None, and the caller says so.
+        assert_eq!(choose_families(&[GC], GC, |_| false), (Some(0), None));
+        assert_eq!(choose_families(&[T], C, |_| true), (None, Some(0)));
     }
 }
