@@ -1,6 +1,8 @@
 //! File formats end to end: project round trips and hostile files, atomic saves, .vox
 //! import of every sample, import → export → import, scenes beyond 256³, rotations.
 
+mod common;
+
 use app::Scene;
 use app::formats::{FormatError, project, vox};
 use app::scene::{SceneSize, default_scene};
@@ -402,26 +404,15 @@ fn rotated_and_translated_instances_land_where_magicavoxel_puts_them() {
             }],
         },
     ];
-    let data = DotVoxData {
-        version: 150,
-        index_map: DEFAULT_INDEX_MAP.to_vec(),
-        models: vec![model],
-        palette: DEFAULT_PALETTE.to_vec(),
-        materials: vec![],
+    let bytes = common::vox_bytes(
+        vec![model],
+        vec![],
         scenes,
-        layers: vec![Layer {
+        vec![Layer {
             attributes: Dict::new(),
         }],
-    };
-    let mut bytes = Vec::new();
-    data.write_vox(&mut bytes).unwrap();
-    let (scene, report) = vox::import_bytes(
-        &bytes,
-        Path::new("rot.vox"),
-        &vox::ImportOptions::default(),
-        1,
-    )
-    .unwrap();
+    );
+    let (scene, report) = common::import(&bytes, "rot.vox");
     assert_eq!(report.instances, 2);
     // MagicaVoxel coordinates, ⌊R·(v + ½ − ⌊s/2⌋) + t⌋ with pivot ⌊(3, 1, 1)/2⌋ = (1, 0, 0):
     // unrotated, v = (x, 0, 0) has centre (x − ½, ½, ½) and lands at (x + 9, 0, 0); rotated
@@ -495,10 +486,9 @@ fn matl_materials_map_to_voxbrick_materials() {
             .map(|(k, v)| (k.to_string(), v.to_string()))
             .collect(),
     };
-    let data = DotVoxData {
-        version: 150,
-        index_map: DEFAULT_INDEX_MAP.to_vec(),
-        models: vec![Model {
+    // MATL ids are the file's palette indices: voxel i uses MATL i + 1.
+    let bytes = common::vox_bytes(
+        vec![Model {
             size: Size { x: 7, y: 1, z: 1 },
             voxels: (0..7)
                 .map(|x| Voxel {
@@ -509,9 +499,7 @@ fn matl_materials_map_to_voxbrick_materials() {
                 })
                 .collect(),
         }],
-        palette: DEFAULT_PALETTE.to_vec(),
-        // MATL ids are the file's palette indices: voxel i uses MATL i + 1.
-        materials: vec![
+        vec![
             matl(1, &[("_type", "_diffuse")]),
             matl(
                 2,
@@ -522,18 +510,10 @@ fn matl_materials_map_to_voxbrick_materials() {
             matl(5, &[("_type", "_emit"), ("_emit", "0.5"), ("_flux", "2")]),
             matl(6, &[("_type", "_cloud")]),
         ],
-        scenes: vec![],
-        layers: vec![],
-    };
-    let mut bytes = Vec::new();
-    data.write_vox(&mut bytes).unwrap();
-    let (scene, report) = vox::import_bytes(
-        &bytes,
-        Path::new("matl.vox"),
-        &vox::ImportOptions::default(),
-        1,
-    )
-    .unwrap();
+        vec![],
+        vec![],
+    );
+    let (scene, report) = common::import(&bytes, "matl.vox");
     let view = scene.world.read();
     let table = view.materials();
     let at = |x: i32| {

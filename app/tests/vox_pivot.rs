@@ -5,6 +5,8 @@
 //! cases, every one of the 48 rotations on models of sizes 1–5 per axis, nested group
 //! transforms, and the round trip import → export → import of a rotated multi-model scene.
 
+mod common;
+
 use app::formats::vox;
 use dot_vox::*;
 use glam::{DVec3, IVec3};
@@ -186,13 +188,7 @@ fn colour_of(v: IVec3) -> u8 {
 fn imported(data: &DotVoxData) -> BTreeSet<([i32; 3], [u8; 3])> {
     let mut bytes = Vec::new();
     data.write_vox(&mut bytes).unwrap();
-    let (scene, _) = vox::import_bytes(
-        &bytes,
-        Path::new("t.vox"),
-        &vox::ImportOptions::default(),
-        1,
-    )
-    .unwrap();
+    let (scene, _) = common::import(&bytes, "t.vox");
     cells_of(&scene.world)
 }
 
@@ -392,13 +388,7 @@ fn a_rotated_multi_model_scene_survives_export_and_import_voxel_for_voxel() {
     let data = scene(&models, &instances);
     let mut bytes = Vec::new();
     data.write_vox(&mut bytes).unwrap();
-    let (first, _) = vox::import_bytes(
-        &bytes,
-        Path::new("a.vox"),
-        &vox::ImportOptions::default(),
-        1,
-    )
-    .unwrap();
+    let (first, _) = common::import(&bytes, "a.vox");
     assert_eq!(cells_of(&first.world), expected(&models, &instances));
     let exported = vox::export_data(&first.world).unwrap();
     let mut again = Vec::new();
@@ -465,24 +455,8 @@ fn several_models_without_a_scene_graph_are_frames_and_only_the_first_is_kept() 
             }],
         })
         .collect();
-    let data = DotVoxData {
-        version: 150,
-        index_map: DEFAULT_INDEX_MAP.to_vec(),
-        models: frames,
-        palette: DEFAULT_PALETTE.to_vec(),
-        materials: vec![],
-        scenes: vec![],
-        layers: vec![],
-    };
-    let mut bytes = Vec::new();
-    data.write_vox(&mut bytes).unwrap();
-    let (scene, report) = vox::import_bytes(
-        &bytes,
-        Path::new("anim.vox"),
-        &vox::ImportOptions::default(),
-        1,
-    )
-    .unwrap();
+    let bytes = common::vox_bytes(frames, vec![], vec![], vec![]);
+    let (scene, report) = common::import(&bytes, "anim.vox");
     assert_eq!(scene.world.read().solid_count(), 1, "only the first frame");
     let c = DEFAULT_PALETTE[10];
     assert!(
