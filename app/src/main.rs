@@ -136,54 +136,7 @@ enum Command {
         output: PathBuf,
     },
     /// Render a scene offscreen to an image.
-    Render {
-        /// A .ron or .vox file (a .vox gets the default camera, sun and sky).
-        scene: PathBuf,
-        /// Output image (.png).
-        #[arg(long)]
-        out: PathBuf,
-        /// Also write the linear image as PFM (for error measurement).
-        #[arg(long)]
-        hdr: Option<PathBuf>,
-        /// Samples per pixel.
-        #[arg(long, default_value_t = 16)]
-        spp: u32,
-        /// Max bounces (default: the scene's setting).
-        #[arg(long)]
-        bounces: Option<u32>,
-        /// Image width.
-        #[arg(long, default_value_t = 512)]
-        width: u32,
-        /// Image height.
-        #[arg(long, default_value_t = 288)]
-        height: u32,
-        /// Camera as EYE_X,EYE_Y,EZE_Z:TARGET_X,TARGET_Y,TARGET_Z (default: the scene's; for
-        /// .vox, framing the whole scene).
-        #[arg(long)]
-        camera: Option<String>,
-        /// An orthographic view H voxels tall (parallel rays from the plane through the eye).
-        #[arg(long, value_name = "H")]
-        orthographic: Option<f64>,
-        /// gpu (the Vulkan path tracer on the best device), cpu (the reference path tracer), or
-        /// part of a Vulkan device's name.
-        #[arg(long, default_value = "gpu")]
-        device: String,
-        /// Random seed.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Internal resolution as a fraction of the output (0 < F <= 1): paths are traced at
-        /// ceil(W·F)×ceil(H·F) and upscaled bilinearly.
-        #[arg(long, default_value_t = 1.0)]
-        scale: f64,
-        /// GPU: samples per pixel in one dispatch, 1..=16 (default: chosen from the image
-        /// size).
-        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16))]
-        samples_per_dispatch: Option<u32>,
-        /// GPU: invocations each pixel's samples are split among in one dispatch, 1..=8
-        /// (default: enough for 0.6 M invocations, where the device has float atomics).
-        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8))]
-        slices: Option<u32>,
-    },
+    Render(RenderArgs),
     /// Replay an edit script headlessly, reporting each step; exits non-zero at the first
     /// failed step.
     Replay {
@@ -439,38 +392,7 @@ fn run(cli: Cli) -> Result<()> {
             );
             Ok(())
         }
-        Command::Render {
-            scene,
-            out,
-            hdr,
-            spp,
-            bounces,
-            width,
-            height,
-            camera,
-            orthographic,
-            device,
-            seed,
-            scale,
-            samples_per_dispatch,
-            slices,
-        } => render_command(RenderArgs {
-            scene,
-            out,
-            hdr,
-            spp,
-            bounces,
-            width,
-            height,
-            camera,
-            orthographic,
-            device,
-            seed,
-            scale,
-            samples_per_dispatch,
-            slices,
-            workers,
-        }),
+        Command::Render(args) => render_command(args, workers),
         Command::Replay {
             script,
             save,

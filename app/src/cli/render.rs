@@ -7,25 +7,58 @@ use glam::DVec3;
 use std::path::PathBuf;
 use std::time::Instant;
 
+/// `voxbrick render`'s arguments.
+#[derive(clap::Args)]
 pub(crate) struct RenderArgs {
+    /// A .ron or .vox file (a .vox gets the default camera, sun and sky).
     pub(crate) scene: PathBuf,
+    /// Output image (.png).
+    #[arg(long)]
     pub(crate) out: PathBuf,
+    /// Also write the linear image as PFM (for error measurement).
+    #[arg(long)]
     pub(crate) hdr: Option<PathBuf>,
+    /// Samples per pixel.
+    #[arg(long, default_value_t = 16)]
     pub(crate) spp: u32,
+    /// Max bounces (default: the scene's setting).
+    #[arg(long)]
     pub(crate) bounces: Option<u32>,
+    /// Image width.
+    #[arg(long, default_value_t = 512)]
     pub(crate) width: u32,
+    /// Image height.
+    #[arg(long, default_value_t = 288)]
     pub(crate) height: u32,
+    /// Camera as EYE_X,EYE_Y,EYE_Z:TARGET_X,TARGET_Y,TARGET_Z (default: the scene's; for
+    /// .vox, framing the whole scene).
+    #[arg(long)]
     pub(crate) camera: Option<String>,
+    /// An orthographic view H voxels tall (parallel rays from the plane through the eye).
+    #[arg(long, value_name = "H")]
     pub(crate) orthographic: Option<f64>,
+    /// gpu (the Vulkan path tracer on the best device), cpu (the reference path tracer), or
+    /// part of a Vulkan device's name.
+    #[arg(long, default_value = "gpu")]
     pub(crate) device: String,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
     pub(crate) seed: u64,
+    /// Internal resolution as a fraction of the output (0 < F <= 1): paths are traced at
+    /// ceil(W·F)×ceil(H·F) and upscaled bilinearly.
+    #[arg(long, default_value_t = 1.0)]
     pub(crate) scale: f64,
+    /// GPU: samples per pixel in one dispatch, 1..=16 (default: chosen from the image
+    /// size).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16))]
     pub(crate) samples_per_dispatch: Option<u32>,
+    /// GPU: invocations each pixel's samples are split among in one dispatch, 1..=8
+    /// (default: enough for 0.6 M invocations, where the device has float atomics).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8))]
     pub(crate) slices: Option<u32>,
-    pub(crate) workers: usize,
 }
 
-pub(crate) fn render_command(a: RenderArgs) -> Result<()> {
+pub(crate) fn render_command(a: RenderArgs, workers: usize) -> Result<()> {
     if a.spp == 0 || a.width == 0 || a.height == 0 || a.width > 16384 || a.height > 16384 {
         bail!("--spp, --width and --height must be positive (sizes at most 16384)");
     }
@@ -33,7 +66,7 @@ pub(crate) fn render_command(a: RenderArgs) -> Result<()> {
         bail!("--scale {} is outside (0, 1]", a.scale);
     }
     let scene = with_progress(format!("reading {}", a.scene.display()), || {
-        Ok(Scene::load(&a.scene, a.workers)?)
+        Ok(Scene::load(&a.scene, workers)?)
     })?;
     let mut params = scene.params.clone();
     if let Some(spec) = &a.camera {
