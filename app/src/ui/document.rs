@@ -1,0 +1,355 @@
+//! The editor's document side: edits queued on the edit thread and what they report, files
+//! (open, save, save as, new, import, export, autosave, recovery) and their results, the
+//! unsaved-changes question, quitting, and a GPU failure's rescue of unsaved work.
+
+use super::*;
+
+impl Editor {
+    pub(super) fn read(&self) -> std::sync::RwLockReadGuard<'_, Document> {
+        self.doc.read().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Saves on the file worker once the edits asked for before are applied (Ctrl+Z then
+    /// Ctrl+S saves the undone scene).
+    pub(super) fn save_to(&mut self, path: PathBuf, autosave: bool) {
+        if self.edits.busy() {
+            self.saves_waiting.push((path, autosave));
+        } else {
+            self.files.save(&self.doc, path, autosave);
+        }
+    }
+
+    /// Applies finished saves' bookkeeping (file, clean flag) to the document, unless
+    /// another save is reading it right now (then next frame: the UI never waits).
+    pub(super) fn mark_saved(&mut self) {
+        if self.saved.is_empty() {
+            return;
+        }
+        let mut d = match self.doc.try_write() {
+            Ok(d) => d,
+            Err(std::sync::TryLockError::Poisoned(p)) => p.into_inner(),
+            Err(std::sync::TryLockError::WouldBlock) => return,
+        };
+        for (path, revision) in self.saved.drain(..) {
+            d.mark_saved(&path, revision);
+        }
+    }
+
+    /// Queues a command on the edit thread (the UI never waits for the world's workers).
+    pub(super) fn execute(&mut self, command: Command) {
+        self.edits.submit(&self.doc, Edit::Command(command));
+    }
+
+    /// What an edit on the edit thread did. A failed script step ends the run (non-zero,
+    /// naming the step).
+    pub(super) fn edited(&mut self, edited: Edited) {
+        self.edits.finished();
+        match edited {
+            Edited::Command(label, result) => {
+                if let Err(e) = result {
+                    self.panels.errors.push(format!("{label}: {e}"));
+                }
+            }
+            Edited::Undo(result) | Edited::Redo(result) => {
+                if let Err(e) = result {
+                    self.panels.errors.push(e.to_string());
+                }
+            }
+            Edited::ScriptStep {
+                run,
+                result,
+                camera_changed,
+            } => {
+                if camera_changed {
+                    let view = scene_view(&self.read().scene);
+                    self.view = view;
+                }
+                if let Some(s) = &mut self.script {
+                    s.run = Some(run);
+                    match result {
+                        Ok(Some(line)) => println!("{line}"),
+                        Ok(None) => s.finished = true,
+                        Err(e) => {
+                            s.finished = true;
+                            self.outcome = Err(e);
+                            self.quitting = true;
+                        }
+                    }
+                }
+            }
+        }
+        self.refresh_stats();
+    }
+
+    pub(super) fn refresh_stats(&mut self) {
+        let text = scene_statistics(&self.read());
+        self.panels.stats = text;
+    }
+
+    pub(super) fn replace_document(&mut self, scene: Scene, path: Option<PathBuf>) {
+        let mut doc = Document::new(scene, History::with_budget(DEFAULT_BUDGET));
+        doc.folder = path
+            .as_ref()
+            .and_then(|p| p.parent())
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from("."));
+        let is_project = path.as_ref().is_some_and(|p| {
+            crate::formats::Format::of(p).ok() == Some(crate::formats::Format::Project)
+        });
+        if let Some(p) = &path {
+            let _ = self.config.add_recent(p);
+            self.panels.recent = self.config.recent();
+        }
+        doc.path = path.filter(|_| is_project);
+        self.view = scene_view(&doc.scene);
+        self.doc = Arc::new(RwLock::new(doc));
+        self.generation += 1;
+        self.refresh_stats();
+    }
+
+    /// Runs `then` now, or asks about unsaved changes first.
+    pub(super) fn guard_unsaved(&mut self, then: Pending) {
+        if self.read().dirty && self.script.is_none() {
+            self.pending = Some(then);
+            self.panels.asking_unsaved = true;
+        } else {
+            self.proceed(then);
+        }
+    }
+
+    pub(super) fn proceed(&mut self, then: Pending) {
+        match then {
+            Pending::Quit => self.quit_now(),
+            Pending::Open(Some(p)) => self.files.load(p, self.options.workers),
+            Pending::Open(None) => self.files.pick(Purpose::Open, self.folder(), None),
+            Pending::New { size, terrain } => self.new_scene(size, terrain),
+        }
+    }
+
+    pub(super) fn new_scene(&mut self, size: (u32, u32, u32), terrain: bool) {
+        // Built on a worker; it replaces the document like a default-scene build.
+        self.awaiting_built_scene = true;
+        self.files.build_new(size, terrain, self.options.workers);
+    }
+
+    pub(super) fn folder(&self) -> Option<PathBuf> {
+        self.read()
+            .path
+            .as_ref()
+            .and_then(|p| p.parent())
+            .map(Path::to_path_buf)
+    }
+
+    pub(super) fn save(&mut self, as_new: bool) {
+        let path = self.read().path.clone();
+        match path.filter(|_| !as_new) {
+            Some(p) => self.save_to(p, false),
+            None => self
+                .files
+                .pick(Purpose::SaveAs, self.folder(), Some("scene.ron".into())),
+        }
+    }
+
+    pub(super) fn quit_now(&mut self) {
+        self.config.remove_recovery();
+        if self.script.is_none()
+            && let Err(e) = self.config.save_settings(&self.settings)
+        {
+            eprintln!("voxbrick: {e:#}");
+        }
+        self.quitting = true;
+    }
+
+    pub(super) fn file_done(&mut self, done: Done) {
+        self.files.finished();
+        match done {
+            Done::Picked(purpose, Ok(Some(path))) => match purpose {
+                Purpose::Open => self.files.load(path, self.options.workers),
+                Purpose::SaveAs | Purpose::Export => {
+                    let path = if purpose == Purpose::SaveAs && path.extension().is_none() {
+                        path.with_extension("ron")
+                    } else {
+                        path
+                    };
+                    self.save_to(path, false)
+                }
+                // Asks for the offset first (the import dialog), then `ImportVox`.
+                Purpose::Import => self.panels.import = Some((path, [0, 0, 0])),
+            },
+            Done::Picked(_, Ok(None)) => self.save_then = None,
+            Done::Picked(Purpose::SaveAs, Err(e)) => {
+                // Nothing is lost for want of a dialog: save beside the home folder.
+                let home =
+                    std::env::var_os("HOME").map_or_else(|| PathBuf::from("."), PathBuf::from);
+                let path = files::fallback_path(&home, "voxbrick-untitled", "ron");
+                self.panels
+                    .errors
+                    .push(format!("{e}; saving to {} instead", path.display()));
+                self.save_to(path, false);
+            }
+            Done::Picked(_, Err(e)) => {
+                self.save_then = None;
+                self.panels.errors.push(format!(
+                    "{e}; open a file by dropping it onto the window or naming it on the command line"
+                ));
+            }
+            Done::Loaded(path, loaded) => match *loaded {
+                Ok(scene) => {
+                    if self.awaiting_built_scene && path.is_some() {
+                        // A file opened while the default scene was building wins.
+                        self.awaiting_built_scene = false;
+                    }
+                    if path.is_none() && !self.awaiting_built_scene {
+                        return;
+                    }
+                    self.awaiting_built_scene = false;
+                    let recovered = std::mem::take(&mut self.recovering);
+                    self.replace_document(scene, path.filter(|_| !recovered));
+                    if recovered {
+                        if let Ok(mut d) = self.doc.write() {
+                            d.dirty = true;
+                        }
+                        self.config.remove_recovery();
+                    }
+                }
+                Err(e) => {
+                    self.awaiting_built_scene = false;
+                    self.panels.errors.push(format!("{e:#}"));
+                }
+            },
+            Done::Saved {
+                path,
+                autosave,
+                revision,
+                result,
+            } => match result {
+                Ok(()) if autosave => {}
+                Ok(()) => {
+                    self.saved.push((path.clone(), revision));
+                    self.mark_saved();
+                    let _ = self.config.add_recent(&path);
+                    self.panels.recent = self.config.recent();
+                    if let Some(then) = self.save_then.take() {
+                        self.proceed(then);
+                    }
+                }
+                Err(e) => {
+                    self.save_then = None;
+                    self.panels.errors.push(format!("{e:#}"));
+                }
+            },
+        }
+    }
+
+    pub(super) fn autosave(&mut self) {
+        let secs = self.settings.autosave_secs;
+        if secs == 0
+            || self.script.is_some()
+            || self.last_autosave.elapsed() < Duration::from_secs(secs)
+        {
+            return;
+        }
+        self.last_autosave = Instant::now();
+        if self.read().dirty {
+            let recovery = self.config.recovery_file();
+            self.save_to(recovery, true);
+        }
+    }
+
+    /// A GPU error mid-session: say so; unsaved work goes to the recovery file at once
+    /// (offered on the next start), then a dialog offers to save it as a project too (not
+    /// in a script run: nobody is there to answer).
+    pub(super) fn gpu_failed(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+        // The message itself is the run's error, printed once at exit.
+        let message = format!("{e:#}");
+        self.gfx = None;
+        if self.read().dirty {
+            let recovery = self.config.recovery_file();
+            match std::fs::create_dir_all(self.config.0.as_path())
+                .map_err(anyhow::Error::from)
+                .and_then(|()| Ok(self.read().scene.save(&recovery)?))
+            {
+                Ok(()) => eprintln!(
+                    "voxbrick: unsaved work is in {} (offered on the next start)",
+                    recovery.display()
+                ),
+                Err(e) => eprintln!("voxbrick: writing {} failed: {e:#}", recovery.display()),
+            }
+            if self.script.is_none() {
+                self.offer_save(&message);
+            }
+        } else if self.script.is_none() {
+            rfd::MessageDialog::new()
+                .set_level(rfd::MessageLevel::Error)
+                .set_title("voxbrick: the GPU failed")
+                .set_description(format!("{message}\n\nThe scene has no unsaved changes."))
+                .set_buttons(rfd::MessageButtons::Ok)
+                .show();
+        }
+        self.outcome = Err(anyhow!("the GPU failed: {message}"));
+        event_loop.exit();
+    }
+
+    /// After a GPU failure: "save the scene?", to its file or one the user picks.
+    pub(super) fn offer_save(&mut self, message: &str) {
+        let answer = rfd::MessageDialog::new()
+            .set_level(rfd::MessageLevel::Error)
+            .set_title("voxbrick: the GPU failed")
+            .set_description(format!(
+                "{message}\n\nYour work is in the recovery file. Save the scene as well?"
+            ))
+            .set_buttons(rfd::MessageButtons::YesNo)
+            .show();
+        if answer != rfd::MessageDialogResult::Yes {
+            return;
+        }
+        let path = self.read().path.clone().or_else(|| {
+            rfd::FileDialog::new()
+                .add_filter("voxbrick project", &["ron"])
+                .save_file()
+        });
+        if let Some(path) = path {
+            match self.read().scene.save(&path) {
+                Ok(()) => eprintln!("voxbrick: saved {}", path.display()),
+                Err(e) => eprintln!("voxbrick: saving {} failed: {e}", path.display()),
+            }
+        }
+    }
+}
+
+/// The statistics panel's text.
+pub(super) fn scene_statistics(doc: &Document) -> String {
+    let view = doc.scene.world.read();
+    let m = view.memory();
+    let dims = doc.scene.world.dims().voxels();
+    let solid = view.solid_count();
+    let mut s = format!(
+        "size         {} x {} x {} voxels\nsolid        {solid} voxels\nbricks       {} stored, {} full cells\nmaterials    {}\n\
+         GPU memory   {:.1} MiB used\n  brick index {:.2} MiB\n  bricks      {:.2} MiB\n  coarse grid {:.2} MiB\n  materials   {:.2} MiB\n  tables      {} B\n",
+        dims.x,
+        dims.y,
+        dims.z,
+        view.brick_count(),
+        m.full_cells,
+        view.materials().len(),
+        m.gpu_used() as f64 / 1048576.0,
+        m.brick_index as f64 / 1048576.0,
+        m.bricks_used as f64 / 1048576.0,
+        m.coarse as f64 / 1048576.0,
+        m.material_used as f64 / 1048576.0,
+        m.tables
+    );
+    if solid > 0 {
+        s += &format!(
+            "per voxel    {:.4} B per solid voxel\n",
+            m.gpu_used() as f64 / solid as f64
+        );
+    }
+    s += &format!(
+        "history      {} steps ({:.1} MiB), {} oldest dropped",
+        doc.history.undo_len(),
+        doc.history.bytes() as f64 / 1048576.0,
+        doc.history.dropped()
+    );
+    s
+}

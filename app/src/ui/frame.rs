@@ -1,0 +1,320 @@
+//! The editor's frames: the window's GPU session (made on the first `resumed`), one frame
+//! per redraw (results of edits and files, backlog input, fly keys, a script step, the
+//! panels, trace and present), progressive refinement and the samples-per-frame controller,
+//! and the script run's capture.
+
+use super::*;
+
+impl Editor {
+    pub(super) fn create_gfx(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        let (w, h) = self.options.size;
+        let attrs = Window::default_attributes()
+            .with_title("voxbrick")
+            .with_inner_size(winit::dpi::PhysicalSize::new(w.max(64), h.max(64)));
+        let window = Arc::new(
+            event_loop
+                .create_window(attrs)
+                .context("creating the window")?,
+        );
+        let handles = WindowHandles {
+            display: window.display_handle().context("display handle")?.as_raw(),
+            window: window.window_handle().context("window handle")?.as_raw(),
+        };
+        let ctx = GpuContext::new(&ContextOptions {
+            device: crate::gpu::device_choice(&self.options.device),
+            validation: self.options.validation,
+            window: Some(handles),
+            draw_ui: true,
+        })
+        .context("no Vulkan device can draw this window")?;
+        let ctx = Arc::new(ctx);
+        let size = window.inner_size();
+        let presenter = Presenter::new(ctx.clone(), (size.width, size.height))?;
+        let viewport = {
+            let doc = self.read();
+            let view = doc.scene.world.read();
+            Viewport::new(ctx, &view)?
+        };
+        self.gpu_generation = self.generation;
+        let egui_state = egui_winit::State::new(
+            self.egui.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            None,
+        );
+        self.gfx = Some(Gfx {
+            presenter,
+            viewport,
+            egui_state,
+            window,
+        });
+        self.refresh_stats();
+        Ok(())
+    }
+
+    pub(super) fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+        self.outcome = Err(e);
+        event_loop.exit();
+    }
+
+    /// One frame: script step, file results, egui, trace, present. Skipped (not waited
+    /// for) while a command runs on the worker; its completion wakes the loop.
+    pub(super) fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        let gate = self.edits.gate.clone();
+        let Ok(_frame) = gate.try_lock() else {
+            return Ok(());
+        };
+        while let Ok(done) = self.files.done.try_recv() {
+            self.file_done(done);
+        }
+        while let Ok(edited) = self.edits.done.try_recv() {
+            self.edited(edited);
+        }
+        if !self.edits.busy() {
+            for (path, autosave) in std::mem::take(&mut self.saves_waiting) {
+                self.files.save(&self.doc, path, autosave);
+            }
+        }
+        self.mark_saved();
+        for event in std::mem::take(&mut self.backlog) {
+            self.handle_window_event(event_loop, event);
+        }
+        self.tick_fly();
+        self.step_script();
+        self.autosave();
+        let Some(mut gfx) = self.gfx.take() else {
+            return Ok(());
+        };
+        let result = self.draw(&mut gfx, event_loop);
+        self.gfx = Some(gfx);
+        result
+    }
+
+    pub(super) fn draw(&mut self, gfx: &mut Gfx, event_loop: &ActiveEventLoop) -> Result<()> {
+        self.frames += 1;
+        if self.fail_at_frame == Some(self.frames) {
+            return Err(render::vulkan::GpuError::Vk {
+                call: "vkQueueSubmit (simulated: VOXBRICK_TEST_GPU_FAILURE_AT_FRAME)",
+                result: ash::vk::Result::ERROR_DEVICE_LOST,
+            }
+            .into());
+        }
+        if self.gpu_generation != self.generation {
+            // A new document: a new GPU world on the same device (the old one goes first).
+            let ctx = gfx.viewport.ctx().clone();
+            let next = {
+                let doc = self.read();
+                let view = doc.scene.world.read();
+                Viewport::new(ctx, &view)?
+            };
+            gfx.viewport = next;
+            self.gpu_generation = self.generation;
+        }
+        let capture_now = self
+            .script
+            .as_ref()
+            .is_some_and(|s| s.captured_at.is_none() && s.finished)
+            && gfx.viewport.samples() >= self.settings.target_spp;
+        // The status line and the panels.
+        self.panels.busy = self.files.running.clone();
+        self.panels.busy.extend(self.edits.pending.iter().cloned());
+        let samples = gfx.viewport.samples();
+        let gpu_ms = gfx.viewport.last_gpu_seconds().map_or(0.0, |s| s * 1e3);
+        let size = gfx.window.inner_size();
+        let internal = self.internal_size((size.width, size.height));
+        let paths = internal.0 as f64 * internal.1 as f64 * self.last_added as f64;
+        self.panels.status = format!(
+            "{samples}/{} spp · GPU {gpu_ms:.2} ms/frame · {:.1} Mpaths/s · internal {}x{}{} · {}{}",
+            self.settings.target_spp,
+            if gpu_ms > 0.0 {
+                paths / gpu_ms / 1e3
+            } else {
+                0.0
+            },
+            internal.0,
+            internal.1,
+            if self.view.camera.is_orthographic() {
+                " · orthographic"
+            } else {
+                ""
+            },
+            gfx.viewport.ctx().name,
+            self.latency.map_or_else(String::new, |l| format!(
+                " · input to photon {:.1} ms",
+                l.as_secs_f64() * 1e3
+            )),
+        );
+        // The title only when it changes (each set is a round trip to the window system).
+        let title = files::title(&self.read());
+        if title != self.title {
+            gfx.window.set_title(&title);
+            self.title = title;
+        }
+        let raw = gfx.egui_state.take_egui_input(&gfx.window);
+        let egui_ctx = self.egui.clone();
+        let mut events = Vec::new();
+        let output = {
+            let doc = self.doc.clone();
+            let doc = doc.read().unwrap_or_else(|p| p.into_inner());
+            egui_ctx.run_ui(raw, |ui| {
+                events = panels::draw(ui, &mut self.panels, &doc, &mut self.settings);
+            })
+        };
+        for e in events {
+            self.ui_event(e);
+        }
+        let egui::FullOutput {
+            platform_output,
+            textures_delta,
+            shapes,
+            pixels_per_point,
+            viewport_output,
+        } = output;
+        gfx.egui_state
+            .handle_platform_output(&gfx.window, platform_output);
+        // Texture changes wait here until a frame with the UI applies them.
+        self.pending_textures.append(textures_delta);
+        let primitives = egui_ctx.tessellate(shapes, pixels_per_point);
+        let moving = Instant::now() < self.moving_until;
+        let internal = if moving {
+            scaled(
+                (size.width, size.height),
+                self.settings.moving_scale.min(self.settings.internal_scale),
+            )
+        } else {
+            internal
+        };
+        let doc = self.doc.clone();
+        let doc = doc.read().unwrap_or_else(|p| p.into_inner());
+        let mut params = doc.scene.params.clone();
+        params.camera = self.view.camera.clone();
+        let request = FrameRequest {
+            params: &params,
+            internal,
+            output: (size.width, size.height),
+            spp: self.spp_per_frame,
+            target_spp: self.settings.target_spp,
+            exposure: doc.scene.params.settings.exposure + self.settings.exposure,
+            bgra: false,
+        };
+        let ui = (!capture_now).then(|| EguiFrame {
+            primitives: &primitives,
+            pixels_per_point,
+            textures: &self.pending_textures,
+        });
+        let (presented, captured) = gfx.presenter.frame(
+            &mut gfx.viewport,
+            &doc.scene.world,
+            &request,
+            ui,
+            capture_now,
+        )?;
+        drop(doc);
+        match &presented {
+            Presented::Shown(status) => {
+                if !capture_now {
+                    self.pending_textures.clear();
+                }
+                self.last_added = status.added;
+                if let Some(t) = self.move_event.take() {
+                    self.latency = Some(t.elapsed());
+                }
+                self.adapt_samples(gfx.viewport.last_gpu_seconds());
+            }
+            Presented::NotReady | Presented::Recreated => gfx.window.request_redraw(),
+        }
+        if let Some(c) = captured {
+            self.finish_capture(gfx, c)?;
+        }
+        if let Some(s) = &self.script
+            && let Some(at) = s.captured_at
+            && at.elapsed() >= self.options.linger
+        {
+            let errors = gfx.viewport.ctx().validation_errors();
+            if errors > 0 {
+                anyhow::bail!("{errors} Vulkan validation errors");
+            }
+            event_loop.exit();
+        }
+        if self.quitting {
+            event_loop.exit();
+        }
+        // Keep drawing while refining, moving, running a script or waiting for files.
+        let busy = gfx.viewport.samples() < self.settings.target_spp
+            || moving
+            || !self.flying.is_empty()
+            || self.script.is_some()
+            || !self.files.running.is_empty()
+            || self.edits.busy()
+            || !self.saves_waiting.is_empty()
+            || !self.saved.is_empty()
+            || viewport_output.values().any(|v| v.repaint_delay.is_zero());
+        if busy {
+            gfx.window.request_redraw();
+        }
+        Ok(())
+    }
+
+    pub(super) fn internal_size(&self, size: (u32, u32)) -> (u32, u32) {
+        scaled(size, self.settings.internal_scale)
+    }
+
+    /// Samples per frame follow the GPU time: about 16 ms of tracing per frame.
+    pub(super) fn adapt_samples(&mut self, gpu: Option<f64>) {
+        let Some(t) = gpu else { return };
+        if t < 0.008 && self.spp_per_frame < 16 {
+            self.spp_per_frame *= 2;
+        } else if t > 0.033 && self.spp_per_frame > 1 {
+            self.spp_per_frame /= 2;
+        }
+    }
+
+    /// Runs the script's next step, one per frame, so the viewport shows each edit; a camera
+    /// step resets the view to the scene camera (what the capture is compared against).
+    /// Queues the script's next step on the edit thread (the same path as the UI's own
+    /// edits), one at a time: the frame after a step shows it.
+    pub(super) fn step_script(&mut self) {
+        let Some(s) = &mut self.script else {
+            return;
+        };
+        if s.finished {
+            return;
+        }
+        if let Some(run) = s.run.take() {
+            self.edits
+                .submit(&self.doc, Edit::ScriptStep(s.script.clone(), run));
+        }
+    }
+
+    pub(super) fn finish_capture(&mut self, gfx: &Gfx, c: render::present::Capture) -> Result<()> {
+        let Some(s) = &mut self.script else {
+            return Ok(());
+        };
+        s.captured_at = Some(Instant::now());
+        if let Some(path) = &s.capture {
+            let bytes: Vec<u8> = c.rgb.iter().flatten().copied().collect();
+            crate::atomic::write_atomic(path, |w| {
+                render::image::write_png_rgb8(w, c.width, c.height, &bytes)
+            })
+            .with_context(|| format!("writing {}", path.display()))?;
+            println!(
+                "captured {}x{} at {} spp to {}",
+                c.width,
+                c.height,
+                gfx.viewport.samples(),
+                path.display()
+            );
+        }
+        Ok(())
+    }
+}
+
+pub(super) fn scaled((w, h): (u32, u32), f: f32) -> (u32, u32) {
+    let f = f.clamp(0.05, 1.0) as f64;
+    (
+        ((w as f64 * f).ceil() as u32).max(1),
+        ((h as f64 * f).ceil() as u32).max(1),
+    )
+}
