@@ -115,7 +115,7 @@ impl Editor {
         let capture_now = self
             .script
             .as_ref()
-            .is_some_and(|s| s.captured_at.is_none() && s.finished)
+            .is_some_and(|s| s.captured_at.is_none() && s.finished && self.outcome.is_ok())
             && gfx.viewport.samples() >= self.settings.target_spp;
         // The status line and the panels.
         self.panels.busy = self.files.running.clone();
