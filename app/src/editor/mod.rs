@@ -7,6 +7,7 @@ mod error;
 mod fill;
 pub mod history;
 mod inverse;
+pub mod live;
 pub mod script;
 
 pub use error::{EditError, Result};
@@ -43,6 +44,8 @@ pub struct Document {
     pub folder: PathBuf,
     /// When set, every successful command, undo, redo and save is recorded as a script step.
     pub recorder: Option<script::Recorder>,
+    /// The stroke being drawn, if any (see [`live`]).
+    live: Option<live::LiveStroke>,
 }
 
 impl Document {
@@ -56,14 +59,76 @@ impl Document {
             history,
             folder: PathBuf::from("."),
             recorder: None,
+            live: None,
         }
+    }
+
+    fn changed(&mut self) {
+        self.dirty = true;
+        self.revision += 1;
+    }
+
+    /// Starts drawing a stroke: its first points are applied now. A stroke already open is
+    /// finished first (one step each). On error nothing changed.
+    pub fn begin_stroke(&mut self, stroke: command::Stroke) -> Result<()> {
+        self.end_stroke()?;
+        self.live = Some(live::LiveStroke::begin(&self.scene, stroke)?);
+        self.changed();
+        Ok(())
+    }
+
+    /// Adds points to the open stroke (visible as soon as this returns). On error the whole
+    /// stroke is undone and closed, and nothing reaches the history.
+    pub fn extend_stroke(&mut self, points: &[glam::DVec3]) -> Result<()> {
+        let Some(live) = &mut self.live else {
+            return Err(error::invalid("no stroke is being drawn"));
+        };
+        let result = live.extend(&self.scene, points);
+        if result.is_err() {
+            self.live = None;
+        }
+        self.changed();
+        result
+    }
+
+    /// Ends the open stroke as one history step (recorded as the whole stroke); Ok(None)
+    /// when none was open. On error nothing of the stroke remains.
+    pub fn end_stroke(&mut self) -> Result<Option<Executed>> {
+        let Some(live) = self.live.take() else {
+            return Ok(None);
+        };
+        let (stroke, inverse, changed_voxels) = live.finish(&self.scene)?;
+        self.changed();
+        let command = Command::Stroke(stroke);
+        if let Some(r) = &mut self.recorder {
+            r.record(script::Step::Do(command.clone()));
+        }
+        let dropped = self.history.push(command, inverse);
+        Ok(Some(Executed {
+            dropped,
+            changed_voxels,
+        }))
+    }
+
+    /// Abandons the open stroke, undoing what it applied (nothing reaches the history).
+    pub fn abort_stroke(&mut self) -> Result<()> {
+        if let Some(live) = self.live.take() {
+            live.abort(&self.scene)?;
+            self.changed();
+        }
+        Ok(())
+    }
+
+    /// The stroke being drawn.
+    pub fn live_stroke(&self) -> Option<&live::LiveStroke> {
+        self.live.as_ref()
     }
 
     /// Executes a command and records it; on error nothing changed (world, tables, history).
     pub fn execute(&mut self, command: Command) -> Result<Executed> {
+        self.end_stroke()?;
         let applied = command.apply(&mut self.scene, &self.folder)?;
-        self.dirty = true;
-        self.revision += 1;
+        self.changed();
         if let Some(r) = &mut self.recorder {
             r.record(script::Step::Do(command.clone()));
         }
@@ -76,14 +141,14 @@ impl Document {
 
     /// Undoes the latest step; the label of what was undone.
     pub fn undo(&mut self) -> Result<String> {
+        self.end_stroke()?;
         let Some(step) = self.history.take_undo() else {
             return Err(EditError::NothingToUndo);
         };
         let (label, command, inverse) = step.into_parts();
         let redo = inverse.apply(&mut self.scene)?;
         self.history.push_redo(label.clone(), command, redo);
-        self.dirty = true;
-        self.revision += 1;
+        self.changed();
         if let Some(r) = &mut self.recorder {
             r.record(script::Step::Undo);
         }
@@ -92,14 +157,14 @@ impl Document {
 
     /// Redoes the latest undone step; its label.
     pub fn redo(&mut self) -> Result<String> {
+        self.end_stroke()?;
         let Some(step) = self.history.take_redo() else {
             return Err(EditError::NothingToRedo);
         };
         let (label, command, inverse) = step.into_parts();
         let undo = inverse.apply(&mut self.scene)?;
         self.history.push_undone(label.clone(), command, undo);
-        self.dirty = true;
-        self.revision += 1;
+        self.changed();
         if let Some(r) = &mut self.recorder {
             r.record(script::Step::Redo);
         }

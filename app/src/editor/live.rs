@@ -1,0 +1,144 @@
+//! A stroke being drawn: one undo step that grows while the mouse moves. Each new segment's
+//! edits go to the world's workers as soon as it is given (the edit thread runs it; the UI
+//! never waits), so it is visible the next frame; on release the step's inverse is the
+//! union of its segments' inverses, and the history gets the whole stroke as one command
+//! (scripts and the recorder replay it at once, to the same content hash). A segment that
+//! fails undoes everything the stroke applied.
+//!
+//! Segments are applied one after another, not pipelined: if a later edit were queued
+//! behind one that fails, the failed edit's rollback would land after it and undo part of
+//! it too.
+
+use super::brush::{BrushShape, Stroke, stroke_edits};
+use super::error::{EditError, Result, invalid};
+use super::inverse::Inverse;
+use crate::scene::Scene;
+use brickmap::{EditInverse, EditOp};
+use glam::DVec3;
+
+/// The open stroke of a document.
+#[derive(Debug)]
+pub struct LiveStroke {
+    /// The stroke so far (every point given).
+    pub stroke: Stroke,
+    inverses: Vec<EditInverse>,
+    /// Voxels changed so far (by the segments; a voxel changed twice counts twice).
+    pub changed_voxels: u64,
+}
+
+impl LiveStroke {
+    /// Starts a stroke at its first points and applies them (a box waits for its last corner:
+    /// nothing is applied until the end). On error nothing changed.
+    pub fn begin(scene: &Scene, stroke: Stroke) -> Result<Self> {
+        // Validate the whole stroke (points, size, material) before touching the world.
+        stroke_edits(&stroke)?;
+        if stroke.mode != super::brush::BrushMode::Erase {
+            scene.world.materials().check(stroke.material as u32)?;
+        }
+        let mut live = LiveStroke {
+            stroke: Stroke {
+                points: Vec::new(),
+                ..stroke.clone()
+            },
+            inverses: Vec::new(),
+            changed_voxels: 0,
+        };
+        live.extend(scene, &stroke.points)?;
+        Ok(live)
+    }
+
+    /// Adds points: the next segment. On error everything the stroke applied is undone (the
+    /// caller drops the stroke) and the error returned.
+    pub fn extend(&mut self, scene: &Scene, points: &[DVec3]) -> Result<()> {
+        if points.is_empty() {
+            return Ok(());
+        }
+        let edits = match self.segment(points) {
+            Ok(e) => e,
+            Err(e) => return Err(self.fail(scene, e)),
+        };
+        self.stroke.points.extend_from_slice(points);
+        if self.stroke.shape == BrushShape::Box && self.stroke.points.len() > 2 {
+            // A box is its first and latest corners.
+            let last = self.stroke.points[self.stroke.points.len() - 1];
+            self.stroke.points.truncate(1);
+            self.stroke.points.push(last);
+        }
+        for edit in edits {
+            match scene.world.apply(edit) {
+                Ok(out) => {
+                    self.changed_voxels += out.changed_voxels;
+                    self.inverses.push(out.inverse);
+                }
+                Err(e) => return Err(self.fail(scene, e.into())),
+            }
+        }
+        Ok(())
+    }
+
+    /// The edits of the segment that adds `points`: a polyline continues from the last
+    /// point; a box is applied only at the end.
+    fn segment(&self, points: &[DVec3]) -> Result<Vec<EditOp>> {
+        let mut part = Stroke {
+            points: points.to_vec(),
+            ..self.stroke.clone()
+        };
+        // Validated even when nothing is applied yet (a box's corners).
+        stroke_edits(&part)?;
+        match self.stroke.shape {
+            BrushShape::Box => Ok(Vec::new()),
+            BrushShape::Line => {
+                if let Some(last) = self.stroke.points.last() {
+                    part.points.insert(0, *last);
+                }
+                stroke_edits(&part)
+            }
+            _ => stroke_edits(&part),
+        }
+    }
+
+    /// Undoes what the stroke applied and returns `error` (or the failure to undo).
+    fn fail(&mut self, scene: &Scene, error: EditError) -> EditError {
+        match undo_all(scene, std::mem::take(&mut self.inverses)) {
+            Ok(()) => error,
+            Err(undo) => undo,
+        }
+    }
+
+    /// Ends the stroke: a box is applied now (its first and last points). Returns the
+    /// command for the history (the whole stroke) and its inverse; on error nothing the
+    /// stroke applied remains.
+    pub fn finish(mut self, scene: &Scene) -> Result<(Stroke, Inverse, u64)> {
+        if self.stroke.points.is_empty() {
+            return Err(invalid("a stroke needs at least one point"));
+        }
+        if self.stroke.shape == BrushShape::Box {
+            for edit in stroke_edits(&self.stroke)? {
+                match scene.world.apply(edit) {
+                    Ok(out) => {
+                        self.changed_voxels += out.changed_voxels;
+                        self.inverses.push(out.inverse);
+                    }
+                    Err(e) => return Err(self.fail(scene, e.into())),
+                }
+            }
+        }
+        Ok((
+            self.stroke,
+            Inverse::Voxels(self.inverses, None),
+            self.changed_voxels,
+        ))
+    }
+
+    /// Abandons the stroke, undoing what it applied.
+    pub fn abort(self, scene: &Scene) -> Result<()> {
+        undo_all(scene, self.inverses)
+    }
+}
+
+fn undo_all(scene: &Scene, inverses: Vec<EditInverse>) -> Result<()> {
+    for inv in inverses.into_iter().rev() {
+        scene.world.apply(EditOp::Restore(inv))?;
+    }
+    Ok(())
+}

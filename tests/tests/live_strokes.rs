@@ -1,0 +1,190 @@
+//! Live strokes: a drag is one undoable step that grows segment by segment. For every shape
+//! and mode (and with mirror symmetry), the segments give the content hash of the same stroke
+//! applied at once; undo restores the exact hash before the stroke, redo the one after; a
+//! segment that fails undoes the whole stroke; the recorder replays the stroke at once to the
+//! same hash.
+
+use app::editor::Document;
+use app::editor::command::{BrushMode, BrushShape, Command, Mirror, Stroke};
+use app::editor::history::History;
+use app::editor::{EditError, script};
+use app::scene::{SceneSize, default_scene};
+use glam::DVec3;
+
+fn document() -> Document {
+    Document::new(
+        default_scene(SceneSize::Small, 2).unwrap(),
+        History::default(),
+    )
+}
+
+fn hash(doc: &Document) -> u64 {
+    doc.scene.world.read().content_hash()
+}
+
+/// A wandering drag over the small default scene's ground (128 × 64 × 128).
+fn drag() -> Vec<DVec3> {
+    (0..12)
+        .map(|i| {
+            let t = i as f64;
+            DVec3::new(30.0 + 5.0 * t, 34.0 + (t * 0.7).sin() * 6.0, 40.0 + 3.0 * t)
+        })
+        .collect()
+}
+
+fn stroke(mode: BrushMode, shape: BrushShape, mirror: bool) -> Stroke {
+    Stroke {
+        mode,
+        shape,
+        size: 3.5,
+        material: 4,
+        mirror: Mirror {
+            x: mirror,
+            z: mirror,
+            centre: DVec3::new(64.0, 0.0, 64.0),
+            ..Mirror::default()
+        },
+        points: drag(),
+    }
+}
+
+#[test]
+fn segments_give_the_hash_of_the_stroke_applied_at_once_and_undo_exactly() {
+    use BrushShape::*;
+    for shape in [Voxel, Sphere, Cube, Cylinder, Line, Box] {
+        for mode in [BrushMode::Attach, BrushMode::Erase, BrushMode::Paint] {
+            for mirror in [false, true] {
+                let what = format!("{shape:?} {mode:?} mirror {mirror}");
+                let s = stroke(mode, shape, mirror);
+                let mut at_once = document();
+                at_once.execute(Command::Stroke(s.clone())).unwrap();
+                let mut live = document();
+                let before = hash(&live);
+                let points = s.points.clone();
+                // First two points, then segments of one, three and the rest.
+                live.begin_stroke(Stroke {
+                    points: points[..2].to_vec(),
+                    ..s.clone()
+                })
+                .unwrap();
+                live.extend_stroke(&points[2..3]).unwrap();
+                live.extend_stroke(&points[3..6]).unwrap();
+                live.extend_stroke(&points[6..]).unwrap();
+                assert!(live.live_stroke().is_some());
+                let done = live.end_stroke().unwrap().expect("a stroke was open");
+                let after = hash(&live);
+                assert_eq!(after, hash(&at_once), "{what}");
+                if mode != BrushMode::Erase || shape != Voxel {
+                    assert_ne!(after, before, "{what}: the stroke changed something");
+                    assert!(done.changed_voxels > 0, "{what}");
+                }
+                assert_eq!(live.history.undo_len(), 1, "{what}: one step");
+                live.undo().unwrap();
+                assert_eq!(hash(&live), before, "{what}: undo");
+                live.redo().unwrap();
+                assert_eq!(hash(&live), after, "{what}: redo");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_box_follows_its_last_corner_and_is_applied_on_release() {
+    let mut doc = document();
+    let before = hash(&doc);
+    let s = Stroke {
+        points: vec![DVec3::new(20.0, 40.0, 20.0)],
+        ..stroke(BrushMode::Attach, BrushShape::Box, false)
+    };
+    doc.begin_stroke(s.clone()).unwrap();
+    doc.extend_stroke(&[DVec3::new(90.0, 45.0, 90.0)]).unwrap();
+    doc.extend_stroke(&[DVec3::new(30.0, 44.0, 35.0)]).unwrap();
+    assert_eq!(hash(&doc), before, "nothing until release");
+    doc.end_stroke().unwrap();
+    let mut at_once = document();
+    at_once
+        .execute(Command::Stroke(Stroke {
+            points: vec![s.points[0], DVec3::new(30.0, 44.0, 35.0)],
+            ..s
+        }))
+        .unwrap();
+    assert_eq!(hash(&doc), hash(&at_once));
+}
+
+#[test]
+fn a_failing_segment_undoes_the_whole_stroke_and_leaves_no_step() {
+    let mut doc = document();
+    let before = hash(&doc);
+    let s = stroke(BrushMode::Attach, BrushShape::Sphere, false);
+    doc.begin_stroke(s.clone()).unwrap();
+    assert_ne!(hash(&doc), before);
+    let err = doc
+        .extend_stroke(&[DVec3::new(40.0, f64::NAN, 40.0)])
+        .unwrap_err();
+    assert!(matches!(err, EditError::Invalid(_)), "{err}");
+    assert_eq!(hash(&doc), before, "the stroke so far is undone");
+    assert!(doc.live_stroke().is_none());
+    assert_eq!(doc.end_stroke().unwrap().map(|e| e.changed_voxels), None);
+    assert_eq!(doc.history.undo_len(), 0);
+    // A bad material is refused before anything is applied.
+    let err = doc
+        .begin_stroke(Stroke {
+            material: 250,
+            ..s.clone()
+        })
+        .unwrap_err();
+    assert!(matches!(err, EditError::World(_)), "{err}");
+    assert_eq!(hash(&doc), before);
+    // Abort undoes what was applied.
+    doc.begin_stroke(s).unwrap();
+    doc.abort_stroke().unwrap();
+    assert_eq!(hash(&doc), before);
+    assert_eq!(doc.history.undo_len(), 0);
+}
+
+#[test]
+fn a_recorded_live_stroke_replays_to_the_same_hash() {
+    let mut doc = document();
+    doc.recorder = Some(script::Recorder::default());
+    let s = stroke(BrushMode::Attach, BrushShape::Line, true);
+    doc.begin_stroke(Stroke {
+        points: s.points[..1].to_vec(),
+        ..s.clone()
+    })
+    .unwrap();
+    for p in &s.points[1..] {
+        doc.extend_stroke(std::slice::from_ref(p)).unwrap();
+    }
+    // Undo finishes the open stroke first: it is one step, then undone.
+    doc.undo().unwrap();
+    doc.redo().unwrap();
+    let steps = doc
+        .recorder
+        .take()
+        .unwrap()
+        .script(
+            script::Start::New {
+                size: (1, 1, 1),
+                terrain: None,
+            },
+            None,
+        )
+        .steps;
+    assert_eq!(steps.len(), 3, "{steps:?}");
+    let mut replayed = document();
+    for step in steps {
+        match step {
+            script::Step::Do(c) => {
+                replayed.execute(c).unwrap();
+            }
+            script::Step::Undo => {
+                replayed.undo().unwrap();
+            }
+            script::Step::Redo => {
+                replayed.redo().unwrap();
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+    assert_eq!(hash(&replayed), hash(&doc));
+}
