@@ -188,3 +188,49 @@ fn a_recorded_live_stroke_replays_to_the_same_hash() {
     }
     assert_eq!(hash(&replayed), hash(&doc));
 }
+
+#[test]
+fn the_preview_is_exactly_what_the_click_then_changes() {
+    use BrushShape::*;
+    let doc = document();
+    let dims = doc.scene.world.dims().voxels();
+    let snapshot = |doc: &Document| {
+        let view = doc.scene.world.read();
+        let mut all = Vec::with_capacity((dims.x * dims.y * dims.z) as usize);
+        for x in 0..dims.x {
+            for y in 0..dims.y {
+                for z in 0..dims.z {
+                    all.push(view.voxel(glam::IVec3::new(x, y, z)).unwrap());
+                }
+            }
+        }
+        all
+    };
+    let before = snapshot(&doc);
+    drop(doc);
+    for shape in [Voxel, Sphere, Cube, Cylinder, Box] {
+        for mode in [BrushMode::Attach, BrushMode::Erase, BrushMode::Paint] {
+            let mut doc = document();
+            let s = Stroke {
+                points: vec![DVec3::new(50.5, 33.5, 60.5), DVec3::new(58.5, 38.5, 66.5)],
+                ..stroke(mode, shape, true)
+            };
+            let preview = {
+                let view = doc.scene.world.read();
+                app::editor::command::preview(&view, &s).unwrap().unwrap()
+            };
+            doc.execute(Command::Stroke(s)).unwrap();
+            let after = snapshot(&doc);
+            let changed: Vec<glam::IVec3> = (0..before.len())
+                .filter(|&i| before[i] != after[i])
+                .map(|i| {
+                    let i = i as i32;
+                    glam::IVec3::new(i / (dims.y * dims.z), i / dims.z % dims.y, i % dims.z)
+                })
+                .collect();
+            let what = format!("{shape:?} {mode:?}");
+            assert!(!changed.is_empty(), "{what} changes something");
+            assert_eq!(preview, changed, "{what}");
+        }
+    }
+}

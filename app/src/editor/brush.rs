@@ -2,7 +2,7 @@
 
 use super::error::{EditError, Result, invalid};
 use brickmap::{EditOp, Mode, Shape};
-use glam::DVec3;
+use glam::{DVec3, IVec3};
 use serde::{Deserialize, Serialize};
 
 /// What a brush does.
@@ -153,4 +153,56 @@ pub fn stroke_edits(s: &Stroke) -> Result<Vec<EditOp>> {
         }
     }
     Ok(edits)
+}
+
+/// The most voxels a preview examines; a larger brush previews nothing (its outline is
+/// drawn instead).
+pub const PREVIEW_LIMIT: u64 = 4 << 20;
+
+/// Exactly the voxels `stroke` would change in the world as it is now, sorted by x, then y,
+/// then z (the brush preview); None when the brush covers more than [`PREVIEW_LIMIT`] voxels.
+pub fn preview(view: &brickmap::WorldView<'_>, stroke: &Stroke) -> Result<Option<Vec<IVec3>>> {
+    let edits = stroke_edits(stroke)?;
+    let dims = view.dims().voxels();
+    let mut examined = 0u64;
+    let mut out = std::collections::BTreeSet::new();
+    for edit in &edits {
+        let EditOp::Shape { shape, mode } = edit else {
+            continue;
+        };
+        let (lo, hi) = shape.voxel_bounds();
+        let (lo, hi) = (lo.max(IVec3::ZERO), hi.min(dims - 1));
+        if lo.cmpgt(hi).any() {
+            continue;
+        }
+        let n = (hi - lo + 1).as_u64vec3();
+        examined += n.x * n.y * n.z;
+        if examined > PREVIEW_LIMIT {
+            return Ok(None);
+        }
+        for x in lo.x..=hi.x {
+            for y in lo.y..=hi.y {
+                for z in lo.z..=hi.z {
+                    let v = IVec3::new(x, y, z);
+                    if !shape.contains(v) {
+                        continue;
+                    }
+                    let now = view.voxel(v).map_err(EditError::World)?;
+                    let changes = match mode {
+                        Mode::Add(m) => now != Some(*m),
+                        Mode::Remove => now.is_some(),
+                        Mode::Paint(m) => now.is_some_and(|c| c != *m),
+                    };
+                    if changes {
+                        out.insert((x, y, z));
+                    }
+                }
+            }
+        }
+    }
+    Ok(Some(
+        out.into_iter()
+            .map(|(x, y, z)| IVec3::new(x, y, z))
+            .collect(),
+    ))
 }

@@ -2,7 +2,7 @@
 //! recorder use the same form). `apply` executes one and returns how to undo it
 //! ([`Inverse`]). Strokes are in `brush`, flood fill in `fill`.
 
-pub use super::brush::{BrushMode, BrushShape, Mirror, Stroke, stroke_edits};
+pub use super::brush::{BrushMode, BrushShape, Mirror, PREVIEW_LIMIT, Stroke, preview, stroke_edits};
 pub use super::inverse::{Applied, Inverse};
 
 use super::error::{EditError, Result};
