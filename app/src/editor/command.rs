@@ -2,7 +2,9 @@
 //! recorder use the same form). `apply` executes one and returns how to undo it
 //! ([`Inverse`]). Strokes are in `brush`, flood fill in `fill`.
 
-pub use super::brush::{BrushMode, BrushShape, Mirror, PREVIEW_LIMIT, Stroke, preview, stroke_edits};
+pub use super::brush::{
+    BrushMode, BrushShape, Mirror, PREVIEW_LIMIT, Stroke, preview, stroke_edits,
+};
 pub use super::inverse::{Applied, Inverse};
 
 use super::error::{EditError, Result};
@@ -118,6 +120,27 @@ impl From<KindSpec> for MaterialKind {
             KindSpec::Metal => MaterialKind::Metal,
             KindSpec::Dielectric => MaterialKind::Dielectric,
             KindSpec::Emissive => MaterialKind::Emissive,
+        }
+    }
+}
+
+impl From<MaterialKind> for KindSpec {
+    fn from(k: MaterialKind) -> Self {
+        match k {
+            MaterialKind::Lambertian => KindSpec::Lambertian,
+            MaterialKind::Metal => KindSpec::Metal,
+            MaterialKind::Dielectric => KindSpec::Dielectric,
+            MaterialKind::Emissive => KindSpec::Emissive,
+        }
+    }
+}
+
+impl From<Material> for MaterialSpec {
+    fn from(m: Material) -> Self {
+        MaterialSpec {
+            kind: m.kind.into(),
+            param: m.param,
+            colour: m.colour,
         }
     }
 }

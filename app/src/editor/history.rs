@@ -19,13 +19,15 @@ pub struct Step {
     pub command: Command,
     /// How to undo (in the undo list) or redo (in the redo list).
     pub inverse: Inverse,
+    /// Voxels the step changed (for the history list).
+    pub changed_voxels: u64,
     bytes: usize,
 }
 
 impl Step {
-    /// Label, command and inverse.
-    pub fn into_parts(self) -> (String, Command, Inverse) {
-        (self.label, self.command, self.inverse)
+    /// Label, command, inverse and voxels changed.
+    pub fn into_parts(self) -> (String, Command, Inverse, u64) {
+        (self.label, self.command, self.inverse, self.changed_voxels)
     }
 }
 
@@ -58,7 +60,7 @@ impl History {
     }
 
     /// Records an executed command; returns how many old steps were dropped to fit the budget.
-    pub fn push(&mut self, command: Command, inverse: Inverse) -> u64 {
+    pub fn push(&mut self, command: Command, inverse: Inverse, changed_voxels: u64) -> u64 {
         self.clear_redo();
         let key = command.coalesce_key();
         if let (Some(key), Some(last)) = (&key, self.undo.back_mut())
@@ -67,6 +69,7 @@ impl History {
             // Keep the oldest inverse (the value before the drag), take the newest command.
             last.label = command.label();
             last.command = command;
+            last.changed_voxels += changed_voxels;
             return 0;
         }
         let bytes = inverse.bytes() + std::mem::size_of::<Step>();
@@ -75,6 +78,7 @@ impl History {
             label: command.label(),
             command,
             inverse,
+            changed_voxels,
             bytes,
         });
         let mut dropped = 0;
@@ -95,13 +99,14 @@ impl History {
     }
 
     /// Puts an undone step on the redo list with the inverse that redoes it.
-    pub fn push_redo(&mut self, label: String, command: Command, redo: Inverse) {
+    pub fn push_redo(&mut self, label: String, command: Command, redo: Inverse, changed: u64) {
         let bytes = redo.bytes() + std::mem::size_of::<Step>();
         self.bytes += bytes;
         self.redo.push(Step {
             label,
             command,
             inverse: redo,
+            changed_voxels: changed,
             bytes,
         });
     }
@@ -114,13 +119,14 @@ impl History {
     }
 
     /// Puts a redone step back on the undo list with the inverse that undoes it again.
-    pub fn push_undone(&mut self, label: String, command: Command, undo: Inverse) {
+    pub fn push_undone(&mut self, label: String, command: Command, undo: Inverse, changed: u64) {
         let bytes = undo.bytes() + std::mem::size_of::<Step>();
         self.bytes += bytes;
         self.undo.push_back(Step {
             label,
             command,
             inverse: undo,
+            changed_voxels: changed,
             bytes,
         });
     }
@@ -134,6 +140,14 @@ impl History {
     /// Labels of the undoable steps, oldest first.
     pub fn labels(&self) -> Vec<&str> {
         self.undo.iter().map(|s| s.label.as_str()).collect()
+    }
+    /// The undoable steps, oldest first.
+    pub fn undo_steps(&self) -> impl Iterator<Item = &Step> {
+        self.undo.iter()
+    }
+    /// The redoable steps, the next to redo first.
+    pub fn redo_steps(&self) -> impl Iterator<Item = &Step> {
+        self.redo.iter().rev()
     }
     /// Steps that can be undone.
     pub fn undo_len(&self) -> usize {

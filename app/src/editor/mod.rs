@@ -103,7 +103,7 @@ impl Document {
         if let Some(r) = &mut self.recorder {
             r.record(script::Step::Do(command.clone()));
         }
-        let dropped = self.history.push(command, inverse);
+        let dropped = self.history.push(command, inverse, changed_voxels);
         Ok(Some(Executed {
             dropped,
             changed_voxels,
@@ -132,7 +132,9 @@ impl Document {
         if let Some(r) = &mut self.recorder {
             r.record(script::Step::Do(command.clone()));
         }
-        let dropped = self.history.push(command, applied.inverse);
+        let dropped = self
+            .history
+            .push(command, applied.inverse, applied.changed_voxels);
         Ok(Executed {
             dropped,
             changed_voxels: applied.changed_voxels,
@@ -145,9 +147,10 @@ impl Document {
         let Some(step) = self.history.take_undo() else {
             return Err(EditError::NothingToUndo);
         };
-        let (label, command, inverse) = step.into_parts();
+        let (label, command, inverse, changed) = step.into_parts();
         let redo = inverse.apply(&mut self.scene)?;
-        self.history.push_redo(label.clone(), command, redo);
+        self.history
+            .push_redo(label.clone(), command, redo, changed);
         self.changed();
         if let Some(r) = &mut self.recorder {
             r.record(script::Step::Undo);
@@ -161,9 +164,10 @@ impl Document {
         let Some(step) = self.history.take_redo() else {
             return Err(EditError::NothingToRedo);
         };
-        let (label, command, inverse) = step.into_parts();
+        let (label, command, inverse, changed) = step.into_parts();
         let undo = inverse.apply(&mut self.scene)?;
-        self.history.push_undone(label.clone(), command, undo);
+        self.history
+            .push_undone(label.clone(), command, undo, changed);
         self.changed();
         if let Some(r) = &mut self.recorder {
             r.record(script::Step::Redo);

@@ -55,6 +55,13 @@ impl Editor {
                     self.panels.errors.push(e.to_string());
                 }
             }
+            Edited::Stroke(result) => {
+                if let Err(e) = result {
+                    // The stroke is undone and closed: stop sending it segments.
+                    self.drawing = None;
+                    self.panels.errors.push(format!("stroke: {e}"));
+                }
+            }
             Edited::ScriptStep {
                 run,
                 result,

@@ -29,6 +29,7 @@ impl Editor {
         .context("no Vulkan device can draw this window")?;
         let ctx = Arc::new(ctx);
         let size = window.inner_size();
+        self.window_size = (size.width, size.height);
         let presenter = Presenter::new(ctx.clone(), (size.width, size.height))?;
         let viewport = {
             let doc = self.read();
@@ -158,7 +159,16 @@ impl Editor {
         let output = {
             let doc = self.doc.clone();
             let doc = doc.read().unwrap_or_else(|p| p.into_inner());
+            {
+                let view = doc.scene.world.read();
+                let stroke = self.previewed_stroke(&view);
+                self.preview.update(&view, stroke.as_ref(), doc.revision);
+            }
             egui_ctx.run_ui(raw, |ui| {
+                // Under every panel and window, over the viewport image.
+                let painter = ui.ctx().layer_painter(egui::LayerId::background());
+                self.preview
+                    .paint(&painter, &self.view, ui.ctx().content_rect());
                 events = panels::draw(ui, &mut self.panels, &doc, &mut self.settings);
             })
         };

@@ -2,6 +2,7 @@
 //! buttons that move the view. Pure functions of keys and modifiers, so they are tested
 //! without a window.
 
+use crate::editor::command::{BrushMode, BrushShape};
 use glam::DVec3;
 use winit::event::MouseButton;
 use winit::keyboard::KeyCode;
@@ -40,6 +41,14 @@ pub enum Action {
     Frame,
     /// Switch between perspective and orthographic.
     ToggleProjection,
+    /// Brush one voxel smaller.
+    BrushSmaller,
+    /// Brush one voxel larger.
+    BrushLarger,
+    /// Brush mode.
+    Mode(BrushMode),
+    /// Brush shape.
+    Shape(BrushShape),
     /// Store the view in camera slot n (1..=9).
     StoreView(u8),
     /// Recall camera slot n.
@@ -84,6 +93,17 @@ pub fn action_for_key(key: KeyCode, m: Mods) -> Option<Action> {
         (KeyQ, true, false) => Action::Quit,
         (KeyF, false, false) => Action::Frame,
         (KeyO, false, false) | (Numpad5, false, false) => Action::ToggleProjection,
+        (BracketLeft, false, _) => Action::BrushSmaller,
+        (BracketRight, false, _) => Action::BrushLarger,
+        (KeyT, false, false) => Action::Mode(BrushMode::Attach),
+        (KeyX, false, false) => Action::Mode(BrushMode::Erase),
+        (KeyP, false, false) => Action::Mode(BrushMode::Paint),
+        (KeyV, false, false) => Action::Shape(BrushShape::Voxel),
+        (KeyB, false, false) => Action::Shape(BrushShape::Sphere),
+        (KeyC, false, false) => Action::Shape(BrushShape::Cube),
+        (KeyY, false, false) => Action::Shape(BrushShape::Cylinder),
+        (KeyL, false, false) => Action::Shape(BrushShape::Line),
+        (KeyR, false, false) => Action::Shape(BrushShape::Box),
         (F1, false, false) => Action::Help,
         _ => return None,
     })
@@ -123,6 +143,15 @@ pub fn fly_axis(key: KeyCode) -> Option<DVec3> {
 
 /// Every shortcut, for the help window: (keys, what it does).
 pub const SHORTCUTS: &[(&str, &str)] = &[
+    ("Left drag", "draw with the brush (one undo step per drag)"),
+    ("Alt + click", "pick the material under the cursor"),
+    ("Esc (while drawing)", "cancel the stroke"),
+    ("T / X / P", "attach / erase / paint"),
+    (
+        "V / B / C / Y / L / R",
+        "voxel / sphere / cube / cylinder / line / box brush",
+    ),
+    ("[ / ]", "brush smaller / larger"),
     ("Right drag", "orbit about the pivot"),
     ("Middle drag, Shift + right drag", "pan"),
     ("Wheel", "zoom to the cursor"),

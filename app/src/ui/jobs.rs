@@ -6,10 +6,11 @@
 //! come back by channel, with a wake-up for the idle frame loop.
 
 use super::files::SharedDocument;
-use crate::editor::command::Command;
+use crate::editor::command::{Command, Stroke};
 use crate::editor::script::{Script, ScriptRun};
 use crate::editor::{Document, EditError, Executed};
 use crossbeam_channel::{Receiver, Sender};
+use glam::DVec3;
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex, TryLockError};
 use std::time::Duration;
@@ -24,6 +25,14 @@ pub enum Edit {
     Redo,
     /// Run a replay script's next step (the run travels with the job and comes back).
     ScriptStep(Arc<Script>, Box<ScriptRun>),
+    /// Start drawing a stroke (its first points are applied).
+    StrokeBegin(Stroke),
+    /// The stroke's next segment.
+    StrokeExtend(Vec<DVec3>),
+    /// End the stroke: one undo step.
+    StrokeEnd,
+    /// Abandon the stroke, undoing it.
+    StrokeAbort,
 }
 
 impl Edit {
@@ -34,6 +43,9 @@ impl Edit {
             Edit::Undo => "Undo".into(),
             Edit::Redo => "Redo".into(),
             Edit::ScriptStep(_, run) => format!("Script step {}", run.steps_run() + 1),
+            Edit::StrokeBegin(_) | Edit::StrokeExtend(_) => "Stroke".into(),
+            Edit::StrokeEnd => "Stroke (end)".into(),
+            Edit::StrokeAbort => "Stroke (cancel)".into(),
         }
     }
 }
@@ -46,6 +58,8 @@ pub enum Edited {
     Undo(Result<String, EditError>),
     /// A redo.
     Redo(Result<String, EditError>),
+    /// A stroke's begin, segment or end (the end reports the step).
+    Stroke(Result<Option<Executed>, EditError>),
     /// A script step: the run back, its report line (None: every step ran), and whether the
     /// scene camera changed (the view follows it).
     ScriptStep {
@@ -159,6 +173,10 @@ fn run(doc: &SharedDocument, edit: Edit) -> Edited {
         }
         Edit::Undo => Edited::Undo(d.undo()),
         Edit::Redo => Edited::Redo(d.redo()),
+        Edit::StrokeBegin(stroke) => Edited::Stroke(d.begin_stroke(stroke).map(|()| None)),
+        Edit::StrokeExtend(points) => Edited::Stroke(d.extend_stroke(&points).map(|()| None)),
+        Edit::StrokeEnd => Edited::Stroke(d.end_stroke()),
+        Edit::StrokeAbort => Edited::Stroke(d.abort_stroke().map(|()| None)),
         Edit::ScriptStep(script, mut run) => {
             let camera = d.scene.params.camera.clone();
             let result = run.step(&script, &mut d);

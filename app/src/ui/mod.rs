@@ -6,11 +6,14 @@
 
 pub mod camera;
 mod document;
+mod editing;
 pub mod files;
 mod frame;
 pub mod input;
 pub mod jobs;
 pub mod panels;
+mod preview;
+pub mod tools;
 
 use crate::Scene;
 use crate::editor::Document;
@@ -33,7 +36,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, RwLock};
 use std::time::{Duration, Instant};
 use winit::application::ApplicationHandler;
-use winit::event::{ElementState, MouseScrollDelta, WindowEvent};
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
 use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::window::{Window, WindowId};
@@ -98,6 +101,13 @@ struct LiveScript {
     captured_at: Option<Instant>,
 }
 
+/// A stroke being drawn: the layer it keeps to, its first and its last voxel sent.
+struct Drawing {
+    layer: tools::Layer,
+    first: glam::IVec3,
+    last: glam::IVec3,
+}
+
 /// What to do once the unsaved-changes question is answered.
 #[derive(Clone, Debug)]
 enum Pending {
@@ -160,6 +170,12 @@ pub struct Editor {
     latency: Option<Duration>,
     /// Frames drawn.
     frames: u64,
+    /// The window's inner size in physical pixels (cursor positions are in these).
+    window_size: (u32, u32),
+    /// The stroke being drawn with the left button.
+    drawing: Option<Drawing>,
+    /// What a click would change, under the cursor.
+    preview: preview::Preview,
     /// Tests only: the frame that fails as if the device were lost
     /// (`VOXBRICK_TEST_GPU_FAILURE_AT_FRAME`), to check nothing is lost when the GPU fails.
     fail_at_frame: Option<u64>,
@@ -254,6 +270,9 @@ impl Editor {
             move_event: None,
             latency: None,
             frames: 0,
+            window_size: (16, 9),
+            drawing: None,
+            preview: Default::default(),
             fail_at_frame: std::env::var("VOXBRICK_TEST_GPU_FAILURE_AT_FRAME")
                 .ok()
                 .and_then(|v| v.parse().ok()),
@@ -312,6 +331,10 @@ impl Editor {
                     self.moved();
                 }
             }
+            Action::BrushSmaller => self.settings.brush.resize(-1.0),
+            Action::BrushLarger => self.settings.brush.resize(1.0),
+            Action::Mode(m) => self.settings.brush.mode = m,
+            Action::Shape(s) => self.settings.brush.shape = s,
             Action::Help => self.panels.help_open = !self.panels.help_open,
             Action::Quit => self.guard_unsaved(Pending::Quit),
         }
@@ -329,6 +352,22 @@ impl Editor {
                 path: path.display().to_string(),
                 offset: glam::IVec3::from_array(offset),
             }),
+            UiEvent::SetColour { index, rgb } => self.execute(Command::SetColour { index, rgb }),
+            UiEvent::SetMaterial { index, material } => {
+                self.execute(Command::SetMaterial { index, material })
+            }
+            UiEvent::AddMaterial(m) => self.execute(Command::AddMaterial(m)),
+            UiEvent::SetParam { kind, index, value } => {
+                self.execute(Command::SetParam { kind, index, value })
+            }
+            UiEvent::Jump { undo, redo } => {
+                for _ in 0..undo {
+                    self.edits.submit(&self.doc, Edit::Undo);
+                }
+                for _ in 0..redo {
+                    self.edits.submit(&self.doc, Edit::Redo);
+                }
+            }
             UiEvent::UseViewAsSceneCamera => {
                 self.execute(Command::SetCamera(self.view.camera.clone()))
             }
@@ -372,22 +411,93 @@ impl Editor {
     }
 
     fn aspect(&self) -> f64 {
-        self.gfx.as_ref().map_or(16.0 / 9.0, |g| {
-            let s = g.window.inner_size();
-            s.width.max(1) as f64 / s.height.max(1) as f64
-        })
+        let (w, h) = self.window_size;
+        w.max(1) as f64 / h.max(1) as f64
     }
 
     /// Normalized device coordinates of the cursor (v up).
     fn cursor_ndc(&self) -> (f64, f64) {
-        let Some(g) = &self.gfx else {
-            return (0.0, 0.0);
-        };
-        let s = g.window.inner_size();
+        let (w, h) = self.window_size;
         (
-            2.0 * self.cursor.0 / s.width.max(1) as f64 - 1.0,
-            1.0 - 2.0 * self.cursor.1 / s.height.max(1) as f64,
+            2.0 * self.cursor.0 / w.max(1) as f64 - 1.0,
+            1.0 - 2.0 * self.cursor.1 / h.max(1) as f64,
         )
+    }
+
+    /// The cursor's ray.
+    fn cursor_ray(&self) -> (DVec3, DVec3) {
+        let (u, v) = self.cursor_ndc();
+        self.view.ray(u, v, self.aspect())
+    }
+
+    /// Left button down: the eyedropper (Alt) or a new stroke under the cursor.
+    fn press(&mut self) {
+        let (origin, dir) = self.cursor_ray();
+        let doc = self.doc.clone();
+        let doc = doc.read().unwrap_or_else(|p| p.into_inner());
+        let view = doc.scene.world.read();
+        if self.mods.alt {
+            if let Some((_, material)) = tools::pick(&view, origin, dir) {
+                self.settings.brush.material = material;
+            }
+            return;
+        }
+        let brush = &self.settings.brush;
+        let Some((v, layer)) = tools::start(&view, brush.mode, origin, dir) else {
+            return;
+        };
+        let stroke = brush.stroke(vec![tools::centre(v)], view.dims().voxels());
+        drop(view);
+        drop(doc);
+        self.drawing = Some(Drawing {
+            layer,
+            first: v,
+            last: v,
+        });
+        self.edits.submit(&self.doc, Edit::StrokeBegin(stroke));
+    }
+
+    /// While drawing: the stroke's next point, when the cursor reached another voxel.
+    fn stroke_to_cursor(&mut self) {
+        let Some(d) = &self.drawing else { return };
+        let (origin, dir) = self.cursor_ray();
+        let next = {
+            let doc = self.read();
+            let view = doc.scene.world.read();
+            tools::next(&view, &self.settings.brush, d.layer, origin, dir)
+        };
+        if let Some(v) = next
+            && v != d.last
+        {
+            if let Some(d) = &mut self.drawing {
+                d.last = v;
+            }
+            self.edits
+                .submit(&self.doc, Edit::StrokeExtend(vec![tools::centre(v)]));
+        }
+    }
+
+    /// The stroke a click would make now (the preview's), or a box being dragged.
+    fn previewed_stroke(
+        &self,
+        view: &brickmap::WorldView<'_>,
+    ) -> Option<crate::editor::command::Stroke> {
+        let brush = &self.settings.brush;
+        let dims = view.dims().voxels();
+        match &self.drawing {
+            Some(d) if brush.shape == crate::editor::command::BrushShape::Box => {
+                Some(brush.stroke(vec![tools::centre(d.first), tools::centre(d.last)], dims))
+            }
+            Some(_) => None,
+            None => {
+                if self.egui.egui_wants_pointer_input() || self.egui.is_pointer_over_egui() {
+                    return None;
+                }
+                let (origin, dir) = self.cursor_ray();
+                let (v, _) = tools::start(view, brush.mode, origin, dir)?;
+                Some(brush.stroke(vec![tools::centre(v)], dims))
+            }
+        }
     }
 
     fn zoom(&mut self, steps: f64) {
@@ -510,6 +620,7 @@ impl Editor {
         match event {
             WindowEvent::CloseRequested => self.action(Action::Quit),
             WindowEvent::Resized(size) => {
+                self.window_size = (size.width, size.height);
                 gfx.presenter.resize((size.width, size.height));
                 gfx.window.request_redraw();
             }
@@ -551,6 +662,10 @@ impl Editor {
                 if consumed || self.egui.egui_wants_keyboard_input() {
                     return;
                 }
+                if code == KeyCode::Escape && self.drawing.take().is_some() {
+                    self.edits.submit(&self.doc, Edit::StrokeAbort);
+                    return;
+                }
                 if let Some(a) = input::action_for_key(code, self.mods) {
                     if !event.repeat {
                         self.action(a);
@@ -562,18 +677,27 @@ impl Editor {
                 }
             }
             WindowEvent::MouseInput { state, button, .. } => {
-                if state == ElementState::Pressed
-                    && !consumed
-                    && !self.egui.egui_wants_pointer_input()
-                {
-                    self.drag = input::drag_for_button(button, self.mods).map(|d| (d, self.cursor));
-                } else if state == ElementState::Released {
-                    self.drag = None;
+                gfx.window.request_redraw();
+                let free = !consumed && !self.egui.egui_wants_pointer_input();
+                match (state, button) {
+                    (ElementState::Pressed, MouseButton::Left) if free => self.press(),
+                    (ElementState::Released, MouseButton::Left) if self.drawing.is_some() => {
+                        self.drawing = None;
+                        self.edits.submit(&self.doc, Edit::StrokeEnd);
+                    }
+                    (ElementState::Pressed, _) if free => {
+                        self.drag =
+                            input::drag_for_button(button, self.mods).map(|d| (d, self.cursor));
+                    }
+                    (ElementState::Released, _) => self.drag = None,
+                    _ => {}
                 }
             }
             WindowEvent::CursorMoved { position, .. } => {
                 let previous = self.cursor;
                 self.cursor = (position.x, position.y);
+                // The preview follows the cursor.
+                gfx.window.request_redraw();
                 if let Some((drag, _)) = self.drag {
                     let h = gfx.window.inner_size().height.max(1) as f64;
                     let (dx, dy) = (self.cursor.0 - previous.0, self.cursor.1 - previous.1);
@@ -586,6 +710,7 @@ impl Editor {
                     }
                     self.moved();
                 }
+                self.stroke_to_cursor();
             }
             WindowEvent::MouseWheel { delta, .. } => {
                 if consumed || self.egui.egui_wants_pointer_input() {

@@ -22,6 +22,8 @@ pub struct ViewSettings {
     pub exposure: f32,
     /// Autosave period in seconds (0: off).
     pub autosave_secs: u64,
+    /// The brush.
+    pub brush: super::tools::Brush,
 }
 
 impl Default for ViewSettings {
@@ -32,6 +34,7 @@ impl Default for ViewSettings {
             moving_scale: 0.5,
             exposure: 0.0,
             autosave_secs: 180,
+            brush: Default::default(),
         }
     }
 }
@@ -58,6 +61,38 @@ pub enum UiEvent {
     },
     /// Make the current view the scene's camera (undoable).
     UseViewAsSceneCamera,
+    /// A colour of the table changed (one step per drag).
+    SetColour {
+        /// Colour index.
+        index: u8,
+        /// sRGB.
+        rgb: [u8; 3],
+    },
+    /// A material changed.
+    SetMaterial {
+        /// Its index.
+        index: u8,
+        /// The new value.
+        material: crate::editor::command::MaterialSpec,
+    },
+    /// A material was added.
+    AddMaterial(crate::editor::command::MaterialSpec),
+    /// A parameter-table value changed (roughness, IOR, strength).
+    SetParam {
+        /// Which table.
+        kind: crate::editor::command::KindSpec,
+        /// Slot 0..64.
+        index: u8,
+        /// The value.
+        value: f32,
+    },
+    /// Go back (undo) or forward (redo) this many steps in the history.
+    Jump {
+        /// Steps to undo.
+        undo: usize,
+        /// Steps to redo.
+        redo: usize,
+    },
     /// The unsaved-changes question was answered.
     Unsaved(UnsavedAnswer),
     /// The recovery offer was answered (true: recover).
@@ -115,6 +150,8 @@ pub struct PanelState {
     pub stats: String,
     /// Background jobs running.
     pub busy: Vec<String>,
+    /// The editing windows (tools, palette, history).
+    pub editing: super::editing::EditingState,
 }
 
 /// Draws the panels; returns what the user asked for.
@@ -195,6 +232,12 @@ pub fn draw(
                 ui.checkbox(&mut state.sun_open, "Sun and sky");
                 ui.checkbox(&mut state.stats_open, "Scene statistics");
                 ui.checkbox(&mut state.help_open, "Shortcuts  F1");
+                ui.separator();
+                let mut tools = !state.editing.tools_hidden;
+                ui.checkbox(&mut tools, "Tools");
+                state.editing.tools_hidden = !tools;
+                ui.checkbox(&mut state.editing.palette_open, "Palette and materials");
+                ui.checkbox(&mut state.editing.history_open, "History");
             });
             if !state.busy.is_empty() {
                 ui.separator();
@@ -206,6 +249,7 @@ pub fn draw(
     egui::Panel::bottom("status").show(root, |ui| {
         ui.label(&state.status);
     });
+    super::editing::draw(ctx, &mut state.editing, doc, &mut view.brush, &mut out);
     if state.render_open {
         let mut open = true;
         egui::Window::new("Render settings")

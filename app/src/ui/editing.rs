@@ -1,0 +1,295 @@
+//! The editing panels: tools (mode, shape, size, mirror symmetry, the current material),
+//! palette and materials (the 256-colour table and the material list, edited live: each
+//! slider drag is one undo step, and only the material tables are uploaded), and the
+//! history list (every step with the voxels it changed; click one to go back or forward to
+//! it; how many of the oldest steps the memory budget dropped).
+
+use super::panels::UiEvent;
+use super::tools::{Brush, MAX_SIZE};
+use crate::editor::Document;
+use crate::editor::command::{BrushMode, BrushShape, KindSpec, MaterialSpec};
+use brickmap::{MaterialKind, MaterialTable};
+
+/// Which editing windows are shown, and the palette's selected colour.
+#[derive(Default)]
+pub struct EditingState {
+    /// The tools window is hidden (shown by default).
+    pub tools_hidden: bool,
+    /// The palette and materials window.
+    pub palette_open: bool,
+    /// The history window.
+    pub history_open: bool,
+    /// The colour selected in the palette grid.
+    pub colour: u8,
+}
+
+fn rgb(table: &MaterialTable, colour: u8) -> egui::Color32 {
+    let [r, g, b] = table.colour(colour);
+    egui::Color32::from_rgb(r, g, b)
+}
+
+/// A square swatch; returns its response.
+fn swatch(ui: &mut egui::Ui, colour: egui::Color32, selected: bool, size: f32) -> egui::Response {
+    let (rect, response) = ui.allocate_exact_size(egui::vec2(size, size), egui::Sense::click());
+    ui.painter().rect_filled(rect, 2.0, colour);
+    if selected {
+        ui.painter().rect_stroke(
+            rect,
+            2.0,
+            egui::Stroke::new(2.0, egui::Color32::WHITE),
+            egui::StrokeKind::Outside,
+        );
+    }
+    response
+}
+
+fn kind_name(k: MaterialKind) -> &'static str {
+    match k {
+        MaterialKind::Lambertian => "lambertian",
+        MaterialKind::Metal => "metal",
+        MaterialKind::Dielectric => "dielectric",
+        MaterialKind::Emissive => "emissive",
+    }
+}
+
+/// Draws the editing windows.
+pub fn draw(
+    ctx: &egui::Context,
+    state: &mut EditingState,
+    doc: &Document,
+    brush: &mut Brush,
+    out: &mut Vec<UiEvent>,
+) {
+    let table = doc.scene.world.materials();
+    if !state.tools_hidden {
+        let mut open = true;
+        egui::Window::new("Tools")
+            .open(&mut open)
+            .default_pos(egui::pos2(8.0, 40.0))
+            .resizable(false)
+            .show(ctx, |ui| tools(ui, brush, &table, doc));
+        state.tools_hidden = !open;
+    }
+    if state.palette_open {
+        let mut open = true;
+        egui::Window::new("Palette and materials")
+            .open(&mut open)
+            .show(ctx, |ui| palette(ui, state, brush, &table, out));
+        state.palette_open = open;
+    }
+    if state.history_open {
+        let mut open = true;
+        egui::Window::new("History")
+            .open(&mut open)
+            .show(ctx, |ui| history(ui, doc, out));
+        state.history_open = open;
+    }
+}
+
+fn tools(ui: &mut egui::Ui, brush: &mut Brush, table: &MaterialTable, doc: &Document) {
+    ui.horizontal(|ui| {
+        for (m, name) in [
+            (BrushMode::Attach, "Attach  T"),
+            (BrushMode::Erase, "Erase  X"),
+            (BrushMode::Paint, "Paint  P"),
+        ] {
+            ui.selectable_value(&mut brush.mode, m, name);
+        }
+    });
+    ui.horizontal_wrapped(|ui| {
+        for (s, name) in [
+            (BrushShape::Voxel, "Voxel V"),
+            (BrushShape::Sphere, "Sphere B"),
+            (BrushShape::Cube, "Cube C"),
+            (BrushShape::Cylinder, "Cylinder Y"),
+            (BrushShape::Line, "Line L"),
+            (BrushShape::Box, "Box R"),
+        ] {
+            ui.selectable_value(&mut brush.shape, s, name);
+        }
+    });
+    ui.add(
+        egui::Slider::new(&mut brush.size, 1.0..=MAX_SIZE)
+            .step_by(1.0)
+            .text("size  [ ]"),
+    );
+    ui.horizontal(|ui| {
+        ui.label("mirror");
+        ui.checkbox(&mut brush.mirror[0], "X");
+        ui.checkbox(&mut brush.mirror[1], "Y");
+        ui.checkbox(&mut brush.mirror[2], "Z");
+    });
+    if brush.mirror.iter().any(|m| *m) {
+        let dims = doc.scene.world.dims().voxels();
+        let mut c = brush.centre(dims);
+        ui.horizontal(|ui| {
+            ui.label("centre");
+            let mut changed = false;
+            for k in 0..3 {
+                changed |= ui
+                    .add(
+                        egui::DragValue::new(&mut c[k])
+                            .speed(0.5)
+                            .range(0.0..=dims[k] as f64),
+                    )
+                    .changed();
+            }
+            if changed {
+                brush.mirror_centre = Some(c);
+            }
+            if ui.button("scene centre").clicked() {
+                brush.mirror_centre = None;
+            }
+        });
+    }
+    ui.separator();
+    ui.label("material (Alt + click picks one)");
+    ui.horizontal_wrapped(|ui| {
+        for i in 0..table.len() {
+            let Ok(m) = table.get(i as u8) else { continue };
+            let r = swatch(ui, rgb(table, m.colour), brush.material == i as u8, 18.0)
+                .on_hover_text(format!("{i}: {}", kind_name(m.kind)));
+            if r.clicked() {
+                brush.material = i as u8;
+            }
+        }
+    });
+}
+
+fn palette(
+    ui: &mut egui::Ui,
+    state: &mut EditingState,
+    brush: &mut Brush,
+    table: &MaterialTable,
+    out: &mut Vec<UiEvent>,
+) {
+    ui.label("colours (click one, then edit it)");
+    egui::Grid::new("palette")
+        .spacing(egui::vec2(1.0, 1.0))
+        .show(ui, |ui| {
+            for row in 0..16u8 {
+                for col in 0..16u8 {
+                    let i = row * 16 + col;
+                    if swatch(ui, rgb(table, i), state.colour == i, 12.0).clicked() {
+                        state.colour = i;
+                    }
+                }
+                ui.end_row();
+            }
+        });
+    ui.horizontal(|ui| {
+        let mut c = table.colour(state.colour);
+        ui.label(format!("colour {}", state.colour));
+        if ui.color_edit_button_srgb(&mut c).changed() {
+            out.push(UiEvent::SetColour {
+                index: state.colour,
+                rgb: c,
+            });
+        }
+    });
+    ui.separator();
+    let Ok(m) = table.get(brush.material) else {
+        return;
+    };
+    ui.label(format!(
+        "material {} ({} of 256)",
+        brush.material,
+        table.len()
+    ));
+    let mut spec: MaterialSpec = m.into();
+    let before = spec;
+    egui::ComboBox::from_label("type")
+        .selected_text(kind_name(m.kind))
+        .show_ui(ui, |ui| {
+            for k in [
+                KindSpec::Lambertian,
+                KindSpec::Metal,
+                KindSpec::Dielectric,
+                KindSpec::Emissive,
+            ] {
+                ui.selectable_value(&mut spec.kind, k, kind_name(k.into()));
+            }
+        });
+    if m.kind != MaterialKind::Lambertian {
+        ui.add(egui::Slider::new(&mut spec.param, 0..=63).text("parameter slot"));
+        let (name, lo, hi) = match m.kind {
+            MaterialKind::Metal => ("roughness", 0.0, 1.0),
+            MaterialKind::Dielectric => ("index of refraction", 1.0, 4.0),
+            _ => ("strength", 0.0, 100.0),
+        };
+        if let Ok(mut value) = table.param(m.kind, m.param)
+            && ui
+                .add(egui::Slider::new(&mut value, lo..=hi).text(name))
+                .changed()
+        {
+            out.push(UiEvent::SetParam {
+                kind: spec.kind,
+                index: m.param,
+                value,
+            });
+        }
+    }
+    ui.horizontal(|ui| {
+        swatch(ui, rgb(table, m.colour), false, 16.0);
+        ui.label(format!("colour {}", m.colour));
+        if m.colour != state.colour && ui.button("use the selected colour").clicked() {
+            spec.colour = state.colour;
+        }
+    });
+    if spec != before {
+        out.push(UiEvent::SetMaterial {
+            index: brush.material,
+            material: spec,
+        });
+    }
+    if table.len() < 256 && ui.button("duplicate as a new material").clicked() {
+        out.push(UiEvent::AddMaterial(spec));
+        brush.material = table.len() as u8;
+    }
+}
+
+fn history(ui: &mut egui::Ui, doc: &Document, out: &mut Vec<UiEvent>) {
+    let h = &doc.history;
+    ui.label(format!(
+        "{} steps, {:.1} MiB{}",
+        h.undo_len() + h.redo_len(),
+        h.bytes() as f64 / (1 << 20) as f64,
+        if h.dropped() > 0 {
+            format!(
+                "; the {} oldest dropped to stay within the memory budget",
+                h.dropped()
+            )
+        } else {
+            String::new()
+        }
+    ));
+    egui::ScrollArea::vertical()
+        .max_height(320.0)
+        .show(ui, |ui| {
+            let undo: Vec<_> = h.undo_steps().collect();
+            let n = undo.len();
+            for (k, step) in undo.iter().enumerate() {
+                let text = format!("{}  ({} voxels)", step.label, step.changed_voxels);
+                let current = k + 1 == n;
+                if ui.selectable_label(current, text).clicked() && !current {
+                    out.push(UiEvent::Jump {
+                        undo: n - 1 - k,
+                        redo: 0,
+                    });
+                }
+            }
+            for (j, step) in h.redo_steps().enumerate() {
+                let text = egui::RichText::new(format!(
+                    "{}  ({} voxels)",
+                    step.label, step.changed_voxels
+                ))
+                .weak();
+                if ui.selectable_label(false, text).clicked() {
+                    out.push(UiEvent::Jump {
+                        undo: 0,
+                        redo: j + 1,
+                    });
+                }
+            }
+        });
+}

@@ -1,0 +1,197 @@
+//! The brush preview: exactly the voxels a click would change (`command::preview`), drawn
+//! translucent over the viewport as the outer faces of that set that face the camera. It is
+//! recomputed only when the stroke it previews or the document changes (not every frame),
+//! and drawn each frame from the kept faces, so it follows the cursor with at most one
+//! frame of lag. A brush too large to examine voxel by voxel shows its bounding box.
+
+use super::camera::ViewCamera;
+use crate::editor::command::{BrushMode, Stroke, preview, stroke_edits};
+use brickmap::{EditOp, WorldView};
+use glam::{DVec3, IVec3};
+use std::collections::HashSet;
+
+/// What is previewed: the stroke and the document revision it was computed for.
+type Key = (Stroke, u64);
+
+/// The kept preview.
+#[derive(Default)]
+pub struct Preview {
+    key: Option<Key>,
+    /// Outer faces of the voxel set: corners and outward normal.
+    faces: Vec<([DVec3; 4], IVec3)>,
+    /// Voxels in the set (None: too large, `bounds` is drawn).
+    pub voxels: Option<usize>,
+    /// The brush's bounding box when the set was too large.
+    bounds: Option<(DVec3, DVec3)>,
+    mode: Option<BrushMode>,
+    /// Seconds the last recomputation took (for the status line and benchmarks).
+    pub seconds: f64,
+}
+
+impl Preview {
+    /// Shows `stroke` (None: nothing) in the world at document revision `revision`;
+    /// recomputes only when either changed.
+    pub fn update(&mut self, view: &WorldView<'_>, stroke: Option<&Stroke>, revision: u64) {
+        let Some(stroke) = stroke else {
+            self.clear();
+            return;
+        };
+        if self
+            .key
+            .as_ref()
+            .is_some_and(|(s, r)| s == stroke && *r == revision)
+        {
+            return;
+        }
+        let started = std::time::Instant::now();
+        self.clear();
+        self.key = Some((stroke.clone(), revision));
+        self.mode = Some(stroke.mode);
+        match preview(view, stroke) {
+            Ok(Some(voxels)) => {
+                self.voxels = Some(voxels.len());
+                self.faces = outer_faces(&voxels);
+            }
+            Ok(None) => self.bounds = bounds(stroke),
+            Err(_) => {}
+        }
+        self.seconds = started.elapsed().as_secs_f64();
+    }
+
+    fn clear(&mut self) {
+        self.key = None;
+        self.faces.clear();
+        self.voxels = None;
+        self.bounds = None;
+    }
+
+    /// Paints the preview for the view's camera into `rect` (the viewport, in points).
+    pub fn paint(&self, painter: &egui::Painter, view: &ViewCamera, rect: egui::Rect) {
+        let Some(mode) = self.mode else { return };
+        let colour = match mode {
+            BrushMode::Attach => egui::Color32::from_rgba_unmultiplied(255, 255, 255, 70),
+            BrushMode::Erase => egui::Color32::from_rgba_unmultiplied(255, 60, 40, 90),
+            BrushMode::Paint => egui::Color32::from_rgba_unmultiplied(80, 200, 255, 80),
+        };
+        let aspect = (rect.width() / rect.height().max(1.0)) as f64;
+        let to_screen = |p: DVec3| {
+            view.project(p, aspect).map(|(u, v)| {
+                egui::pos2(
+                    rect.left() + (u as f32 + 1.0) * 0.5 * rect.width(),
+                    rect.top() + (1.0 - v as f32) * 0.5 * rect.height(),
+                )
+            })
+        };
+        let eye = view.camera.position;
+        let forward = view.camera.forward();
+        let mut mesh = egui::Mesh::default();
+        for (corners, normal) in &self.faces {
+            let centre = (corners[0] + corners[2]) * 0.5;
+            let towards = if view.camera.is_orthographic() {
+                forward
+            } else {
+                centre - eye
+            };
+            if towards.dot(normal.as_dvec3()) >= 0.0 {
+                continue;
+            }
+            let Some(pts) = corners
+                .iter()
+                .map(|c| to_screen(*c))
+                .collect::<Option<Vec<_>>>()
+            else {
+                continue;
+            };
+            let base = mesh.vertices.len() as u32;
+            for p in pts {
+                mesh.colored_vertex(p, colour);
+            }
+            mesh.add_triangle(base, base + 1, base + 2);
+            mesh.add_triangle(base, base + 2, base + 3);
+        }
+        if !mesh.is_empty() {
+            painter.add(egui::Shape::mesh(mesh));
+        }
+        if let Some((lo, hi)) = self.bounds {
+            let stroke = egui::Stroke::new(1.5, colour.to_opaque());
+            let corner = |i: usize| {
+                DVec3::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                )
+            };
+            for a in 0..8usize {
+                for bit in [1, 2, 4] {
+                    let b = a | bit;
+                    if b != a
+                        && let (Some(p), Some(q)) = (to_screen(corner(a)), to_screen(corner(b)))
+                    {
+                        painter.line_segment([p, q], stroke);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The faces between the set and the rest, each with its outward normal.
+fn outer_faces(voxels: &[IVec3]) -> Vec<([DVec3; 4], IVec3)> {
+    let set: HashSet<IVec3> = voxels.iter().copied().collect();
+    let mut faces = Vec::new();
+    for &v in voxels {
+        for axis in 0..3 {
+            for sign in [-1, 1] {
+                let mut n = IVec3::ZERO;
+                n[axis] = sign;
+                if set.contains(&(v + n)) {
+                    continue;
+                }
+                // The face's four corners, in order around it.
+                let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+                let mut base = v.as_dvec3();
+                if sign > 0 {
+                    base[axis] += 1.0;
+                }
+                let mut du = DVec3::ZERO;
+                du[u] = 1.0;
+                let mut dw = DVec3::ZERO;
+                dw[w] = 1.0;
+                faces.push(([base, base + du, base + du + dw, base + dw], n));
+            }
+        }
+    }
+    faces
+}
+
+/// The union of the stroke's shapes' voxel bounds, as a box of voxel corners.
+fn bounds(stroke: &Stroke) -> Option<(DVec3, DVec3)> {
+    let mut lo = IVec3::MAX;
+    let mut hi = IVec3::MIN;
+    for edit in stroke_edits(stroke).ok()? {
+        if let EditOp::Shape { shape, .. } = edit {
+            let (a, b) = shape.voxel_bounds();
+            lo = lo.min(a);
+            hi = hi.max(b);
+        }
+    }
+    (lo.cmple(hi).all()).then(|| (lo.as_dvec3(), hi.as_dvec3() + 1.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_voxel_has_six_outer_faces_and_two_touching_have_ten() {
+        let one = outer_faces(&[IVec3::ZERO]);
+        assert_eq!(one.len(), 6);
+        // Each face lies on its side of the voxel, its corners one unit apart.
+        for (c, n) in &one {
+            let centre = (c[0] + c[2]) * 0.5;
+            assert_eq!(centre - DVec3::splat(0.5), n.as_dvec3() * 0.5);
+            assert!(((c[1] - c[0]).length() - 1.0).abs() < 1e-12);
+        }
+        assert_eq!(outer_faces(&[IVec3::ZERO, IVec3::X]).len(), 10);
+    }
+}
