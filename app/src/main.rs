@@ -60,9 +60,14 @@ struct EditorArgs {
     /// Vulkan device: gpu (the best) or part of a device's name.
     #[arg(long, default_value = "gpu")]
     device: String,
-    /// Enable the Vulkan validation layer (a script run fails on any validation error).
+    /// Enable the Vulkan validation layer (the editor exits non-zero on any validation
+    /// error).
     #[arg(long)]
     validation: bool,
+    /// Record the session's edits (strokes, commands, undo, redo, saves) as a replay script,
+    /// written here when the editor exits (needs FILE: the script starts from it).
+    #[arg(long, requires = "file", conflicts_with = "script")]
+    record: Option<PathBuf>,
 }
 
 fn parse_window_size(s: &str) -> Result<(u32, u32), String> {
@@ -289,6 +294,7 @@ fn run(cli: Cli) -> Result<()> {
             workers,
             device: e.device,
             validation: e.validation,
+            record: e.record,
         });
     };
     match command {

@@ -38,6 +38,10 @@ struct Xvfb {
 
 impl Xvfb {
     fn start() -> Option<Self> {
+        Self::start_sized("320x240")
+    }
+
+    fn start_sized(size: &str) -> Option<Self> {
         // Tests of this file run in parallel: each takes its own number, and a server that
         // lost the race for a number (it exits at once) makes it try the next.
         static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
@@ -51,7 +55,14 @@ impl Xvfb {
             }
             let display = format!(":{number}");
             let child = Command::new("Xvfb")
-                .args([&display, "-screen", "0", "320x240x24", "-nolisten", "tcp"])
+                .args([
+                    &display,
+                    "-screen",
+                    "0",
+                    &format!("{size}x24"),
+                    "-nolisten",
+                    "tcp",
+                ])
                 .stdout(Stdio::null())
                 .stderr(Stdio::null())
                 .spawn()
@@ -401,4 +412,142 @@ fn a_gpu_failure_mid_session_keeps_the_unsaved_work_in_the_recovery_file() {
     let command: app::editor::command::Command = ron::from_str(last).unwrap();
     command.apply(&mut expected, &dir).unwrap();
     assert_eq!(hash(&recovered), hash(&expected));
+}
+
+/// Runs xdotool with these arguments against the test's display.
+fn xdotool(display: &str, args: &[&str]) -> String {
+    let out = Command::new("xdotool")
+        .args(args)
+        .env("DISPLAY", display)
+        .output()
+        .expect("xdotool runs");
+    assert!(
+        out.status.success(),
+        "xdotool {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+#[test]
+fn strokes_drawn_with_the_mouse_replay_headlessly_to_the_same_scene() {
+    if !have("Xvfb") || !have("xdotool") {
+        return skip("Xvfb or xdotool is not installed (packages xvfb, xdotool)");
+    }
+    let Some(x) = Xvfb::start_sized("800x600") else {
+        return skip("Xvfb did not start");
+    };
+    let dir = scratch("strokes");
+    let work = dir.join("work.ron");
+    let made = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
+        .args(["new", "--terrain", "--size", "64x32x64"])
+        .arg(&work)
+        .output()
+        .unwrap();
+    assert!(made.status.success());
+    let session = dir.join("session.ron");
+    let mut editor = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
+        .arg(&work)
+        .arg("--record")
+        .arg(&session)
+        .args(["--window", "640x400", "--validation"])
+        .env("DISPLAY", &x.display)
+        .env_remove("WAYLAND_DISPLAY")
+        .env("VOXBRICK_CONFIG_DIR", dir.join("config"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("voxbrick starts");
+    let d = x.display.as_str();
+    let window = xdotool(d, &["search", "--sync", "--name", "voxbrick"]);
+    let window = window.lines().next().unwrap().to_string();
+    std::thread::sleep(Duration::from_secs(4));
+    xdotool(d, &["windowfocus", &window]);
+    let pause = |s: f64| std::thread::sleep(Duration::from_secs_f64(s));
+    // Each press waits for a frame or two with the cursor over the viewport (right of the
+    // tools window), so the panels know the pointer is not theirs.
+    let drag = |points: &[(i32, i32)]| {
+        let (x0, y0) = points[0];
+        xdotool(d, &["mousemove", &x0.to_string(), &y0.to_string()]);
+        pause(1.5);
+        xdotool(d, &["mousedown", "1"]);
+        for (x, y) in &points[1..] {
+            xdotool(d, &["mousemove", &x.to_string(), &y.to_string()]);
+            pause(0.3);
+        }
+        xdotool(d, &["mouseup", "1"]);
+        pause(1.0);
+    };
+    // Attach, paint, undo, redo, erase, save, quit.
+    drag(&[(480, 220), (490, 230), (500, 230), (510, 230), (520, 230)]);
+    xdotool(d, &["key", "p"]);
+    drag(&[(450, 300), (470, 300), (490, 310)]);
+    xdotool(d, &["key", "ctrl+z"]);
+    pause(1.0);
+    xdotool(d, &["key", "ctrl+shift+z"]);
+    pause(1.0);
+    xdotool(d, &["key", "x"]);
+    drag(&[(560, 260), (565, 262)]);
+    xdotool(d, &["key", "ctrl+s"]);
+    pause(2.0);
+    xdotool(d, &["key", "ctrl+q"]);
+    let started = Instant::now();
+    while started.elapsed() < Duration::from_secs(60) {
+        if let Ok(Some(_)) = editor.try_wait() {
+            break;
+        }
+        pause(0.1);
+    }
+    let _ = editor.kill();
+    let out = editor.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success()
+        && (stderr.contains("no usable Vulkan") || stderr.contains("no Vulkan device"))
+    {
+        return skip(&format!(
+            "no Vulkan device can draw a window: {}",
+            stderr.trim()
+        ));
+    }
+    assert!(
+        out.status.success(),
+        "the editor (validation on) failed: {stderr}"
+    );
+    // What the mouse and keys did, as recorded.
+    let text = std::fs::read_to_string(&session).expect("the session was recorded");
+    for what in [
+        "mode: Attach",
+        "mode: Paint",
+        "Undo",
+        "Redo",
+        "mode: Erase",
+        "Save(\"work.ron\")",
+    ] {
+        assert!(
+            text.contains(what),
+            "{what} missing from the session:\n{text}"
+        );
+    }
+    // The same actions replayed headlessly give the scene the window saved.
+    let replayed = dir.join("replayed");
+    let replay = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
+        .arg("replay")
+        .arg(&session)
+        .arg("--out-dir")
+        .arg(&replayed)
+        .output()
+        .unwrap();
+    assert!(
+        replay.status.success(),
+        "{}",
+        String::from_utf8_lossy(&replay.stderr)
+    );
+    let hash = |p: &Path| app::Scene::load(p, 1).unwrap().world.read().content_hash();
+    let saved = hash(&work);
+    assert_ne!(
+        saved,
+        hash(&dir.join("session-start.ron")),
+        "the session changed the scene"
+    );
+    assert_eq!(saved, hash(&replayed.join("work.ron")));
 }

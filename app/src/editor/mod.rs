@@ -187,7 +187,10 @@ impl Document {
     /// clean unless it changed since that revision.
     pub fn mark_saved(&mut self, path: &Path, revision: u64) {
         if let Some(r) = &mut self.recorder {
-            r.record(script::Step::Save(path.display().to_string()));
+            // By file name: a replay writes it into its output folder, never over the file
+            // the session saved.
+            let name = path.file_name().unwrap_or(path.as_os_str());
+            r.record(script::Step::Save(name.to_string_lossy().into_owned()));
         }
         if crate::formats::Format::of(path).ok() == Some(crate::formats::Format::Project) {
             self.path = Some(path.to_path_buf());

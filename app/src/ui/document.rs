@@ -107,6 +107,10 @@ impl Editor {
             let _ = self.config.add_recent(p);
             self.panels.recent = self.config.recent();
         }
+        // A recording covers the file it starts from: the first document only.
+        if self.options.record.is_some() && self.generation == 0 {
+            doc.recorder = Some(crate::editor::script::Recorder::default());
+        }
         doc.path = path.filter(|_| is_project);
         self.view = scene_view(&doc.scene);
         self.doc = Arc::new(RwLock::new(doc));
@@ -321,6 +325,26 @@ impl Editor {
                 Err(e) => eprintln!("voxbrick: saving {} failed: {e}", path.display()),
             }
         }
+    }
+
+    /// With `--record`: the session's script, starting from the file opened (atomic write).
+    pub(super) fn write_recording(&mut self) -> Result<()> {
+        let (Some(out), Some(file)) = (&self.options.record, &self.options.file) else {
+            return Ok(());
+        };
+        let doc = self.read();
+        let Some(recorder) = &doc.recorder else {
+            anyhow::bail!("--record: the file was not opened, so nothing was recorded");
+        };
+        // The copy of the file made at start-up, beside the script (relative to it).
+        let start = super::recording_start(out, file);
+        let name = start.file_name().map(|n| n.to_string_lossy().into_owned());
+        let text = recorder.to_ron(
+            crate::editor::script::Start::File(name.unwrap_or_default()),
+            None,
+        );
+        crate::atomic::write_atomic(out, |w| w.write_all(text.as_bytes()))
+            .with_context(|| format!("writing the recording {}", out.display()))
     }
 }
 

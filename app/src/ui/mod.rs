@@ -60,8 +60,11 @@ pub struct EditorOptions {
     pub workers: usize,
     /// Vulkan device choice ("gpu" or part of a name).
     pub device: String,
-    /// Enable the validation layer (a script run fails on any validation error).
+    /// Enable the validation layer (the editor exits non-zero on any validation error).
     pub validation: bool,
+    /// Record the first document's edits as a replay script starting from `file`, written
+    /// here on exit.
+    pub record: Option<PathBuf>,
 }
 
 /// Wakes the event loop from other threads (file work finished).
@@ -74,11 +77,32 @@ pub fn run(options: EditorOptions) -> Result<()> {
         anyhow!("cannot open a window: {e} (no display? set DISPLAY or WAYLAND_DISPLAY)")
     })?;
     let proxy = event_loop.create_proxy();
+    if let (Some(record), Some(file)) = (&options.record, &options.file) {
+        // The recording starts from the file as it is now (a save may overwrite it).
+        let start = recording_start(record, file);
+        std::fs::copy(file, &start).with_context(|| {
+            format!(
+                "--record: copying {} to {}",
+                file.display(),
+                start.display()
+            )
+        })?;
+    }
     let mut editor = Editor::new(options, proxy)?;
     event_loop
         .run_app(&mut editor)
         .map_err(|e| anyhow!("event loop: {e}"))?;
     std::mem::replace(&mut editor.outcome, Ok(()))
+}
+
+/// Where `--record OUT` keeps the opened file as it was: beside OUT, named after it.
+fn recording_start(record: &Path, file: &Path) -> PathBuf {
+    let ext = file.extension().and_then(|e| e.to_str()).unwrap_or("ron");
+    let stem = record
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("session");
+    record.with_file_name(format!("{stem}-start.{ext}"))
 }
 
 /// What the GPU and the window are, once the window exists. Field order is drop order:
@@ -601,8 +625,20 @@ impl ApplicationHandler<Wake> for Editor {
     }
 
     fn exiting(&mut self, _event_loop: &ActiveEventLoop) {
+        if let Some(g) = &self.gfx {
+            let errors = g.viewport.ctx().validation_errors();
+            if errors > 0 && self.outcome.is_ok() {
+                self.outcome = Err(anyhow!("{errors} Vulkan validation errors"));
+            }
+        }
         // Drop the GPU objects before the window goes.
         self.gfx = None;
+        if let Err(e) = self.write_recording() {
+            eprintln!("voxbrick: {e:#}");
+            if self.outcome.is_ok() {
+                self.outcome = Err(e);
+            }
+        }
     }
 }
 
