@@ -154,6 +154,7 @@ fn every_command() -> Vec<Command> {
             octaves: 4,
             height_range: (10, 50),
             water_level: 24,
+            noise: app::editor::command::NoiseSpec::OpenSimplex,
         }),
         Command::ImportVox {
             path: "../assets/vox/mmmm_chr_robot.vox".into(),
@@ -265,6 +266,7 @@ fn failed_commands_change_nothing() {
             octaves: 40,
             height_range: (1, 5),
             water_level: 0,
+            noise: Default::default(),
         }),
         Command::ImportVox {
             path: "no/such.vox".into(),

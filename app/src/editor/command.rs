@@ -29,6 +29,49 @@ pub struct TerrainSpec {
     pub height_range: (u32, u32),
     /// Water level (0: none).
     pub water_level: u32,
+    /// Noise function (Perlin when absent).
+    #[serde(default)]
+    pub noise: NoiseSpec,
+}
+
+impl TerrainSpec {
+    /// The defaults for a grid of `size` voxels (New scene, the terrain panel): hills over
+    /// the lower five eighths of the height, water at a quarter.
+    pub fn for_size(size: (u32, u32, u32)) -> Self {
+        TerrainSpec {
+            seed: 2022,
+            scale: size.0.max(size.2) as f64 / 2.0,
+            octaves: 5,
+            height_range: (size.1 / 8, size.1 * 5 / 8),
+            water_level: size.1 / 4,
+            noise: NoiseSpec::Perlin,
+        }
+    }
+}
+
+/// Noise functions in commands and scripts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum NoiseSpec {
+    /// Classic gradient noise.
+    #[default]
+    Perlin,
+    /// OpenSimplex (fewer directional artefacts).
+    OpenSimplex,
+    /// SuperSimplex.
+    SuperSimplex,
+    /// Value noise (blockier).
+    Value,
+}
+
+impl From<NoiseSpec> for NoiseKind {
+    fn from(n: NoiseSpec) -> Self {
+        match n {
+            NoiseSpec::Perlin => NoiseKind::Perlin,
+            NoiseSpec::OpenSimplex => NoiseKind::OpenSimplex,
+            NoiseSpec::SuperSimplex => NoiseKind::SuperSimplex,
+            NoiseSpec::Value => NoiseKind::Value,
+        }
+    }
 }
 
 /// Every change a document can undergo.
@@ -269,7 +312,7 @@ impl Command {
                     let mut params =
                         crate::scene::thesis_terrain(materials, world.dims().voxels().y as u32);
                     (params.seed, params.noise, params.scale, params.octaves) =
-                        (t.seed, NoiseKind::Perlin, t.scale, t.octaves);
+                        (t.seed, t.noise.into(), t.scale, t.octaves);
                     (params.height_range, params.water_level) = (t.height_range, t.water_level);
                     let edit = NoiseTerrain::new(params, world.dims())?.edit();
                     Ok::<_, EditError>(world.apply(edit)?)

@@ -7,7 +7,7 @@
 use super::panels::UiEvent;
 use super::tools::{Brush, MAX_SIZE};
 use crate::editor::Document;
-use crate::editor::command::{BrushMode, BrushShape, KindSpec, MaterialSpec};
+use crate::editor::command::{BrushMode, BrushShape, KindSpec, MaterialSpec, NoiseSpec, TerrainSpec};
 use brickmap::{MaterialKind, MaterialTable};
 
 /// Which editing windows are shown, and the palette's selected colour.
@@ -21,6 +21,8 @@ pub struct EditingState {
     pub history_open: bool,
     /// The colour selected in the palette grid.
     pub colour: u8,
+    /// The terrain window, with its parameters.
+    pub terrain: Option<TerrainSpec>,
 }
 
 fn rgb(table: &MaterialTable, colour: u8) -> egui::Color32 {
@@ -76,6 +78,16 @@ pub fn draw(
             .open(&mut open)
             .show(ctx, |ui| palette(ui, state, brush, &table, out));
         state.palette_open = open;
+    }
+    if let Some(spec) = &mut state.terrain {
+        let mut open = true;
+        let height = doc.scene.world.dims().voxels().y as u32;
+        egui::Window::new("Terrain and water")
+            .open(&mut open)
+            .show(ctx, |ui| terrain(ui, spec, height, out));
+        if !open {
+            state.terrain = None;
+        }
     }
     if state.history_open {
         let mut open = true;
@@ -292,4 +304,35 @@ fn history(ui: &mut egui::Ui, doc: &Document, out: &mut Vec<UiEvent>) {
                 }
             }
         });
+}
+
+fn terrain(ui: &mut egui::Ui, spec: &mut TerrainSpec, height: u32, out: &mut Vec<UiEvent>) {
+    egui::ComboBox::from_label("noise")
+        .selected_text(format!("{:?}", spec.noise))
+        .show_ui(ui, |ui| {
+            for n in [
+                NoiseSpec::Perlin,
+                NoiseSpec::OpenSimplex,
+                NoiseSpec::SuperSimplex,
+                NoiseSpec::Value,
+            ] {
+                ui.selectable_value(&mut spec.noise, n, format!("{n:?}"));
+            }
+        });
+    ui.add(egui::DragValue::new(&mut spec.seed).prefix("seed "));
+    ui.add(
+        egui::Slider::new(&mut spec.scale, 4.0..=4096.0)
+            .logarithmic(true)
+            .text("scale (voxels)"),
+    );
+    ui.add(egui::Slider::new(&mut spec.octaves, 1..=10).text("octaves"));
+    let top = height.saturating_sub(1);
+    ui.add(egui::Slider::new(&mut spec.height_range.0, 0..=top).text("lowest ground"));
+    ui.add(egui::Slider::new(&mut spec.height_range.1, 0..=top).text("highest ground"));
+    spec.height_range.1 = spec.height_range.1.max(spec.height_range.0);
+    ui.add(egui::Slider::new(&mut spec.water_level, 0..=top).text("water level (0: none)"));
+    ui.label("Replaces every voxel of the scene (one undoable step), on the workers.");
+    if ui.button("Generate").clicked() {
+        out.push(UiEvent::Generate(spec.clone()));
+    }
 }

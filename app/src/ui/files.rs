@@ -267,13 +267,7 @@ pub fn new_scene(size: (u32, u32, u32), terrain: bool, workers: usize) -> Result
     let mut scene = Scene::empty(dims, workers)?;
     scene.params = render::SceneParams::framing(dims.voxels().as_dvec3());
     if terrain {
-        let spec = TerrainSpec {
-            seed: 2022,
-            scale: size.0.max(size.2) as f64 / 2.0,
-            octaves: 5,
-            height_range: (size.1 / 8, size.1 * 5 / 8),
-            water_level: size.1 / 4,
-        };
+        let spec = TerrainSpec::for_size(size);
         Command::GenerateTerrain(spec).apply(&mut scene, Path::new("."))?;
     }
     Ok(scene)

@@ -384,6 +384,7 @@ impl Editor {
             UiEvent::SetParam { kind, index, value } => {
                 self.execute(Command::SetParam { kind, index, value })
             }
+            UiEvent::Generate(spec) => self.execute(Command::GenerateTerrain(spec)),
             UiEvent::Jump { undo, redo } => {
                 for _ in 0..undo {
                     self.edits.submit(&self.doc, Edit::Undo);

@@ -86,6 +86,8 @@ pub enum UiEvent {
         /// The value.
         value: f32,
     },
+    /// Replace the scene's voxels by generated terrain (undoable).
+    Generate(crate::editor::command::TerrainSpec),
     /// Go back (undo) or forward (redo) this many steps in the history.
     Jump {
         /// Steps to undo.
@@ -238,6 +240,12 @@ pub fn draw(
                 state.editing.tools_hidden = !tools;
                 ui.checkbox(&mut state.editing.palette_open, "Palette and materials");
                 ui.checkbox(&mut state.editing.history_open, "History");
+                if ui.button("Terrain and water…").clicked() {
+                    let d = doc.scene.world.dims().voxels();
+                    state.editing.terrain = Some(crate::editor::command::TerrainSpec::for_size(
+                        (d.x as u32, d.y as u32, d.z as u32),
+                    ));
+                }
             });
             if !state.busy.is_empty() {
                 ui.separator();
