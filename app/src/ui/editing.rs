@@ -7,7 +7,9 @@
 use super::panels::UiEvent;
 use super::tools::{Brush, MAX_SIZE};
 use crate::editor::Document;
-use crate::editor::command::{BrushMode, BrushShape, KindSpec, MaterialSpec, NoiseSpec, TerrainSpec};
+use crate::editor::command::{
+    BrushMode, BrushShape, KindSpec, MaterialSpec, NoiseSpec, TerrainSpec,
+};
 use brickmap::{MaterialKind, MaterialTable};
 
 /// Which editing windows are shown, and the palette's selected colour.

@@ -85,6 +85,38 @@ impl ConfigDir {
         }
     }
 
+    /// The key map: keys.ron, written with the defaults when there is none (so the user
+    /// has a file to edit). A broken file is an error naming it, and the defaults are used
+    /// (the file is left alone).
+    pub fn keymap(&self) -> (super::keymap::KeyMap, Option<String>) {
+        use super::keymap::{KeyMap, default_bindings};
+        let f = self.0.join("keys.ron");
+        match std::fs::read_to_string(&f) {
+            Ok(text) => match KeyMap::parse(&text) {
+                Ok(map) => (map, None),
+                Err(e) => (
+                    KeyMap::default(),
+                    Some(format!("{}: {e}; using the default keys", f.display())),
+                ),
+            },
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                let text = KeyMap::to_ron(&default_bindings());
+                let written = std::fs::create_dir_all(&self.0).and_then(|()| {
+                    crate::atomic::write_atomic(&f, |w| w.write_all(text.as_bytes()))
+                        .map_err(std::io::Error::other)
+                });
+                let note = written
+                    .err()
+                    .map(|e| format!("writing {}: {e}", f.display()));
+                (KeyMap::default(), note)
+            }
+            Err(e) => (
+                KeyMap::default(),
+                Some(format!("reading {}: {e}", f.display())),
+            ),
+        }
+    }
+
     /// Saves the view settings (atomically).
     pub fn save_settings<T: serde::Serialize>(&self, settings: &T) -> Result<()> {
         std::fs::create_dir_all(&self.0)

@@ -19,7 +19,7 @@ pub struct Mods {
 }
 
 /// What a shortcut does.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Action {
     /// Undo the latest step.
     Undo,
@@ -59,54 +59,10 @@ pub enum Action {
     Quit,
 }
 
-/// The shortcut for a key pressed with modifiers.
+/// The shortcut for a key pressed with modifiers, in the default key map (the editor uses
+/// the user's, see `keymap`).
 pub fn action_for_key(key: KeyCode, m: Mods) -> Option<Action> {
-    use KeyCode::*;
-    let digit = match key {
-        Digit1 => Some(1),
-        Digit2 => Some(2),
-        Digit3 => Some(3),
-        Digit4 => Some(4),
-        Digit5 => Some(5),
-        Digit6 => Some(6),
-        Digit7 => Some(7),
-        Digit8 => Some(8),
-        Digit9 => Some(9),
-        _ => None,
-    };
-    if let Some(n) = digit {
-        return match (m.ctrl, m.alt) {
-            (true, false) => Some(Action::StoreView(n)),
-            (false, false) => Some(Action::RecallView(n)),
-            _ => None,
-        };
-    }
-    Some(match (key, m.ctrl, m.shift) {
-        (KeyZ, true, false) => Action::Undo,
-        (KeyZ, true, true) | (KeyY, true, false) => Action::Redo,
-        (KeyN, true, false) => Action::New,
-        (KeyO, true, false) => Action::Open,
-        (KeyS, true, false) => Action::Save,
-        (KeyS, true, true) => Action::SaveAs,
-        (KeyI, true, false) => Action::Import,
-        (KeyE, true, false) => Action::Export,
-        (KeyQ, true, false) => Action::Quit,
-        (KeyF, false, false) => Action::Frame,
-        (KeyO, false, false) | (Numpad5, false, false) => Action::ToggleProjection,
-        (BracketLeft, false, _) => Action::BrushSmaller,
-        (BracketRight, false, _) => Action::BrushLarger,
-        (KeyT, false, false) => Action::Mode(BrushMode::Attach),
-        (KeyX, false, false) => Action::Mode(BrushMode::Erase),
-        (KeyP, false, false) => Action::Mode(BrushMode::Paint),
-        (KeyV, false, false) => Action::Shape(BrushShape::Voxel),
-        (KeyB, false, false) => Action::Shape(BrushShape::Sphere),
-        (KeyC, false, false) => Action::Shape(BrushShape::Cube),
-        (KeyY, false, false) => Action::Shape(BrushShape::Cylinder),
-        (KeyL, false, false) => Action::Shape(BrushShape::Line),
-        (KeyR, false, false) => Action::Shape(BrushShape::Box),
-        (F1, false, false) => Action::Help,
-        _ => return None,
-    })
+    super::keymap::KeyMap::default().action(key, m)
 }
 
 /// How a mouse drag moves the view.

@@ -11,6 +11,7 @@ pub mod files;
 mod frame;
 pub mod input;
 pub mod jobs;
+pub mod keymap;
 pub mod panels;
 mod preview;
 pub mod tools;
@@ -194,6 +195,8 @@ pub struct Editor {
     latency: Option<Duration>,
     /// Frames drawn.
     frames: u64,
+    /// Which keys do what (keys.ron).
+    keymap: keymap::KeyMap,
     /// The window's inner size in physical pixels (cursor positions are in these).
     window_size: (u32, u32),
     /// The stroke being drawn with the left button.
@@ -294,6 +297,7 @@ impl Editor {
             move_event: None,
             latency: None,
             frames: 0,
+            keymap: Default::default(),
             window_size: (16, 9),
             drawing: None,
             preview: Default::default(),
@@ -304,6 +308,17 @@ impl Editor {
             options,
         };
         editor.panels.errors.extend(settings_error);
+        if editor.script.is_none() {
+            let (keymap, error) = editor.config.keymap();
+            editor.keymap = keymap;
+            editor.panels.errors.extend(error);
+            editor.panels.keys = editor
+                .keymap
+                .bindings()
+                .iter()
+                .map(|b| (b.keys.clone(), format!("{:?}", b.action)))
+                .collect();
+        }
         if editor.script.is_some() {
             // A script run is reproducible: the defaults, whatever the user saved.
             editor.settings = ViewSettings {
@@ -703,7 +718,7 @@ impl Editor {
                     self.edits.submit(&self.doc, Edit::StrokeAbort);
                     return;
                 }
-                if let Some(a) = input::action_for_key(code, self.mods) {
+                if let Some(a) = self.keymap.action(code, self.mods) {
                     if !event.repeat {
                         self.action(a);
                     }

@@ -154,6 +154,8 @@ pub struct PanelState {
     pub busy: Vec<String>,
     /// The editing windows (tools, palette, history).
     pub editing: super::editing::EditingState,
+    /// The key map's bindings (chord, action) for the shortcut list.
+    pub keys: Vec<(String, String)>,
 }
 
 /// Draws the panels; returns what the user asked for.
@@ -242,9 +244,9 @@ pub fn draw(
                 ui.checkbox(&mut state.editing.history_open, "History");
                 if ui.button("Terrain and water…").clicked() {
                     let d = doc.scene.world.dims().voxels();
-                    state.editing.terrain = Some(crate::editor::command::TerrainSpec::for_size(
-                        (d.x as u32, d.y as u32, d.z as u32),
-                    ));
+                    state.editing.terrain = Some(crate::editor::command::TerrainSpec::for_size((
+                        d.x as u32, d.y as u32, d.z as u32,
+                    )));
                 }
             });
             if !state.busy.is_empty() {
@@ -323,6 +325,17 @@ pub fn draw(
                             ui.end_row();
                         }
                     });
+                    if !state.keys.is_empty() {
+                        ui.separator();
+                        ui.label("The key map in force (keys.ron in the config folder):");
+                        egui::Grid::new("keymap").striped(true).show(ui, |ui| {
+                            for (keys, action) in &state.keys {
+                                ui.monospace(keys);
+                                ui.label(action);
+                                ui.end_row();
+                            }
+                        });
+                    }
                 });
             });
         state.help_open = open;

@@ -1,0 +1,293 @@
+//! The key map: which key chord does which [`Action`]. The defaults follow MagicaVoxel where
+//! it has a shortcut; `keys.ron` in the config folder (written with the defaults on the
+//! first start, so there is a file to edit) replaces them. A chord is written as in menus:
+//! `"Ctrl+Shift+Z"`, `"F"`, `"["`, `"Numpad5"`, `"F1"`. A file that does not parse, or
+//! names a key that does not exist, is an error naming the binding; the defaults are used
+//! and the file is left as it is. Flying (W A S D, Q / E, held) is not an action and not
+//! remapped.
+
+use super::input::{Action, Mods};
+use crate::editor::command::{BrushMode, BrushShape};
+use serde::{Deserialize, Serialize};
+use winit::keyboard::KeyCode;
+
+/// One line of keys.ron.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Binding {
+    /// The chord, e.g. "Ctrl+Shift+Z".
+    pub keys: String,
+    /// What it does.
+    pub action: Action,
+}
+
+/// A key with the modifiers that must be held (exactly).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Chord {
+    key: KeyCode,
+    mods: Mods,
+}
+
+/// The bindings in force.
+#[derive(Clone, Debug)]
+pub struct KeyMap {
+    chords: Vec<(Chord, Action)>,
+    bindings: Vec<Binding>,
+}
+
+impl Default for KeyMap {
+    fn default() -> Self {
+        Self::from_bindings(&default_bindings()).expect("the default bindings parse")
+    }
+}
+
+impl KeyMap {
+    /// The map of these bindings; an error names the first bad chord.
+    pub fn from_bindings(bindings: &[Binding]) -> Result<Self, String> {
+        let chords = bindings
+            .iter()
+            .map(|b| parse_chord(&b.keys).map(|c| (c, b.action)))
+            .collect::<Result<_, _>>()?;
+        Ok(Self {
+            chords,
+            bindings: bindings.to_vec(),
+        })
+    }
+
+    /// The action of a key pressed with modifiers (the first binding that matches).
+    pub fn action(&self, key: KeyCode, mods: Mods) -> Option<Action> {
+        self.chords
+            .iter()
+            .find(|(c, _)| c.key == key && c.mods == mods)
+            .map(|(_, a)| *a)
+    }
+
+    /// The bindings, as written (for the help window).
+    pub fn bindings(&self) -> &[Binding] {
+        &self.bindings
+    }
+
+    /// keys.ron's text for these bindings: a header, then one binding per line.
+    pub fn to_ron(bindings: &[Binding]) -> String {
+        let mut text = String::from(
+            "// voxbrick key map: each line binds a chord (\"Ctrl+Shift+Z\", \"F\", \"[\",\n\
+             // \"Numpad5\", \"F1\") to an action. Edit and restart the editor; delete the\n\
+             // file to get the defaults back.\n[\n",
+        );
+        for b in bindings {
+            let line = ron::to_string(b).expect("a binding serializes");
+            text += &format!("    {line},\n");
+        }
+        text + "]\n"
+    }
+
+    /// Parses keys.ron's text.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let bindings: Vec<Binding> = ron::from_str(text).map_err(|e| e.to_string())?;
+        Self::from_bindings(&bindings)
+    }
+}
+
+/// The default bindings.
+pub fn default_bindings() -> Vec<Binding> {
+    let mut b: Vec<(String, Action)> = [
+        ("Ctrl+Z", Action::Undo),
+        ("Ctrl+Shift+Z", Action::Redo),
+        ("Ctrl+Y", Action::Redo),
+        ("Ctrl+N", Action::New),
+        ("Ctrl+O", Action::Open),
+        ("Ctrl+S", Action::Save),
+        ("Ctrl+Shift+S", Action::SaveAs),
+        ("Ctrl+I", Action::Import),
+        ("Ctrl+E", Action::Export),
+        ("Ctrl+Q", Action::Quit),
+        ("F", Action::Frame),
+        ("O", Action::ToggleProjection),
+        ("Numpad5", Action::ToggleProjection),
+        ("[", Action::BrushSmaller),
+        ("]", Action::BrushLarger),
+        ("T", Action::Mode(BrushMode::Attach)),
+        ("X", Action::Mode(BrushMode::Erase)),
+        ("P", Action::Mode(BrushMode::Paint)),
+        ("V", Action::Shape(BrushShape::Voxel)),
+        ("B", Action::Shape(BrushShape::Sphere)),
+        ("C", Action::Shape(BrushShape::Cube)),
+        ("Y", Action::Shape(BrushShape::Cylinder)),
+        ("L", Action::Shape(BrushShape::Line)),
+        ("R", Action::Shape(BrushShape::Box)),
+        ("F1", Action::Help),
+    ]
+    .into_iter()
+    .map(|(k, a)| (k.to_string(), a))
+    .collect();
+    for n in 1..=9u8 {
+        b.push((format!("Ctrl+{n}"), Action::StoreView(n)));
+        b.push((format!("{n}"), Action::RecallView(n)));
+    }
+    b.into_iter()
+        .map(|(keys, action)| Binding { keys, action })
+        .collect()
+}
+
+fn parse_chord(s: &str) -> Result<Chord, String> {
+    let mut mods = Mods::default();
+    let parts: Vec<&str> = s.split('+').map(str::trim).collect();
+    // "Ctrl++" would be Ctrl and "+"; no default uses it, and "+" alone is allowed.
+    let (key, held) = match parts.split_last() {
+        Some((k, held)) if !k.is_empty() => (*k, held),
+        _ => return Err(format!("\"{s}\": no key")),
+    };
+    for m in held {
+        match m.to_ascii_lowercase().as_str() {
+            "ctrl" | "control" | "cmd" => mods.ctrl = true,
+            "shift" => mods.shift = true,
+            "alt" => mods.alt = true,
+            other => return Err(format!("\"{s}\": \"{other}\" is not Ctrl, Shift or Alt")),
+        }
+    }
+    let key = key_code(key).ok_or_else(|| format!("\"{s}\": no key is called \"{key}\""))?;
+    Ok(Chord { key, mods })
+}
+
+/// A key by the name a user writes: a letter, a digit, F1..F12, a few symbols, or winit's
+/// own names for the rest ("Numpad5", "ArrowUp", "Delete").
+fn key_code(name: &str) -> Option<KeyCode> {
+    use KeyCode::*;
+    let letters = [
+        KeyA, KeyB, KeyC, KeyD, KeyE, KeyF, KeyG, KeyH, KeyI, KeyJ, KeyK, KeyL, KeyM, KeyN, KeyO,
+        KeyP, KeyQ, KeyR, KeyS, KeyT, KeyU, KeyV, KeyW, KeyX, KeyY, KeyZ,
+    ];
+    let digits = [
+        Digit0, Digit1, Digit2, Digit3, Digit4, Digit5, Digit6, Digit7, Digit8, Digit9,
+    ];
+    let mut chars = name.chars();
+    if let (Some(c), None) = (chars.next(), chars.next()) {
+        return match c {
+            'a'..='z' | 'A'..='Z' => Some(letters[(c.to_ascii_uppercase() as u8 - b'A') as usize]),
+            '0'..='9' => Some(digits[(c as u8 - b'0') as usize]),
+            '[' => Some(BracketLeft),
+            ']' => Some(BracketRight),
+            '-' => Some(Minus),
+            '=' => Some(Equal),
+            ',' => Some(Comma),
+            '.' => Some(Period),
+            '/' => Some(Slash),
+            ';' => Some(Semicolon),
+            _ => None,
+        };
+    }
+    let named = [
+        F1,
+        F2,
+        F3,
+        F4,
+        F5,
+        F6,
+        F7,
+        F8,
+        F9,
+        F10,
+        F11,
+        F12,
+        Numpad0,
+        Numpad1,
+        Numpad2,
+        Numpad3,
+        Numpad4,
+        Numpad5,
+        Numpad6,
+        Numpad7,
+        Numpad8,
+        Numpad9,
+        NumpadAdd,
+        NumpadSubtract,
+        Escape,
+        Space,
+        Tab,
+        Enter,
+        Backspace,
+        Delete,
+        Insert,
+        Home,
+        End,
+        PageUp,
+        PageDown,
+        ArrowUp,
+        ArrowDown,
+        ArrowLeft,
+        ArrowRight,
+    ];
+    let lower = name.to_ascii_lowercase();
+    let alias = match lower.as_str() {
+        "esc" => Some(Escape),
+        "del" => Some(Delete),
+        "up" => Some(ArrowUp),
+        "down" => Some(ArrowDown),
+        "left" => Some(ArrowLeft),
+        "right" => Some(ArrowRight),
+        _ => None,
+    };
+    alias.or_else(|| {
+        named
+            .into_iter()
+            .find(|k| format!("{k:?}").eq_ignore_ascii_case(name))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CTRL: Mods = Mods {
+        ctrl: true,
+        shift: false,
+        alt: false,
+    };
+
+    #[test]
+    fn the_default_file_round_trips_and_means_the_defaults() {
+        let text = KeyMap::to_ron(&default_bindings());
+        let map = KeyMap::parse(&text).unwrap();
+        assert_eq!(map.bindings(), default_bindings().as_slice());
+        assert_eq!(map.action(KeyCode::KeyZ, CTRL), Some(Action::Undo));
+        assert_eq!(
+            map.action(KeyCode::BracketRight, Mods::default()),
+            Some(Action::BrushLarger)
+        );
+        assert_eq!(
+            map.action(KeyCode::Numpad5, Mods::default()),
+            Some(Action::ToggleProjection)
+        );
+        assert_eq!(
+            map.action(KeyCode::Digit7, CTRL),
+            Some(Action::StoreView(7))
+        );
+        assert_eq!(map.action(KeyCode::KeyZ, Mods::default()), None);
+    }
+
+    #[test]
+    fn a_user_binding_replaces_the_defaults_and_bad_ones_are_named() {
+        let map =
+            KeyMap::parse(r#"[(keys: "Alt+U", action: Undo), (keys: "shift+f", action: Frame)]"#)
+                .unwrap();
+        let alt = Mods {
+            alt: true,
+            ..Mods::default()
+        };
+        let shift = Mods {
+            shift: true,
+            ..Mods::default()
+        };
+        assert_eq!(map.action(KeyCode::KeyU, alt), Some(Action::Undo));
+        assert_eq!(map.action(KeyCode::KeyF, shift), Some(Action::Frame));
+        assert_eq!(
+            map.action(KeyCode::KeyZ, CTRL),
+            None,
+            "the defaults are replaced"
+        );
+        let err = KeyMap::parse(r#"[(keys: "Ctrl+Banana", action: Undo)]"#).unwrap_err();
+        assert!(err.contains("Banana"), "{err}");
+        let err = KeyMap::parse(r#"[(keys: "Hyper+Z", action: Undo)]"#).unwrap_err();
+        assert!(err.contains("Hyper"), "{err}");
+        assert!(KeyMap::parse(r#"[(keys: "Z", action: Fly)]"#).is_err());
+    }
+}
