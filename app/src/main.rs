@@ -182,6 +182,11 @@ enum Command {
         /// size and egui panels painted on it.
         #[arg(long)]
         ui: bool,
+        /// Instead: edit → first frame showing it, on the default 512 × 256 × 512 scene, for
+        /// live sphere strokes of these radii (comma-separated), and the brush preview's
+        /// update time.
+        #[arg(long, value_delimiter = ',')]
+        edits: Vec<f64>,
     },
     /// Time the GPU path tracer on the thesis scene with Vulkan timestamp queries: medians
     /// after warm-up for the thesis's complexities 1, 2 and 3.
@@ -451,9 +456,30 @@ fn run(cli: Cli) -> Result<()> {
             spp,
             device,
             ui,
+            edits,
         } => {
             if let Some(s) = scales.iter().find(|s| !(**s > 0.0 && **s <= 1.0)) {
                 bail!("internal scale {s} is outside (0, 1]");
+            }
+            if let Some(r) = edits.iter().find(|r| !(**r >= 1.0 && **r <= 64.0)) {
+                bail!("--edits radius {r} is outside 1..=64");
+            }
+            if !edits.is_empty() {
+                let scene = with_progress("building the default scene".into(), || {
+                    default_scene(SceneSize::Full, workers)
+                })?;
+                let session = {
+                    let view = scene.world.read();
+                    app::gpu::session(device.as_deref().unwrap_or("gpu"), &view)?
+                };
+                return emit(&cli::bench_viewport::edits(
+                    session,
+                    scene,
+                    size,
+                    &scales,
+                    &edits,
+                    frames.clamp(10, 400),
+                )?);
             }
             let mut scene = thesis_scene(workers)?;
             scene.params.sun.enabled = true;

@@ -320,3 +320,147 @@ pub fn run(
     }
     Ok(text)
 }
+
+/// Edit → first frame showing it in the editor's loop, on `scene` (the default scene): a live
+/// sphere stroke (attach) of each radius crosses the terrain in rows, one segment half a
+/// radius on per edit (the first frame showing it: restarted, and no upload of it deferred), as the edit thread applies them (the edit's time is the world's workers'), with a
+/// frame in flight when each edit is made. Reports per radius and internal scale: the edit's
+/// apply time, frames and milliseconds from the edit to the first frame showing it finished
+/// on the GPU, GPU time of the frames while the stroke is drawn, and the brush preview's
+/// update time (exactly the voxels a click changes, on the UI thread).
+pub fn edits(
+    mut vp: Viewport,
+    scene: app::Scene,
+    size: (u32, u32),
+    scales: &[f32],
+    radii: &[f64],
+    count: usize,
+) -> Result<String> {
+    use app::editor::Document;
+    use app::editor::command::{BrushMode, BrushShape, Mirror, Stroke, preview};
+    use app::editor::history::History;
+    let ctx = vp.ctx().clone();
+    let dims = scene.world.dims().voxels();
+    let mut text = format!(
+        "device       {} ({})\nscene        default {}x{}x{}, {} bounces; output {}x{}, 1 spp per frame; {count} edits per case\n",
+        ctx.name,
+        ctx.driver,
+        dims.x,
+        dims.y,
+        dims.z,
+        scene.params.settings.max_bounces,
+        size.0,
+        size.1
+    );
+    text += "radius  scale  edit apply ms median (p99)   edit → frame: frames median (max), ms median (p99)   GPU ms/frame while stroking median (p99)   preview ms median (max)\n";
+    let mut doc = Document::new(scene, History::default());
+    let params = doc.scene.params.clone();
+    for &r in radii {
+        for &scale in scales {
+            let req = FrameRequest {
+                params: &params,
+                internal: scaled(size, scale),
+                output: size,
+                spp: 1,
+                target_spp: u32::MAX,
+                exposure: 0.0,
+                bgra: true,
+            };
+            // Warm-up frames (pipelines, clocks).
+            for _ in 0..WARM_UP {
+                if let Some(f) = vp.begin_frame()? {
+                    vp.trace_frame(&f, &doc.scene.world, &req)?;
+                    vp.submit_frame(f, &[], &[])?;
+                }
+            }
+            vp.wait_idle()?;
+            let step = (r * 0.5).max(1.0);
+            let point = |k: usize| {
+                // Rows across the scene at three tenths of its height, each row a brush
+                // diameter further in z, so every segment reaches voxels not yet changed.
+                let span = dims.x as f64 - 4.0 * r;
+                let per_row = (span / step).floor().max(1.0) as usize;
+                let (row, i) = (k / per_row, k % per_row);
+                let z = (2.0 * r + row as f64 * 2.0 * r) % (dims.z as f64 - 2.0 * r);
+                glam::DVec3::new(2.0 * r + i as f64 * step, dims.y as f64 * 0.3, z.max(r))
+            };
+            let stroke = |k: usize| Stroke {
+                mode: BrushMode::Attach,
+                shape: BrushShape::Sphere,
+                size: r,
+                material: 1,
+                mirror: Mirror::default(),
+                points: vec![point(k)],
+            };
+            let (mut apply, mut frames, mut ms, mut gpu, mut prev) =
+                (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            let mut changed_before = 0;
+            for k in 0..count {
+                // The preview of the next click, as the UI computes it.
+                if k % 4 == 0 {
+                    let view = doc.scene.world.read();
+                    let started = Instant::now();
+                    let _ = preview(&view, &stroke(k))?;
+                    prev.push(started.elapsed().as_secs_f64() * 1e3);
+                }
+                // A frame in flight, as in the window's loop.
+                if let Some(f) = vp.begin_frame()? {
+                    vp.trace_frame(&f, &doc.scene.world, &req)?;
+                    vp.submit_frame(f, &[], &[])?;
+                }
+                let event = Instant::now();
+                if k == 0 {
+                    doc.begin_stroke(stroke(0))?;
+                } else {
+                    doc.extend_stroke(&[point(k)])?;
+                }
+                apply.push(event.elapsed().as_secs_f64() * 1e3);
+                if doc
+                    .live_stroke()
+                    .is_some_and(|l| l.changed_voxels == changed_before)
+                {
+                    // Nothing changed: no frame will show it.
+                    continue;
+                }
+                changed_before = doc.live_stroke().map_or(0, |l| l.changed_voxels);
+                // The first frame that shows the whole edit: it restarted the accumulation
+                // and nothing of the edit is left for later frames' uploads.
+                let mut n = 0;
+                let mut restarted = false;
+                loop {
+                    let Some(f) = vp.begin_frame()? else {
+                        std::thread::yield_now();
+                        continue;
+                    };
+                    n += 1;
+                    let status = vp.trace_frame(&f, &doc.scene.world, &req)?;
+                    vp.submit_frame(f, &[], &[])?;
+                    restarted |= status.restarted;
+                    if restarted && status.upload.deferred_bytes == 0 {
+                        break;
+                    }
+                    anyhow::ensure!(n < 10_000, "the edit never showed");
+                }
+                vp.wait_idle()?;
+                ms.push(event.elapsed().as_secs_f64() * 1e3);
+                frames.push(n as f64);
+                if let Some(g) = vp.last_gpu_seconds() {
+                    gpu.push(g * 1e3);
+                }
+            }
+            doc.end_stroke()?;
+            // Back to the scene as built, for the next case.
+            doc.undo()?;
+            vp.wait_idle()?;
+            let (_, a50, a99, _) = stats(apply);
+            let (_, f50, _, fmax) = stats(frames);
+            let (_, m50, m99, _) = stats(ms);
+            let (_, g50, g99, _) = stats(gpu);
+            let (_, p50, _, pmax) = stats(prev);
+            text += &format!(
+                "{r:<7} {scale:<5}  {a50:.3} ({a99:.3})               {f50:.0} ({fmax:.0}), {m50:.3} ({m99:.3})                       {g50:.3} ({g99:.3})                              {p50:.3} ({pmax:.3})\n"
+            );
+        }
+    }
+    Ok(text)
+}
