@@ -148,6 +148,7 @@ fn every_command() -> Vec<Command> {
             internal_resolution: (640, 360),
             exposure: 1.5,
         }),
+        Command::SetPalette((0..256).map(|i| [i as u8, 7, 255 - i as u8]).collect()),
         Command::GenerateTerrain(TerrainSpec {
             seed: 5,
             scale: 50.0,
@@ -240,6 +241,7 @@ fn failed_commands_change_nothing() {
             start: IVec3::new(500, 0, 0),
             material: 1,
         },
+        Command::SetPalette(vec![[1, 2, 3]; 3]),
         Command::SetMaterial {
             index: 99,
             material: MaterialSpec {

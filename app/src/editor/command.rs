@@ -102,6 +102,8 @@ pub enum Command {
         /// sRGB.
         rgb: [u8; 3],
     },
+    /// Replace the whole colour table (a loaded palette: exactly 256 sRGB colours).
+    SetPalette(Vec<[u8; 3]>),
     /// Set a parameter-table value (roughness, IOR, strength).
     SetParam {
         /// Which table.
@@ -214,6 +216,7 @@ impl Command {
             Command::AddMaterial(_) => "Add material".into(),
             Command::SetMaterial { index, .. } => format!("Edit material {index}"),
             Command::SetColour { index, .. } => format!("Edit colour {index}"),
+            Command::SetPalette(_) => "Load palette".into(),
             Command::SetParam { kind, index, .. } => format!("Edit {kind:?} parameter {index}"),
             Command::SetSun(_) => "Edit sun".into(),
             Command::SetSky(_) => "Edit sky".into(),
@@ -274,6 +277,20 @@ impl Command {
                 w.set_colour(*index, *rgb);
                 Ok(())
             })?,
+            Command::SetPalette(colours) => {
+                if colours.len() != 256 {
+                    return Err(super::error::invalid(format!(
+                        "a palette has 256 colours, not {}",
+                        colours.len()
+                    )));
+                }
+                with_table(scene, |w| {
+                    for (i, c) in colours.iter().enumerate() {
+                        w.set_colour(i as u8, *c);
+                    }
+                    Ok(())
+                })?
+            }
             Command::SetParam { kind, index, value } => with_table(scene, |w| {
                 w.set_param((*kind).into(), *index, *value).map(|_| ())
             })?,

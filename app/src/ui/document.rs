@@ -186,7 +186,28 @@ impl Editor {
                 }
                 // Asks for the offset first (the import dialog), then `ImportVox`.
                 Purpose::Import => self.panels.import = Some((path, [0, 0, 0])),
+                Purpose::LoadPalette => self.files.load_palette(path),
+                Purpose::SavePalette => {
+                    let path = if path.extension().is_none() {
+                        path.with_extension("png")
+                    } else {
+                        path
+                    };
+                    let colours = {
+                        let doc = self.read();
+                        let table = doc.scene.world.materials();
+                        (0..=255u8).map(|i| table.colour(i)).collect()
+                    };
+                    self.files.save_palette(colours, path);
+                }
             },
+            Done::Palette(Ok(colours)) => self.execute(Command::SetPalette(colours)),
+            Done::Palette(Err(e)) => self.panels.errors.push(format!("{e:#}")),
+            Done::PaletteSaved(_, Ok(())) => {}
+            Done::PaletteSaved(path, Err(e)) => self
+                .panels
+                .errors
+                .push(format!("writing {}: {e:#}", path.display())),
             Done::Picked(_, Ok(None)) => self.save_then = None,
             Done::Picked(Purpose::SaveAs, Err(e)) => {
                 // Nothing is lost for want of a dialog: save beside the home folder.

@@ -192,6 +192,18 @@ fn palette(
             }
         });
     ui.horizontal(|ui| {
+        if ui
+            .button("Load palette…")
+            .on_hover_text("a 256 × 1 PNG strip or a .vox file")
+            .clicked()
+        {
+            out.push(UiEvent::PaletteFile { save: false });
+        }
+        if ui.button("Save palette as PNG…").clicked() {
+            out.push(UiEvent::PaletteFile { save: true });
+        }
+    });
+    ui.horizontal(|ui| {
         let mut c = table.colour(state.colour);
         ui.label(format!("colour {}", state.colour));
         if ui.color_edit_button_srgb(&mut c).changed() {

@@ -153,6 +153,10 @@ pub enum Purpose {
     Import,
     /// Write a .vox.
     Export,
+    /// Read a palette (.png strip or .vox).
+    LoadPalette,
+    /// Write the palette as a PNG strip.
+    SavePalette,
 }
 
 /// A finished piece of background work.
@@ -161,6 +165,10 @@ pub enum Done {
     Picked(Purpose, Result<Option<PathBuf>, String>),
     /// A scene was loaded (or failed to) from a path, or built (the default scene: None).
     Loaded(Option<PathBuf>, Box<Result<Scene>>),
+    /// A palette was read (or failed to).
+    Palette(Result<Vec<[u8; 3]>>),
+    /// The palette was written (or failed to).
+    PaletteSaved(PathBuf, Result<()>),
     /// A save finished; `autosave` saves go to the recovery file and don't clean the document.
     Saved {
         /// Where.
@@ -215,6 +223,8 @@ impl FileWorker {
                 Purpose::Import => d.add_filter("MagicaVoxel", &["vox"]),
                 Purpose::SaveAs => d.add_filter("voxbrick project", &["ron"]),
                 Purpose::Export => d.add_filter("MagicaVoxel", &["vox"]),
+                Purpose::LoadPalette => d.add_filter("Palette", &["png", "vox"]),
+                Purpose::SavePalette => d.add_filter("PNG palette strip", &["png"]),
             };
             if let Some(f) = folder {
                 d = d.set_directory(f);
@@ -224,8 +234,8 @@ impl FileWorker {
             }
             let started = std::time::Instant::now();
             let picked = match purpose {
-                Purpose::Open | Purpose::Import => d.pick_file(),
-                Purpose::SaveAs | Purpose::Export => d.save_file(),
+                Purpose::Open | Purpose::Import | Purpose::LoadPalette => d.pick_file(),
+                Purpose::SaveAs | Purpose::Export | Purpose::SavePalette => d.save_file(),
             };
             // rfd answers "cancelled" at once when no dialog can be shown (no
             // xdg-desktop-portal); nobody cancels a dialog that fast.
@@ -242,6 +252,21 @@ impl FileWorker {
             let scene =
                 Scene::load(&path, workers).with_context(|| format!("opening {}", path.display()));
             Done::Loaded(Some(path), Box::new(scene))
+        });
+    }
+
+    /// Reads a palette on a worker thread.
+    pub fn load_palette(&mut self, path: PathBuf) {
+        self.spawn(format!("reading {}", path.display()), move || {
+            Done::Palette(crate::formats::palette::load(&path).map_err(Into::into))
+        });
+    }
+
+    /// Writes a palette on a worker thread.
+    pub fn save_palette(&mut self, colours: Vec<[u8; 3]>, path: PathBuf) {
+        self.spawn(format!("writing {}", path.display()), move || {
+            let result = crate::formats::palette::save_png(&colours, &path).map_err(Into::into);
+            Done::PaletteSaved(path, result)
         });
     }
 

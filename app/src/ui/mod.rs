@@ -396,6 +396,14 @@ impl Editor {
                 self.execute(Command::SetMaterial { index, material })
             }
             UiEvent::AddMaterial(m) => self.execute(Command::AddMaterial(m)),
+            UiEvent::PaletteFile { save: false } => {
+                self.files.pick(Purpose::LoadPalette, self.folder(), None)
+            }
+            UiEvent::PaletteFile { save: true } => self.files.pick(
+                Purpose::SavePalette,
+                self.folder(),
+                Some("palette.png".into()),
+            ),
             UiEvent::SetParam { kind, index, value } => {
                 self.execute(Command::SetParam { kind, index, value })
             }

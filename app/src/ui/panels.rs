@@ -75,6 +75,11 @@ pub enum UiEvent {
         /// The new value.
         material: crate::editor::command::MaterialSpec,
     },
+    /// Load (false: ask for a .png or .vox) or save (true: as a PNG strip) the palette.
+    PaletteFile {
+        /// Save rather than load.
+        save: bool,
+    },
     /// A material was added.
     AddMaterial(crate::editor::command::MaterialSpec),
     /// A parameter-table value changed (roughness, IOR, strength).
