@@ -162,7 +162,9 @@ impl Editor {
             {
                 let view = doc.scene.world.read();
                 let stroke = self.previewed_stroke(&view);
-                self.preview.update(&view, stroke.as_ref(), doc.revision);
+                drop(view);
+                self.preview
+                    .update(&self.doc, stroke.as_ref(), doc.revision);
             }
             egui_ctx.run_ui(raw, |ui| {
                 // Under every panel and window, over the viewport image.

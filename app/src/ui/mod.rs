@@ -215,6 +215,7 @@ impl Editor {
             let _ = wake_proxy.send_event(Wake);
         });
         let files = FileWorker::new(wake.clone());
+        let wake_preview = wake.clone();
         let edits = EditQueue::new(wake);
         let config = ConfigDir::from_env();
         // Until the first real scene arrives the editor shows an empty one-brick grid.
@@ -300,7 +301,7 @@ impl Editor {
             keymap: Default::default(),
             window_size: (16, 9),
             drawing: None,
-            preview: Default::default(),
+            preview: preview::Preview::new(wake_preview),
             fail_at_frame: std::env::var("VOXBRICK_TEST_GPU_FAILURE_AT_FRAME")
                 .ok()
                 .and_then(|v| v.parse().ok()),

@@ -1,73 +1,102 @@
 //! The brush preview: exactly the voxels a click would change (`command::preview`), drawn
 //! translucent over the viewport as the outer faces of that set that face the camera. It is
 //! recomputed only when the stroke it previews or the document changes (not every frame),
-//! and drawn each frame from the kept faces, so it follows the cursor with at most one
-//! frame of lag. A brush too large to examine voxel by voxel shows its bounding box.
+//! on its own thread (a radius-64 brush takes ~50 ms: the UI keeps drawing the previous
+//! preview meanwhile; a small brush's arrives by the next frame), and drawn each frame from
+//! the kept faces. A brush too large to examine voxel by voxel shows its bounding box.
 
 use super::camera::ViewCamera;
+use super::files::SharedDocument;
 use crate::editor::command::{BrushMode, Stroke, preview, stroke_edits};
-use brickmap::{EditOp, WorldView};
+use brickmap::EditOp;
+use crossbeam_channel::{Receiver, Sender};
 use glam::{DVec3, IVec3};
 use std::collections::HashSet;
+use std::sync::Arc;
 
 /// What is previewed: the stroke and the document revision it was computed for.
 type Key = (Stroke, u64);
 
-/// The kept preview.
+/// A computed preview.
 #[derive(Default)]
-pub struct Preview {
-    key: Option<Key>,
+struct Shown {
     /// Outer faces of the voxel set: corners and outward normal.
     faces: Vec<([DVec3; 4], IVec3)>,
-    /// Voxels in the set (None: too large, `bounds` is drawn).
-    pub voxels: Option<usize>,
-    /// The brush's bounding box when the set was too large.
+    /// The brush's bounding box when the set was too large to examine.
     bounds: Option<(DVec3, DVec3)>,
     mode: Option<BrushMode>,
-    /// Seconds the last recomputation took (for the status line and benchmarks).
-    pub seconds: f64,
+}
+
+/// The kept preview and its thread.
+pub struct Preview {
+    requests: Option<Sender<(SharedDocument, Key)>>,
+    results: Receiver<(Key, Shown)>,
+    /// The latest stroke asked for (None: nothing to show).
+    wanted: Option<Key>,
+    /// The one computed for, and shown.
+    shown: Option<(Key, Shown)>,
 }
 
 impl Preview {
-    /// Shows `stroke` (None: nothing) in the world at document revision `revision`;
-    /// recomputes only when either changed.
-    pub fn update(&mut self, view: &WorldView<'_>, stroke: Option<&Stroke>, revision: u64) {
+    /// Starts the preview thread; `wake` redraws the editor when a preview is ready.
+    pub fn new(wake: Arc<dyn Fn() + Send + Sync>) -> Self {
+        let (requests, rx) = crossbeam_channel::unbounded::<(SharedDocument, Key)>();
+        let (tx, results) = crossbeam_channel::unbounded();
+        std::thread::Builder::new()
+            .name("voxbrick-preview".into())
+            .spawn(move || {
+                while let Ok(mut job) = rx.recv() {
+                    // Only the latest request matters.
+                    while let Ok(newer) = rx.try_recv() {
+                        job = newer;
+                    }
+                    let (doc, key) = job;
+                    let shown = {
+                        let d = doc.read().unwrap_or_else(|p| p.into_inner());
+                        let view = d.scene.world.read();
+                        compute(&view, &key.0)
+                    };
+                    if tx.send((key, shown)).is_err() {
+                        break;
+                    }
+                    wake();
+                }
+            })
+            .expect("spawning the preview thread");
+        Self {
+            requests: Some(requests),
+            results,
+            wanted: None,
+            shown: None,
+        }
+    }
+
+    /// Shows `stroke` (None: nothing) of `doc` at revision `revision`: asks the thread when
+    /// either changed, and keeps what it last computed.
+    pub fn update(&mut self, doc: &SharedDocument, stroke: Option<&Stroke>, revision: u64) {
+        while let Ok(done) = self.results.try_recv() {
+            self.shown = Some(done);
+        }
         let Some(stroke) = stroke else {
-            self.clear();
+            self.wanted = None;
             return;
         };
-        if self
-            .key
-            .as_ref()
-            .is_some_and(|(s, r)| s == stroke && *r == revision)
-        {
-            return;
-        }
-        let started = std::time::Instant::now();
-        self.clear();
-        self.key = Some((stroke.clone(), revision));
-        self.mode = Some(stroke.mode);
-        match preview(view, stroke) {
-            Ok(Some(voxels)) => {
-                self.voxels = Some(voxels.len());
-                self.faces = outer_faces(&voxels);
+        let key = (stroke.clone(), revision);
+        if self.wanted.as_ref() != Some(&key) {
+            if let Some(r) = &self.requests {
+                let _ = r.send((doc.clone(), key.clone()));
             }
-            Ok(None) => self.bounds = bounds(stroke),
-            Err(_) => {}
+            self.wanted = Some(key);
         }
-        self.seconds = started.elapsed().as_secs_f64();
     }
 
-    fn clear(&mut self) {
-        self.key = None;
-        self.faces.clear();
-        self.voxels = None;
-        self.bounds = None;
-    }
-
-    /// Paints the preview for the view's camera into `rect` (the viewport, in points).
+    /// Paints the preview for the view's camera into `rect` (the viewport, in points): the
+    /// latest computed one, while a stroke is wanted.
     pub fn paint(&self, painter: &egui::Painter, view: &ViewCamera, rect: egui::Rect) {
-        let Some(mode) = self.mode else { return };
+        let (Some(_), Some((_, shown))) = (&self.wanted, &self.shown) else {
+            return;
+        };
+        let Some(mode) = shown.mode else { return };
         let colour = match mode {
             BrushMode::Attach => egui::Color32::from_rgba_unmultiplied(255, 255, 255, 70),
             BrushMode::Erase => egui::Color32::from_rgba_unmultiplied(255, 60, 40, 90),
@@ -85,7 +114,7 @@ impl Preview {
         let eye = view.camera.position;
         let forward = view.camera.forward();
         let mut mesh = egui::Mesh::default();
-        for (corners, normal) in &self.faces {
+        for (corners, normal) in &shown.faces {
             let centre = (corners[0] + corners[2]) * 0.5;
             let towards = if view.camera.is_orthographic() {
                 forward
@@ -112,7 +141,7 @@ impl Preview {
         if !mesh.is_empty() {
             painter.add(egui::Shape::mesh(mesh));
         }
-        if let Some((lo, hi)) = self.bounds {
+        if let Some((lo, hi)) = shown.bounds {
             let stroke = egui::Stroke::new(1.5, colour.to_opaque());
             let corner = |i: usize| {
                 DVec3::new(
@@ -133,6 +162,27 @@ impl Preview {
             }
         }
     }
+}
+
+impl Drop for Preview {
+    fn drop(&mut self) {
+        // The thread ends when its request channel closes.
+        self.requests = None;
+    }
+}
+
+/// The preview of `stroke` in the world as it is.
+fn compute(view: &brickmap::WorldView<'_>, stroke: &Stroke) -> Shown {
+    let mut shown = Shown {
+        mode: Some(stroke.mode),
+        ..Default::default()
+    };
+    match preview(view, stroke) {
+        Ok(Some(voxels)) => shown.faces = outer_faces(&voxels),
+        Ok(None) => shown.bounds = bounds(stroke),
+        Err(_) => shown.mode = None,
+    }
+    shown
 }
 
 /// The faces between the set and the rest, each with its outward normal.
