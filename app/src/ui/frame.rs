@@ -169,8 +169,18 @@ impl Editor {
             egui_ctx.run_ui(raw, |ui| {
                 // Under every panel and window, over the viewport image.
                 let painter = ui.ctx().layer_painter(egui::LayerId::background());
-                self.preview
-                    .paint(&painter, &self.view, ui.ctx().content_rect());
+                let rect = ui.ctx().content_rect();
+                self.preview.paint(&painter, &self.view, rect);
+                let brush = &self.settings.brush;
+                let dims = doc.scene.world.dims().voxels();
+                preview::paint_mirror(
+                    &painter,
+                    &self.view,
+                    rect,
+                    brush.mirror,
+                    brush.centre(dims),
+                    dims,
+                );
                 events = panels::draw(ui, &mut self.panels, &doc, &mut self.settings);
             })
         };

@@ -101,6 +101,10 @@ pub fn fly_axis(key: KeyCode) -> Option<DVec3> {
 pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Left drag", "draw with the brush (one undo step per drag)"),
     ("Alt + click", "pick the material under the cursor"),
+    (
+        "Shift + click (paint)",
+        "flood-fill the connected surface of that material",
+    ),
     ("Esc (while drawing)", "cancel the stroke"),
     ("T / X / P", "attach / erase / paint"),
     (

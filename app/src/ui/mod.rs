@@ -491,6 +491,19 @@ impl Editor {
             }
             return;
         }
+        if self.mods.shift && self.settings.brush.mode == crate::editor::command::BrushMode::Paint {
+            // Flood fill: the connected surface of the clicked voxel's material.
+            if let Some((hit, _)) = tools::pick(&view, origin, dir) {
+                let material = self.settings.brush.material;
+                drop(view);
+                drop(doc);
+                self.execute(Command::FloodFill {
+                    start: hit.voxel,
+                    material,
+                });
+            }
+            return;
+        }
         let brush = &self.settings.brush;
         let Some((v, layer)) = tools::start(&view, brush.mode, origin, dir) else {
             return;

@@ -102,15 +102,7 @@ impl Preview {
             BrushMode::Erase => egui::Color32::from_rgba_unmultiplied(255, 60, 40, 90),
             BrushMode::Paint => egui::Color32::from_rgba_unmultiplied(80, 200, 255, 80),
         };
-        let aspect = (rect.width() / rect.height().max(1.0)) as f64;
-        let to_screen = |p: DVec3| {
-            view.project(p, aspect).map(|(u, v)| {
-                egui::pos2(
-                    rect.left() + (u as f32 + 1.0) * 0.5 * rect.width(),
-                    rect.top() + (1.0 - v as f32) * 0.5 * rect.height(),
-                )
-            })
-        };
+        let to_screen = |p: DVec3| screen_point(view, rect, p);
         let eye = view.camera.position;
         let forward = view.camera.forward();
         let mut mesh = egui::Mesh::default();
@@ -159,6 +151,60 @@ impl Preview {
                         painter.line_segment([p, q], stroke);
                     }
                 }
+            }
+        }
+    }
+}
+
+/// Where a world point appears in `rect` (the viewport, in points), if in front.
+fn screen_point(view: &ViewCamera, rect: egui::Rect, p: DVec3) -> Option<egui::Pos2> {
+    let aspect = (rect.width() / rect.height().max(1.0)) as f64;
+    view.project(p, aspect).map(|(u, v)| {
+        egui::pos2(
+            rect.left() + (u as f32 + 1.0) * 0.5 * rect.width(),
+            rect.top() + (1.0 - v as f32) * 0.5 * rect.height(),
+        )
+    })
+}
+
+/// Draws the enabled mirror planes as their outlines across the grid (x red, y green,
+/// z blue).
+pub fn paint_mirror(
+    painter: &egui::Painter,
+    view: &ViewCamera,
+    rect: egui::Rect,
+    mirror: [bool; 3],
+    centre: DVec3,
+    dims: IVec3,
+) {
+    let size = dims.as_dvec3();
+    let colours = [
+        egui::Color32::from_rgba_unmultiplied(255, 80, 80, 160),
+        egui::Color32::from_rgba_unmultiplied(80, 255, 80, 160),
+        egui::Color32::from_rgba_unmultiplied(80, 140, 255, 160),
+    ];
+    for axis in (0..3).filter(|&a| mirror[a]) {
+        let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+        let corner = |cu: bool, cw: bool| {
+            let mut p = DVec3::ZERO;
+            p[axis] = centre[axis];
+            p[u] = if cu { size[u] } else { 0.0 };
+            p[w] = if cw { size[w] } else { 0.0 };
+            p
+        };
+        let ring = [
+            corner(false, false),
+            corner(true, false),
+            corner(true, true),
+            corner(false, true),
+        ];
+        let stroke = egui::Stroke::new(1.5, colours[axis]);
+        for k in 0..4 {
+            if let (Some(a), Some(b)) = (
+                screen_point(view, rect, ring[k]),
+                screen_point(view, rect, ring[(k + 1) % 4]),
+            ) {
+                painter.line_segment([a, b], stroke);
             }
         }
     }
