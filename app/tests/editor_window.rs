@@ -22,6 +22,13 @@ fn skip(why: &str) {
     eprintln!("SKIPPED: {why}; VOXBRICK_REQUIRE_GPU=1 makes this a failure");
 }
 
+/// The editor exited because this machine has no Vulkan device that can draw a window.
+fn no_vulkan(out: &std::process::Output) -> bool {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    !out.status.success()
+        && (stderr.contains("no usable Vulkan") || stderr.contains("no Vulkan device"))
+}
+
 fn have(tool: &str) -> bool {
     Command::new("sh")
         .args(["-c", &format!("command -v {tool}")])
@@ -204,15 +211,13 @@ fn the_live_editor_presents_what_a_headless_render_of_the_same_state_shows() {
         std::thread::sleep(Duration::from_millis(100));
     }
     let out = editor.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    if !out.status.success()
-        && (stderr.contains("no usable Vulkan") || stderr.contains("no Vulkan device"))
-    {
+    if no_vulkan(&out) {
         return skip(&format!(
             "no Vulkan device can draw a window: {}",
-            stderr.trim()
+            String::from_utf8_lossy(&out.stderr).trim()
         ));
     }
+    let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
         out.status.success(),
         "the editor failed: {}\n{}",
@@ -337,13 +342,13 @@ fn a_failing_script_step_in_the_live_editor_exits_non_zero_naming_the_step() {
         .env("VOXBRICK_CONFIG_DIR", dir.join("config"))
         .output()
         .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    if stderr.contains("no usable Vulkan") || stderr.contains("no Vulkan device") {
+    if no_vulkan(&out) {
         return skip(&format!(
             "no Vulkan device can draw a window: {}",
-            stderr.trim()
+            String::from_utf8_lossy(&out.stderr).trim()
         ));
     }
+    let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "a failed step must fail the run");
     assert!(stderr.contains("step 2 (ExpectSolidCount)"), "{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
@@ -389,13 +394,13 @@ fn a_gpu_failure_mid_session_keeps_the_unsaved_work_in_the_recovery_file() {
         .env("VOXBRICK_TEST_GPU_FAILURE_AT_FRAME", "40")
         .output()
         .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    if stderr.contains("no usable Vulkan") || stderr.contains("no Vulkan device") {
+    if no_vulkan(&out) {
         return skip(&format!(
             "no Vulkan device can draw a window: {}",
-            stderr.trim()
+            String::from_utf8_lossy(&out.stderr).trim()
         ));
     }
+    let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "a GPU failure fails the run");
     assert!(
         stderr.contains("the GPU failed") && stderr.contains("device has been lost"),
@@ -500,15 +505,13 @@ fn strokes_drawn_with_the_mouse_replay_headlessly_to_the_same_scene() {
     }
     let _ = editor.kill();
     let out = editor.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    if !out.status.success()
-        && (stderr.contains("no usable Vulkan") || stderr.contains("no Vulkan device"))
-    {
+    if no_vulkan(&out) {
         return skip(&format!(
             "no Vulkan device can draw a window: {}",
-            stderr.trim()
+            String::from_utf8_lossy(&out.stderr).trim()
         ));
     }
+    let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
         out.status.success(),
         "the editor (validation on) failed: {stderr}"

@@ -30,8 +30,8 @@ impl LiveStroke {
     /// Starts a stroke at its first points and applies them (a box waits for its last corner:
     /// nothing is applied until the end). On error nothing changed.
     pub fn begin(scene: &Scene, stroke: Stroke) -> Result<Self> {
-        // Validate the whole stroke (points, size, material) before touching the world.
-        stroke_edits(&stroke)?;
+        // The material before touching the world (the points and size are checked with the
+        // first segment, before it is applied).
         if stroke.mode != super::brush::BrushMode::Erase {
             scene.world.materials().check(stroke.material as u32)?;
         }
@@ -83,18 +83,18 @@ impl LiveStroke {
             points: points.to_vec(),
             ..self.stroke.clone()
         };
-        // Validated even when nothing is applied yet (a box's corners).
-        stroke_edits(&part)?;
-        match self.stroke.shape {
-            BrushShape::Box => Ok(Vec::new()),
-            BrushShape::Line => {
-                if let Some(last) = self.stroke.points.last() {
-                    part.points.insert(0, *last);
-                }
-                stroke_edits(&part)
-            }
-            _ => stroke_edits(&part),
+        if self.stroke.shape == BrushShape::Line
+            && let Some(last) = self.stroke.points.last()
+        {
+            part.points.insert(0, *last);
         }
+        let edits = stroke_edits(&part)?;
+        // A box's corners are checked now, applied at the end.
+        Ok(if self.stroke.shape == BrushShape::Box {
+            Vec::new()
+        } else {
+            edits
+        })
     }
 
     /// Undoes what the stroke applied and returns `error` (or the failure to undo).

@@ -55,12 +55,13 @@ impl Editor {
                     self.panels.errors.push(e.to_string());
                 }
             }
-            Edited::Stroke(result) => {
-                if let Err(e) = result {
-                    // The stroke is undone and closed: stop sending it segments.
-                    self.drawing = None;
-                    self.panels.errors.push(format!("stroke: {e}"));
-                }
+            // A segment: the statistics (a walk over every cell) wait for the stroke's end.
+            Edited::Stroke(Ok(None)) => return,
+            Edited::Stroke(Ok(Some(_))) => {}
+            Edited::Stroke(Err(e)) => {
+                // The stroke is undone and closed: stop sending it segments.
+                self.drawing = None;
+                self.panels.errors.push(format!("stroke: {e}"));
             }
             Edited::ScriptStep {
                 run,
