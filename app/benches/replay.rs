@@ -50,6 +50,8 @@ fn session() -> Script {
             material: 0,
             mirror: Mirror::default(),
             points,
+            axis: Default::default(),
+            in_selection: false,
         })));
         if i % 20 == 19 {
             steps.extend([Step::Undo, Step::Undo, Step::Undo, Step::Redo, Step::Redo]);

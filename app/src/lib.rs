@@ -1,11 +1,12 @@
 //! voxbrick's application library: the scene document, file formats and CLI commands that
-//! the `voxbrick` binary (and later the editor) use.
+//! the `voxbrick` binary and the editor use.
 
 pub mod atomic;
 pub mod editor;
 pub mod formats;
 pub mod gpu;
 pub mod scene;
+pub mod selection;
 pub mod ui;
 
 pub use scene::Scene;

@@ -2,6 +2,7 @@
 //! camera, sun, sky and render settings; plus the built-in scenes.
 
 use crate::formats::{self, Format, FormatError};
+use crate::selection::{Clip, Selection};
 use anyhow::{Context, Result};
 use brickmap::{
     EditOp, GridDims, Material, MaterialKind, Mode, Shape, World, WorldConfig, terrain,
@@ -9,6 +10,7 @@ use brickmap::{
 use glam::{DVec3, IVec3};
 use render::SceneParams;
 use std::path::Path;
+use std::sync::Arc;
 
 /// A scene: everything a file carries.
 #[derive(Debug)]
@@ -17,16 +19,31 @@ pub struct Scene {
     pub world: World,
     /// Camera, sun, sky, render settings.
     pub params: SceneParams,
+    /// The editing session's selection (never saved).
+    pub selection: Option<Selection>,
+    /// The editing session's clipboard (never saved; the editor carries it to the next
+    /// document it opens).
+    pub clipboard: Option<Arc<Clip>>,
 }
 
 impl Scene {
     /// An empty scene of a grid size, framed by the default camera.
     pub fn empty(dims: GridDims, workers: usize) -> brickmap::Result<Self> {
         let world = World::new(dims, WorldConfig::with_workers(workers))?;
-        Ok(Self {
-            params: SceneParams::framing(dims.voxels().as_dvec3()),
+        Ok(Self::new(
             world,
-        })
+            SceneParams::framing(dims.voxels().as_dvec3()),
+        ))
+    }
+
+    /// A scene of a world and its parameters, nothing selected.
+    pub fn new(world: World, params: SceneParams) -> Self {
+        Self {
+            world,
+            params,
+            selection: None,
+            clipboard: None,
+        }
     }
 
     /// Loads a `.ron` project or imports a `.vox` file (which gets the default sun and sky).

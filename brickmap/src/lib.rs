@@ -25,6 +25,7 @@ pub mod shape;
 mod slab;
 pub mod storage;
 pub mod terrain;
+pub mod voxel_set;
 pub mod world;
 
 pub use brick::{Brick, Mask};
@@ -37,4 +38,5 @@ pub use material::{Material, MaterialKind, MaterialTable};
 pub use raycast::{Occupancy, Ray, RayHit, cast, cast_from_cell};
 pub use shape::Shape;
 pub use storage::BucketSizes;
+pub use voxel_set::VoxelSet;
 pub use world::{BrickMaterials, DirtySet, GpuBuffer, MemoryStats, World, WorldConfig, WorldView};

@@ -5,7 +5,9 @@
 
 use crate::brick::{Mask, voxel_bit};
 use crate::error::{BrickmapError, Result};
+use crate::voxel_set::VoxelSet;
 use glam::{DVec3, IVec3};
+use std::sync::Arc;
 
 /// A region of voxels an edit applies to.
 #[derive(Clone, Debug, PartialEq)]
@@ -43,6 +45,15 @@ pub enum Shape {
         points: Vec<DVec3>,
         /// Radius, > 0.
         radius: f64,
+    },
+    /// Exactly the voxels of a set (a selection).
+    Set(Arc<VoxelSet>),
+    /// The voxels of a shape that also lie in a set (a tool limited to the selection).
+    Within {
+        /// The shape.
+        shape: Box<Shape>,
+        /// The voxels it is limited to.
+        set: Arc<VoxelSet>,
     },
 }
 
@@ -126,6 +137,8 @@ impl Shape {
                 }
                 positive(*radius, "line radius")
             }
+            Shape::Set(_) => Ok(()),
+            Shape::Within { shape, .. } => shape.validate(),
         }
     }
 
@@ -151,6 +164,10 @@ impl Shape {
                 points
                     .windows(2)
                     .any(|w| segment_dist2(c, w[0], w[1]) <= r2)
+            }
+            Shape::Set(set) => set.contains(c.floor().as_ivec3()),
+            Shape::Within { shape, set } => {
+                set.contains(c.floor().as_ivec3()) && shape.contains_centre(c)
             }
         }
     }
@@ -179,6 +196,19 @@ impl Shape {
                 let lo = points.iter().fold(DVec3::INFINITY, |m, p| m.min(*p));
                 let hi = points.iter().fold(DVec3::NEG_INFINITY, |m, p| m.max(*p));
                 around(lo - *radius, hi + *radius)
+            }
+            // An empty set: bounds no voxel lies in (min above max).
+            Shape::Set(set) => set
+                .bounds()
+                .unwrap_or((IVec3::splat(i32::MAX), IVec3::splat(i32::MIN))),
+            Shape::Within { shape, set } => {
+                let (lo, hi) = shape.voxel_bounds();
+                match set.bounds() {
+                    Some((a, b)) if a.cmple(hi).all() && lo.cmple(b).all() => {
+                        (lo.max(a), hi.min(b))
+                    }
+                    _ => (IVec3::splat(i32::MAX), IVec3::splat(i32::MIN)),
+                }
             }
         }
     }
@@ -259,6 +289,12 @@ impl Shape {
                     Coverage::Partial
                 }
             }
+            Shape::Set(set) => set_coverage(set, min),
+            Shape::Within { shape, set } => match (shape.coverage(min), set_coverage(set, min)) {
+                (Coverage::Outside, _) | (_, Coverage::Outside) => Coverage::Outside,
+                (Coverage::Inside, Coverage::Inside) => Coverage::Inside,
+                _ => Coverage::Partial,
+            },
         }
     }
 
@@ -266,6 +302,15 @@ impl Shape {
     pub fn mask(&self, min: IVec3) -> Mask {
         let mut m = Mask::EMPTY;
         match self {
+            Shape::Set(set) => return set_brick(set, min),
+            Shape::Within { shape, set } => {
+                let inner = match shape.coverage(min) {
+                    Coverage::Outside => Mask::EMPTY,
+                    Coverage::Inside => Mask::FULL,
+                    Coverage::Partial => shape.mask(min),
+                };
+                return inner.and(&set_brick(set, min));
+            }
             Shape::Sphere { centre, radius } => {
                 // Row spans: solve (x + 0.5 - cx)² ≤ r² − dy² − dz² per row.
                 for z in 0..8 {
@@ -301,6 +346,25 @@ impl Shape {
     }
 }
 
+/// The set's voxels in the brick whose minimum voxel is `min` (none outside the grid).
+fn set_brick(set: &VoxelSet, min: IVec3) -> Mask {
+    if min.cmplt(IVec3::ZERO).any() {
+        return Mask::EMPTY;
+    }
+    set.brick((min / 8).as_uvec3())
+}
+
+fn set_coverage(set: &VoxelSet, min: IVec3) -> Coverage {
+    let m = set_brick(set, min);
+    if m.is_empty() {
+        Coverage::Outside
+    } else if m.is_full() {
+        Coverage::Inside
+    } else {
+        Coverage::Partial
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -329,7 +393,24 @@ mod tests {
                 radius: 3.2,
             },
             Shape::Voxel(IVec3::new(9, 8, 7)),
+            Shape::Set(Arc::new(test_set())),
+            Shape::Within {
+                shape: Box::new(Shape::Sphere {
+                    centre: DVec3::new(10.3, 9.0, 11.7),
+                    radius: 9.2,
+                }),
+                set: Arc::new(test_set()),
+            },
         ]
+    }
+
+    /// Voxels of two overlapping boxes, one brick fully inside.
+    fn test_set() -> VoxelSet {
+        let mut s = VoxelSet::new();
+        let grid = IVec3::splat(64);
+        s.apply_box(IVec3::new(4, 0, 3), IVec3::new(17, 15, 16), grid, false);
+        s.apply_box(IVec3::new(9, 5, 0), IVec3::new(12, 30, 30), grid, true);
+        s
     }
 
     #[test]

@@ -670,6 +670,19 @@ impl WorldView<'_> {
             .voxel(self.world.dims.cell_index(b), bit))
     }
 
+    /// The solid voxels of brick `b` (inside the grid) and their materials by voxel index
+    /// (0 where empty): what a copy of a selection reads.
+    pub fn brick_voxels(&self, b: UVec3) -> (crate::Mask, [u8; 512]) {
+        let (mask, mats) = self
+            .slab_for_brick_x(b.x)
+            .read(self.world.dims.cell_index(b));
+        let mut dense = [0u8; 512];
+        for (k, bit) in mask.ones().enumerate() {
+            dense[bit] = mats.at(k);
+        }
+        (mask, dense)
+    }
+
     /// The box of brick cells that hold anything, in voxels (min inclusive, max exclusive;
     /// brick-granular), or None for an empty world. For framing the content in a view.
     pub fn occupied_bounds(&self) -> Option<(IVec3, IVec3)> {

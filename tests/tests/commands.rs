@@ -38,6 +38,8 @@ fn stroke(mode: BrushMode, shape: BrushShape, size: f64, points: &[[f64; 3]]) ->
         material: 4,
         mirror: Mirror::default(),
         points: points.iter().map(|p| DVec3::from_array(*p)).collect(),
+        axis: Default::default(),
+        in_selection: false,
     })
 }
 
@@ -96,6 +98,8 @@ fn every_command() -> Vec<Command> {
                 centre: DVec3::new(64.0, 0.0, 64.0),
             },
             points: vec![DVec3::new(20.0, 50.0, 30.0)],
+            axis: Default::default(),
+            in_selection: false,
         }),
         Command::FloodFill {
             start: IVec3::new(64, 0, 0),

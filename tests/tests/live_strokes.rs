@@ -45,6 +45,8 @@ fn stroke(mode: BrushMode, shape: BrushShape, mirror: bool) -> Stroke {
             ..Mirror::default()
         },
         points: drag(),
+        axis: Default::default(),
+        in_selection: false,
     }
 }
 
@@ -217,7 +219,9 @@ fn the_preview_is_exactly_what_the_click_then_changes() {
             };
             let preview = {
                 let view = doc.scene.world.read();
-                app::editor::command::preview(&view, &s).unwrap().unwrap()
+                app::editor::command::preview(&view, &s, None)
+                    .unwrap()
+                    .unwrap()
             };
             doc.execute(Command::Stroke(s)).unwrap();
             let after = snapshot(&doc);

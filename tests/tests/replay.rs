@@ -175,6 +175,8 @@ fn a_recorded_session_replays_to_the_same_content() {
                 ..Default::default()
             },
             points: vec![glam::DVec3::new(x, 16.0, 20.0)],
+            axis: Default::default(),
+            in_selection: false,
         })
     };
     doc.execute(stroke(20.0, BrushMode::Attach)).unwrap();
@@ -205,6 +207,57 @@ fn a_recorded_session_replays_to_the_same_content() {
     let out = scratch("recorded");
     let replayed = script::replay(&parsed, &out, &options(1, &out), &mut |_| {}).unwrap();
     assert_eq!(replayed.document.scene.world.read().content_hash(), want);
+}
+
+#[test]
+fn a_recorded_selection_session_replays_to_the_same_content() {
+    use app::selection::SelectOp;
+    use glam::IVec3;
+    let dims = brickmap::GridDims::new(8, 4, 8).unwrap();
+    let mut doc = Document::new(Scene::empty(dims, 2).unwrap(), History::default());
+    doc.recorder = Some(Recorder::default());
+    let box_at = |min: IVec3, max: IVec3| SelectOp::Replace { min, max };
+    doc.execute(Command::Select(box_at(
+        IVec3::new(4, 0, 4),
+        IVec3::new(30, 12, 30),
+    )))
+    .unwrap();
+    doc.execute(Command::FillSelection(0)).unwrap();
+    doc.execute(Command::Select(SelectOp::Subtract {
+        min: IVec3::new(10, 0, 10),
+        max: IVec3::new(20, 31, 20),
+    }))
+    .unwrap();
+    doc.execute(Command::Copy).unwrap();
+    doc.execute(Command::MoveSelection(IVec3::new(20, 3, -9)))
+        .unwrap();
+    doc.execute(Command::Paste {
+        at: IVec3::new(40, 0, 40),
+    })
+    .unwrap();
+    doc.execute(Command::PaintSelection(0)).unwrap();
+    doc.undo().unwrap();
+    doc.execute(Command::Cut).unwrap();
+    doc.execute(Command::Paste {
+        at: IVec3::new(0, 20, 0),
+    })
+    .unwrap();
+    let want = doc.scene.world.read().content_hash();
+    let text = doc.recorder.as_ref().unwrap().to_ron(
+        Start::New {
+            size: (64, 32, 64),
+            terrain: None,
+        },
+        Some(2),
+    );
+    let parsed = script::parse(&text).unwrap();
+    let out = scratch("recorded-selection");
+    let replayed = script::replay(&parsed, &out, &options(1, &out), &mut |_| {}).unwrap();
+    assert_eq!(replayed.document.scene.world.read().content_hash(), want);
+    assert_eq!(
+        replayed.document.scene.selection.map(|s| s.region),
+        doc.scene.selection.map(|s| s.region)
+    );
 }
 
 #[test]

@@ -391,6 +391,8 @@ pub fn edits(
                 material: 1,
                 mirror: Mirror::default(),
                 points: vec![point(k)],
+                axis: Default::default(),
+                in_selection: false,
             };
             let (mut apply, mut frames, mut ms, mut gpu, mut prev) =
                 (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -400,7 +402,7 @@ pub fn edits(
                 if k % 4 == 0 {
                     let view = doc.scene.world.read();
                     let started = Instant::now();
-                    let _ = preview(&view, &stroke(k))?;
+                    let _ = preview(&view, &stroke(k), None)?;
                     prev.push(started.elapsed().as_secs_f64() * 1e3);
                 }
                 // A frame in flight, as in the window's loop.

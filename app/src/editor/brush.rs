@@ -1,6 +1,7 @@
 //! Brush strokes: modes, shapes, mirror symmetry, and the world edits a stroke makes.
 
 use super::error::{EditError, Result, invalid};
+use crate::selection::Selection;
 use brickmap::{EditOp, Mode, Shape};
 use glam::{DVec3, IVec3};
 use serde::{Deserialize, Serialize};
@@ -25,12 +26,35 @@ pub enum BrushShape {
     Sphere,
     /// A cube of half-size `size` (edge 2·size + 1 voxels) centred on the point's voxel.
     Cube,
-    /// An upright cylinder of radius and half-height `size`.
+    /// A cylinder of radius and half-height `size` along the stroke's axis.
     Cylinder,
     /// Capsules of radius `size` along the stroke's points.
     Line,
     /// The box spanned by the stroke's first and last points.
     Box,
+}
+
+/// The axis of a cylinder brush.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Axis {
+    /// Along x.
+    X,
+    /// Upright.
+    #[default]
+    Y,
+    /// Along z.
+    Z,
+}
+
+impl Axis {
+    /// The unit vector.
+    pub fn vector(self) -> DVec3 {
+        match self {
+            Axis::X => DVec3::X,
+            Axis::Y => DVec3::Y,
+            Axis::Z => DVec3::Z,
+        }
+    }
 }
 
 /// Mirror symmetry about planes through `centre`.
@@ -62,10 +86,17 @@ pub struct Stroke {
     pub mirror: Mirror,
     /// Points, in voxel coordinates.
     pub points: Vec<DVec3>,
+    /// The cylinder's axis.
+    #[serde(default)]
+    pub axis: Axis,
+    /// Change only selected voxels (when something is selected).
+    #[serde(default)]
+    pub in_selection: bool,
 }
 
-/// The world edits of a stroke, mirror images included, validated before any is applied.
-pub fn stroke_edits(s: &Stroke) -> Result<Vec<EditOp>> {
+/// The world edits of a stroke, mirror images included, validated before any is applied;
+/// a stroke `in_selection` changes only voxels of `selection` (all, when none).
+pub fn stroke_edits(s: &Stroke, selection: Option<&Selection>) -> Result<Vec<EditOp>> {
     if s.points.is_empty() {
         return Err(invalid("a stroke needs at least one point"));
     }
@@ -141,14 +172,21 @@ pub fn stroke_edits(s: &Stroke) -> Result<Vec<EditOp>> {
             BrushShape::Cylinder => pts
                 .iter()
                 .map(|p| Shape::Cylinder {
-                    a: *p - DVec3::Y * s.size,
-                    b: *p + DVec3::Y * s.size,
+                    a: *p - s.axis.vector() * s.size,
+                    b: *p + s.axis.vector() * s.size,
                     radius: s.size,
                 })
                 .collect(),
         };
         for shape in shapes {
             shape.validate().map_err(EditError::World)?;
+            let shape = match selection.filter(|_| s.in_selection) {
+                Some(sel) => Shape::Within {
+                    shape: Box::new(shape),
+                    set: sel.voxels.clone(),
+                },
+                None => shape,
+            };
             edits.push(EditOp::Shape { shape, mode });
         }
     }
@@ -161,8 +199,12 @@ pub const PREVIEW_LIMIT: u64 = 4 << 20;
 
 /// Exactly the voxels `stroke` would change in the world as it is now, sorted by x, then y,
 /// then z (the brush preview); None when the brush covers more than [`PREVIEW_LIMIT`] voxels.
-pub fn preview(view: &brickmap::WorldView<'_>, stroke: &Stroke) -> Result<Option<Vec<IVec3>>> {
-    let edits = stroke_edits(stroke)?;
+pub fn preview(
+    view: &brickmap::WorldView<'_>,
+    stroke: &Stroke,
+    selection: Option<&Selection>,
+) -> Result<Option<Vec<IVec3>>> {
+    let edits = stroke_edits(stroke, selection)?;
     let dims = view.dims().voxels();
     let mut examined = 0u64;
     let mut out = std::collections::BTreeSet::new();

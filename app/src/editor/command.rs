@@ -3,13 +3,14 @@
 //! ([`Inverse`]). Strokes are in `brush`, flood fill in `fill`.
 
 pub use super::brush::{
-    BrushMode, BrushShape, Mirror, PREVIEW_LIMIT, Stroke, preview, stroke_edits,
+    Axis, BrushMode, BrushShape, Mirror, PREVIEW_LIMIT, Stroke, preview, stroke_edits,
 };
 pub use super::inverse::{Applied, Inverse};
 
 use super::error::{EditError, Result};
 use super::inverse::{apply_all, with_table};
 use crate::scene::Scene;
+use crate::selection::{self, Clip, SelectOp, Selection, select};
 use brickmap::terrain::{NoiseKind, NoiseTerrain};
 use brickmap::{EditOp, Material, MaterialKind, Mode, Shape};
 use glam::IVec3;
@@ -132,6 +133,26 @@ pub enum Command {
     },
     /// Remove every voxel.
     Clear,
+    /// Change the selection.
+    Select(SelectOp),
+    /// Empty every selected voxel.
+    DeleteSelection,
+    /// Make every selected voxel solid with a material.
+    FillSelection(u8),
+    /// Give every selected solid voxel a material.
+    PaintSelection(u8),
+    /// Move the selected solid voxels (and the selection) by an offset.
+    MoveSelection(IVec3),
+    /// Copy the selected solid voxels to the clipboard (no history step: nothing changes).
+    Copy,
+    /// Copy, then delete the selection.
+    Cut,
+    /// Put the clipboard down with its minimum corner at `at`; the pasted region becomes the
+    /// selection.
+    Paste {
+        /// Where the copied selection's minimum corner goes.
+        at: IVec3,
+    },
 }
 
 /// A material in commands and scripts.
@@ -225,6 +246,20 @@ impl Command {
             Command::GenerateTerrain(t) => format!("Generate terrain (seed {})", t.seed),
             Command::ImportVox { path, .. } => format!("Import {path}"),
             Command::Clear => "Clear".into(),
+            Command::Select(op) => match op {
+                SelectOp::Replace { .. } => "Select box".into(),
+                SelectOp::Add { .. } => "Add box to selection".into(),
+                SelectOp::Subtract { .. } => "Subtract box from selection".into(),
+                SelectOp::All => "Select all".into(),
+                SelectOp::None => "Select none".into(),
+            },
+            Command::DeleteSelection => "Delete selection".into(),
+            Command::FillSelection(m) => format!("Fill selection with material {m}"),
+            Command::PaintSelection(m) => format!("Paint selection with material {m}"),
+            Command::MoveSelection(d) => format!("Move selection by {d}"),
+            Command::Copy => "Copy".into(),
+            Command::Cut => "Cut".into(),
+            Command::Paste { at } => format!("Paste at {at}"),
         }
     }
 
@@ -242,6 +277,12 @@ impl Command {
         }
     }
 
+    /// Whether the command changes the document (a copy changes only the clipboard: it is
+    /// recorded, but is no history step and leaves the document clean).
+    pub fn changes_document(&self) -> bool {
+        !matches!(self, Command::Copy)
+    }
+
     /// Executes the command. On error the scene is as it was.
     pub fn apply(&self, scene: &mut Scene, folder: &std::path::Path) -> Result<Applied> {
         let world = &scene.world;
@@ -250,7 +291,54 @@ impl Command {
             changed_voxels: 0,
         };
         Ok(match self {
-            Command::Stroke(s) => apply_all(scene, stroke_edits(s)?)?,
+            Command::Stroke(s) => apply_all(scene, stroke_edits(s, scene.selection.as_ref())?)?,
+            Command::Select(op) => {
+                let next = select(scene.selection.as_ref(), *op, world.dims().voxels());
+                unchanged(Inverse::Selection(std::mem::replace(
+                    &mut scene.selection,
+                    next,
+                )))
+            }
+            Command::DeleteSelection => selection_edit(scene, Mode::Remove)?,
+            Command::FillSelection(m) => {
+                world.materials().check(*m as u32)?;
+                selection_edit(scene, Mode::Add(*m))?
+            }
+            Command::PaintSelection(m) => {
+                world.materials().check(*m as u32)?;
+                selection_edit(scene, Mode::Paint(*m))?
+            }
+            Command::MoveSelection(offset) => {
+                let selection = selected(scene)?.clone();
+                let edit = selection::move_edit(&world.read(), &selection, *offset);
+                let moved =
+                    Selection::new(selection.region.translated(*offset), world.dims().voxels());
+                with_selection(scene, edit, Some(moved))?
+            }
+            Command::Copy => {
+                let clip = Clip::copy(&world.read(), selected(scene)?)
+                    .ok_or_else(|| super::error::invalid("nothing is selected"))?;
+                scene.clipboard = Some(std::sync::Arc::new(clip));
+                unchanged(Inverse::Compound(Vec::new()))
+            }
+            Command::Cut => {
+                let clip = Clip::copy(&world.read(), selected(scene)?)
+                    .ok_or_else(|| super::error::invalid("nothing is selected"))?;
+                let applied = selection_edit(scene, Mode::Remove)?;
+                scene.clipboard = Some(std::sync::Arc::new(clip));
+                applied
+            }
+            Command::Paste { at } => {
+                let clip = scene
+                    .clipboard
+                    .clone()
+                    .ok_or_else(|| super::error::invalid("the clipboard is empty"))?;
+                let voxels = world.dims().voxels();
+                let edit = selection::paste_edit(&clip, *at, voxels);
+                let pasted = Selection::new(clip.region.translated(*at), voxels);
+                let pasted = (!pasted.voxels.is_empty()).then_some(pasted);
+                with_selection(scene, edit, pasted)?
+            }
             Command::FloodFill { start, material } => {
                 world.materials().check(*material as u32)?;
                 let edits = super::fill::flood_fill(scene, *start, *material)?;
@@ -367,4 +455,28 @@ impl Command {
             }
         })
     }
+}
+
+/// The current selection, or the error that says there is none.
+fn selected(scene: &Scene) -> Result<&Selection> {
+    scene
+        .selection
+        .as_ref()
+        .ok_or_else(|| super::error::invalid("nothing is selected"))
+}
+
+/// A mode applied to exactly the selected voxels.
+fn selection_edit(scene: &Scene, mode: Mode) -> Result<Applied> {
+    let shape = Shape::Set(selected(scene)?.voxels.clone());
+    apply_all(scene, vec![EditOp::Shape { shape, mode }])
+}
+
+/// Applies a voxel edit and then makes `next` the selection; the inverse puts both back.
+fn with_selection(scene: &mut Scene, edit: EditOp, next: Option<Selection>) -> Result<Applied> {
+    let applied = apply_all(scene, vec![edit])?;
+    let before = std::mem::replace(&mut scene.selection, next);
+    Ok(Applied {
+        inverse: Inverse::Compound(vec![applied.inverse, Inverse::Selection(before)]),
+        changed_voxels: applied.changed_voxels,
+    })
 }

@@ -4,6 +4,7 @@
 
 use super::error::Result;
 use crate::scene::Scene;
+use crate::selection::Selection;
 use brickmap::{EditInverse, EditOp, MaterialTable};
 use render::{Camera, RenderSettings, Sky, Sun};
 
@@ -22,6 +23,10 @@ pub enum Inverse {
     Camera(Camera),
     /// The previous settings.
     Settings(RenderSettings),
+    /// The previous selection.
+    Selection(Option<Selection>),
+    /// Several, undone last first (a move: its voxels, then its selection).
+    Compound(Vec<Inverse>),
 }
 
 impl Inverse {
@@ -35,6 +40,10 @@ impl Inverse {
                         + t.as_ref().map_or(0, |_| table)
                 }
                 Inverse::Table(_) => table,
+                Inverse::Compound(v) => v.iter().map(|i| i.bytes()).sum(),
+                Inverse::Selection(Some(s)) => {
+                    s.voxels.brick_count() * (std::mem::size_of::<brickmap::Mask>() + 32)
+                }
                 _ => 0,
             }
     }
@@ -67,6 +76,25 @@ impl Inverse {
             Inverse::Camera(v) => Inverse::Camera(std::mem::replace(&mut scene.params.camera, v)),
             Inverse::Settings(v) => {
                 Inverse::Settings(std::mem::replace(&mut scene.params.settings, v))
+            }
+            Inverse::Selection(v) => Inverse::Selection(std::mem::replace(&mut scene.selection, v)),
+            Inverse::Compound(list) => {
+                // On a failure the parts already applied are put back (all or nothing).
+                let mut back: Vec<Inverse> = Vec::with_capacity(list.len());
+                for inv in list.into_iter().rev() {
+                    match inv.apply(scene) {
+                        Ok(i) => back.push(i),
+                        Err(e) => {
+                            for done in back.into_iter().rev() {
+                                done.apply(scene)?;
+                            }
+                            return Err(e);
+                        }
+                    }
+                }
+                // Pushed in the order they were applied: applied last first, they redo in the
+                // original order.
+                Inverse::Compound(back)
             }
         })
     }

@@ -53,7 +53,7 @@ impl LiveStroke {
         if points.is_empty() {
             return Ok(());
         }
-        let edits = match self.segment(points) {
+        let edits = match self.segment(scene, points) {
             Ok(e) => e,
             Err(e) => return Err(self.fail(scene, e)),
         };
@@ -78,7 +78,7 @@ impl LiveStroke {
 
     /// The edits of the segment that adds `points`: a polyline continues from the last
     /// point; a box is applied only at the end.
-    fn segment(&self, points: &[DVec3]) -> Result<Vec<EditOp>> {
+    fn segment(&self, scene: &Scene, points: &[DVec3]) -> Result<Vec<EditOp>> {
         let mut part = Stroke {
             points: points.to_vec(),
             ..self.stroke.clone()
@@ -88,7 +88,7 @@ impl LiveStroke {
         {
             part.points.insert(0, *last);
         }
-        let edits = stroke_edits(&part)?;
+        let edits = stroke_edits(&part, scene.selection.as_ref())?;
         // A box's corners are checked now, applied at the end.
         Ok(if self.stroke.shape == BrushShape::Box {
             Vec::new()
@@ -113,7 +113,7 @@ impl LiveStroke {
             return Err(invalid("a stroke needs at least one point"));
         }
         if self.stroke.shape == BrushShape::Box {
-            for edit in stroke_edits(&self.stroke)? {
+            for edit in stroke_edits(&self.stroke, scene.selection.as_ref())? {
                 match scene.world.apply(edit) {
                     Ok(out) => {
                         self.changed_voxels += out.changed_voxels;

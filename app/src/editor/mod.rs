@@ -128,6 +128,15 @@ impl Document {
     pub fn execute(&mut self, command: Command) -> Result<Executed> {
         self.end_stroke()?;
         let applied = command.apply(&mut self.scene, &self.folder)?;
+        if !command.changes_document() {
+            if let Some(r) = &mut self.recorder {
+                r.record(script::Step::Do(command));
+            }
+            return Ok(Executed {
+                dropped: 0,
+                changed_voxels: 0,
+            });
+        }
         self.changed();
         if let Some(r) = &mut self.recorder {
             r.record(script::Step::Do(command.clone()));

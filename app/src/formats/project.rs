@@ -268,7 +268,7 @@ pub fn from_bytes(text: &[u8], path: &Path, workers: usize) -> Result<Scene, For
         )));
     }
     world.take_dirty();
-    Ok(Scene { world, params })
+    Ok(Scene::new(world, params))
 }
 
 fn material_table(

@@ -219,6 +219,8 @@ mod tests {
             material: 0,
             mirror: Default::default(),
             points: vec![glam::DVec3::splat(8.0)],
+            axis: Default::default(),
+            in_selection: false,
         })
     }
 

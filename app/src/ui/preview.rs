@@ -8,6 +8,7 @@
 use super::camera::ViewCamera;
 use super::files::SharedDocument;
 use crate::editor::command::{BrushMode, Stroke, preview, stroke_edits};
+use crate::selection::Selection;
 use brickmap::EditOp;
 use crossbeam_channel::{Receiver, Sender};
 use glam::{DVec3, IVec3};
@@ -54,7 +55,7 @@ impl Preview {
                     let shown = {
                         let d = doc.read().unwrap_or_else(|p| p.into_inner());
                         let view = d.scene.world.read();
-                        compute(&view, &key.0)
+                        compute(&view, &key.0, d.scene.selection.as_ref())
                     };
                     if tx.send((key, shown)).is_err() {
                         break;
@@ -218,14 +219,18 @@ impl Drop for Preview {
 }
 
 /// The preview of `stroke` in the world as it is.
-fn compute(view: &brickmap::WorldView<'_>, stroke: &Stroke) -> Shown {
+fn compute(
+    view: &brickmap::WorldView<'_>,
+    stroke: &Stroke,
+    selection: Option<&Selection>,
+) -> Shown {
     let mut shown = Shown {
         mode: Some(stroke.mode),
         ..Default::default()
     };
-    match preview(view, stroke) {
+    match preview(view, stroke, selection) {
         Ok(Some(voxels)) => shown.faces = outer_faces(&voxels),
-        Ok(None) => shown.bounds = bounds(stroke),
+        Ok(None) => shown.bounds = bounds(stroke, selection),
         Err(_) => shown.mode = None,
     }
     shown
@@ -261,10 +266,10 @@ fn outer_faces(voxels: &[IVec3]) -> Vec<([DVec3; 4], IVec3)> {
 }
 
 /// The union of the stroke's shapes' voxel bounds, as a box of voxel corners.
-fn bounds(stroke: &Stroke) -> Option<(DVec3, DVec3)> {
+fn bounds(stroke: &Stroke, selection: Option<&Selection>) -> Option<(DVec3, DVec3)> {
     let mut lo = IVec3::MAX;
     let mut hi = IVec3::MIN;
-    for edit in stroke_edits(stroke).ok()? {
+    for edit in stroke_edits(stroke, selection).ok()? {
         if let EditOp::Shape { shape, .. } = edit {
             let (a, b) = shape.voxel_bounds();
             lo = lo.min(a);

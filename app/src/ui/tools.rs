@@ -4,7 +4,7 @@
 //! drag paints a layer instead of climbing towards the camera); erase and paint follow the
 //! surface under the cursor. Pure functions of the world and the ray, tested here.
 
-use crate::editor::command::{BrushMode, BrushShape, Mirror, Stroke};
+use crate::editor::command::{Axis, BrushMode, BrushShape, Mirror, Stroke};
 use brickmap::{Ray, WorldView};
 use glam::{DVec3, IVec3};
 use serde::{Deserialize, Serialize};
@@ -25,6 +25,10 @@ pub struct Brush {
     pub mirror: [bool; 3],
     /// The mirror planes' point (None: the grid's centre).
     pub mirror_centre: Option<DVec3>,
+    /// The cylinder's axis.
+    pub axis: Axis,
+    /// Change only selected voxels (when something is selected).
+    pub in_selection: bool,
 }
 
 impl Default for Brush {
@@ -36,6 +40,8 @@ impl Default for Brush {
             material: 0,
             mirror: [false; 3],
             mirror_centre: None,
+            axis: Axis::Y,
+            in_selection: false,
         }
     }
 }
@@ -58,6 +64,8 @@ impl Brush {
                 centre: self.centre(dims),
             },
             points,
+            axis: self.axis,
+            in_selection: self.in_selection,
         }
     }
 

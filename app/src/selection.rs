@@ -1,0 +1,295 @@
+//! Selection: a region of the grid built from boxes added and subtracted in order (what a
+//! drag with or without modifiers makes), its voxels (`brickmap::VoxelSet`, computed once per
+//! change), and what the editor does with it: delete, fill, paint, move, copy, cut and paste.
+//! A selection is a region of space, empty voxels included (fill makes them solid); move,
+//! copy and cut take its solid voxels. Moving and pasting put voxels down over what is there
+//! (empty clipboard voxels leave the destination alone); what lands outside the grid is lost,
+//! and undo brings it back. The selection moves with what it moved and becomes what was
+//! pasted.
+
+use brickmap::{BrickUndo, EditInverse, EditOp, Mask, PriorMaterials, VoxelSet, WorldView};
+use glam::{IVec3, UVec3};
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// One box of a region.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RegionBox {
+    /// Inclusive minimum corner.
+    pub min: IVec3,
+    /// Inclusive maximum corner.
+    pub max: IVec3,
+    /// Taken away from what the boxes before it selected.
+    pub subtract: bool,
+}
+
+/// Boxes added and subtracted in order. Corners may lie outside the grid (a moved
+/// selection); only voxels inside it are selected.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Region {
+    /// The boxes, applied in order.
+    pub boxes: Vec<RegionBox>,
+}
+
+impl Region {
+    /// The region moved by `offset`.
+    pub fn translated(&self, offset: IVec3) -> Region {
+        Region {
+            boxes: self
+                .boxes
+                .iter()
+                .map(|b| RegionBox {
+                    min: b.min + offset,
+                    max: b.max + offset,
+                    ..*b
+                })
+                .collect(),
+        }
+    }
+
+    /// The region's voxels inside a grid of `voxels`.
+    pub fn voxels(&self, voxels: IVec3) -> VoxelSet {
+        let mut set = VoxelSet::new();
+        for b in &self.boxes {
+            set.apply_box(b.min, b.max, voxels, b.subtract);
+        }
+        set
+    }
+}
+
+/// How a box drag changes the selection.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum SelectOp {
+    /// The box becomes the selection.
+    Replace {
+        /// A corner.
+        min: IVec3,
+        /// The opposite corner.
+        max: IVec3,
+    },
+    /// The box is added (Shift).
+    Add {
+        /// A corner.
+        min: IVec3,
+        /// The opposite corner.
+        max: IVec3,
+    },
+    /// The box is taken away (Ctrl).
+    Subtract {
+        /// A corner.
+        min: IVec3,
+        /// The opposite corner.
+        max: IVec3,
+    },
+    /// The whole grid.
+    All,
+    /// Nothing.
+    None,
+}
+
+/// A region and its voxels (shared: edits and the viewport read it without copying).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Selection {
+    /// What was selected, as boxes.
+    pub region: Region,
+    /// Its voxels inside the grid.
+    pub voxels: Arc<VoxelSet>,
+}
+
+impl Selection {
+    /// The selection of a region in a grid of `voxels`.
+    pub fn new(region: Region, voxels: IVec3) -> Self {
+        let set = region.voxels(voxels);
+        Selection {
+            region,
+            voxels: Arc::new(set),
+        }
+    }
+}
+
+/// The selection after `op`, in a grid of `voxels` (None: nothing selected).
+pub fn select(current: Option<&Selection>, op: SelectOp, voxels: IVec3) -> Option<Selection> {
+    let boxed = |a: IVec3, b: IVec3, subtract| RegionBox {
+        min: a.min(b),
+        max: a.max(b),
+        subtract,
+    };
+    let mut region = current.map(|s| s.region.clone()).unwrap_or_default();
+    match op {
+        SelectOp::None => return None,
+        SelectOp::All => region.boxes = vec![boxed(IVec3::ZERO, voxels - 1, false)],
+        SelectOp::Replace { min, max } => region.boxes = vec![boxed(min, max, false)],
+        SelectOp::Add { min, max } => region.boxes.push(boxed(min, max, false)),
+        SelectOp::Subtract { min, max } => {
+            // Nothing selected stays nothing.
+            current?;
+            region.boxes.push(boxed(min, max, true));
+        }
+    }
+    let selection = Selection::new(region, voxels);
+    (!selection.voxels.is_empty()).then_some(selection)
+}
+
+/// The solid voxels of a selection, copied: the clipboard.
+#[derive(Clone, PartialEq)]
+pub struct Clip {
+    /// The region they were copied from, relative to `origin`.
+    pub region: Region,
+    /// The minimum corner of the copied selection's bounds, where the copy came from.
+    pub origin: IVec3,
+    /// Per source brick: its minimum voxel relative to `origin`, the copied solid voxels and
+    /// their materials by voxel index.
+    bricks: Vec<(IVec3, Mask, Box<[u8; 512]>)>,
+    /// Solid voxels copied.
+    pub voxels: u64,
+    /// Size of the copied selection's bounds.
+    pub size: IVec3,
+}
+
+impl std::fmt::Debug for Clip {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "Clip({} voxels, {} from {})",
+            self.voxels, self.size, self.origin
+        )
+    }
+}
+
+impl Clip {
+    /// Copies the solid voxels of `selection` (None when it selects no voxel).
+    pub fn copy(view: &WorldView<'_>, selection: &Selection) -> Option<Clip> {
+        let (lo, hi) = selection.voxels.bounds()?;
+        let mut bricks = Vec::new();
+        let mut voxels = 0;
+        for (b, sel) in selection.voxels.iter() {
+            let (solid, dense) = view.brick_voxels(b);
+            let keep = solid.and(sel);
+            if keep.is_empty() {
+                continue;
+            }
+            voxels += keep.count() as u64;
+            bricks.push((b.as_ivec3() * 8 - lo, keep, Box::new(dense)));
+        }
+        Some(Clip {
+            region: selection.region.translated(-lo),
+            origin: lo,
+            bricks,
+            voxels,
+            size: hi - lo + 1,
+        })
+    }
+}
+
+/// Per target brick: voxels written, which of them end solid, and their materials.
+#[derive(Default)]
+struct Target {
+    touched: Mask,
+    solid: Mask,
+    dense: Option<Box<[u8; 512]>>,
+}
+
+/// Builds the one `Restore` edit that writes whole target bricks (each brick once, so its
+/// inverse is exact).
+#[derive(Default)]
+struct Writes {
+    targets: HashMap<(u32, u32, u32), Target>,
+}
+
+impl Writes {
+    fn target(&mut self, b: UVec3) -> &mut Target {
+        self.targets.entry((b.x, b.y, b.z)).or_default()
+    }
+
+    /// Empties the voxels `mask` of brick `b`.
+    fn clear(&mut self, b: UVec3, mask: &Mask) {
+        let t = self.target(b);
+        t.touched = t.touched.or(mask);
+        t.solid = t.solid.and_not(mask);
+    }
+
+    /// Puts the voxels `mask` (materials by voxel index) of the brick whose minimum voxel is
+    /// `min` down shifted by `offset`, dropping those outside a grid of `voxels`. A shifted
+    /// brick straddles at most 2 × 2 × 2 target bricks: they are gathered locally, then
+    /// merged into the targets once each.
+    fn put(&mut self, min: IVec3, mask: &Mask, mats: &[u8; 512], offset: IVec3, voxels: IVec3) {
+        let base = min + offset;
+        let first = base.div_euclid(IVec3::splat(8));
+        let mut local: [(Mask, [u8; 512]); 8] = [(Mask::EMPTY, [0; 512]); 8];
+        for bit in mask.ones() {
+            let l = IVec3::new(bit as i32 % 8, bit as i32 / 8 % 8, bit as i32 / 64);
+            let v = base + l;
+            if v.cmplt(IVec3::ZERO).any() || v.cmpge(voxels).any() {
+                continue;
+            }
+            let k = v.div_euclid(IVec3::splat(8)) - first;
+            let slot = &mut local[(k.x + 2 * k.y + 4 * k.z) as usize];
+            let lv = v.rem_euclid(IVec3::splat(8));
+            let tb = brickmap::brick::voxel_bit(lv.x, lv.y, lv.z);
+            slot.0.set(tb);
+            slot.1[tb] = mats[bit];
+        }
+        for (i, (m, d)) in local.iter().enumerate() {
+            if m.is_empty() {
+                continue;
+            }
+            let k = IVec3::new(i as i32 & 1, i as i32 >> 1 & 1, i as i32 >> 2);
+            let t = self.target((first + k).as_uvec3());
+            t.touched = t.touched.or(m);
+            t.solid = t.solid.or(m);
+            let dense = t.dense.get_or_insert_with(|| Box::new([0; 512]));
+            for b in m.ones() {
+                dense[b] = d[b];
+            }
+        }
+    }
+
+    fn into_edit(self) -> EditOp {
+        let mut bricks: Vec<BrickUndo> = self
+            .targets
+            .into_iter()
+            .map(|((x, y, z), t)| {
+                let prior = match &t.dense {
+                    Some(d) => PriorMaterials::PerVoxel(t.solid.ones().map(|b| d[b]).collect()),
+                    None => PriorMaterials::PerVoxel(Vec::new()),
+                };
+                BrickUndo {
+                    brick: UVec3::new(x, y, z),
+                    prior_mask: t.solid,
+                    touched: t.touched,
+                    prior,
+                }
+            })
+            .collect();
+        bricks.sort_by_key(|b| (b.brick.x, b.brick.y, b.brick.z));
+        EditOp::Restore(EditInverse { bricks })
+    }
+}
+
+/// The edit that moves the solid voxels of `selection` by `offset` (the selected region is
+/// emptied, its solid voxels put down at the new place).
+pub fn move_edit(view: &WorldView<'_>, selection: &Selection, offset: IVec3) -> EditOp {
+    let voxels = view.dims().voxels();
+    let mut w = Writes::default();
+    for (b, sel) in selection.voxels.iter() {
+        w.clear(b, sel);
+    }
+    for (b, sel) in selection.voxels.iter() {
+        let (solid, dense) = view.brick_voxels(b);
+        let keep = solid.and(sel);
+        if !keep.is_empty() {
+            w.put(b.as_ivec3() * 8, &keep, &dense, offset, voxels);
+        }
+    }
+    w.into_edit()
+}
+
+/// The edit that puts the clipboard down with its origin at `at`.
+pub fn paste_edit(clip: &Clip, at: IVec3, voxels: IVec3) -> EditOp {
+    let mut w = Writes::default();
+    for (min, mask, mats) in &clip.bricks {
+        w.put(*min, mask, mats, at, voxels);
+    }
+    w.into_edit()
+}

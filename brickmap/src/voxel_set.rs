@@ -1,0 +1,190 @@
+//! `VoxelSet`: a sparse set of voxels as one 512-bit mask per touched brick (a selection, the
+//! region a tool is limited to). Edits take it as a shape (`Shape::Set`, `Shape::Within`), so
+//! the workers apply it brick by brick like any brush.
+
+use crate::brick::Mask;
+use glam::{IVec3, UVec3};
+use std::collections::BTreeMap;
+
+/// Voxels, by brick. Bricks whose mask would be empty are never stored.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct VoxelSet {
+    /// Brick coordinate (x, y, z) → the voxels of that brick in the set.
+    bricks: BTreeMap<(u32, u32, u32), Mask>,
+}
+
+/// The voxels of the brick whose minimum voxel is `brick_min` that lie in the inclusive box
+/// `lo..=hi`, built a row at a time.
+pub fn box_mask(brick_min: IVec3, lo: IVec3, hi: IVec3) -> Mask {
+    let l = (lo - brick_min).max(IVec3::ZERO);
+    let h = (hi - brick_min).min(IVec3::splat(7));
+    let mut m = Mask::EMPTY;
+    if l.cmpgt(h).any() {
+        return m;
+    }
+    let row = ((1u32 << (h.x - l.x + 1)) - 1) << l.x;
+    for z in l.z..=h.z {
+        for y in l.y..=h.y {
+            let bit = (8 * y + 64 * z) as usize;
+            m.0[bit >> 5] |= row << (bit & 31);
+        }
+    }
+    m
+}
+
+impl VoxelSet {
+    /// The empty set.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Whether no voxel is in the set.
+    pub fn is_empty(&self) -> bool {
+        self.bricks.is_empty()
+    }
+
+    /// Voxels in the set.
+    pub fn count(&self) -> u64 {
+        self.bricks.values().map(|m| m.count() as u64).sum()
+    }
+
+    /// Bricks with at least one voxel in the set.
+    pub fn brick_count(&self) -> usize {
+        self.bricks.len()
+    }
+
+    /// The voxels of brick `b` in the set.
+    #[inline]
+    pub fn brick(&self, b: UVec3) -> Mask {
+        self.bricks
+            .get(&(b.x, b.y, b.z))
+            .copied()
+            .unwrap_or(Mask::EMPTY)
+    }
+
+    /// Whether voxel `v` is in the set.
+    pub fn contains(&self, v: IVec3) -> bool {
+        if v.cmplt(IVec3::ZERO).any() {
+            return false;
+        }
+        let b = (v / 8).as_uvec3();
+        let l = v - (v / 8) * 8;
+        self.brick(b).get(crate::brick::voxel_bit(l.x, l.y, l.z))
+    }
+
+    /// The bricks and their masks, in (x, y, z) order.
+    pub fn iter(&self) -> impl Iterator<Item = (UVec3, &Mask)> + '_ {
+        self.bricks
+            .iter()
+            .map(|(&(x, y, z), m)| (UVec3::new(x, y, z), m))
+    }
+
+    /// Replaces the mask of brick `b` (an empty mask removes it).
+    pub fn set_brick(&mut self, b: UVec3, mask: Mask) {
+        if mask.is_empty() {
+            self.bricks.remove(&(b.x, b.y, b.z));
+        } else {
+            self.bricks.insert((b.x, b.y, b.z), mask);
+        }
+    }
+
+    /// Adds (or, with `remove`, takes away) the voxels of the inclusive box `lo..=hi` that lie
+    /// in a grid of `voxels` voxels.
+    pub fn apply_box(&mut self, lo: IVec3, hi: IVec3, voxels: IVec3, remove: bool) {
+        let lo = lo.max(IVec3::ZERO);
+        let hi = hi.min(voxels - 1);
+        if lo.cmpgt(hi).any() {
+            return;
+        }
+        let (blo, bhi) = (lo / 8, hi / 8);
+        for x in blo.x..=bhi.x {
+            for y in blo.y..=bhi.y {
+                for z in blo.z..=bhi.z {
+                    let b = IVec3::new(x, y, z);
+                    let m = box_mask(b * 8, lo, hi);
+                    let b = b.as_uvec3();
+                    let old = self.brick(b);
+                    self.set_brick(b, if remove { old.and_not(&m) } else { old.or(&m) });
+                }
+            }
+        }
+    }
+
+    /// Inclusive voxel bounds of the set, or None when it is empty.
+    pub fn bounds(&self) -> Option<(IVec3, IVec3)> {
+        let mut out: Option<(IVec3, IVec3)> = None;
+        for (b, m) in self.iter() {
+            let min = b.as_ivec3() * 8;
+            let (mut lo, mut hi) = (IVec3::splat(8), IVec3::splat(-1));
+            for bit in m.ones() {
+                let l = IVec3::new(bit as i32 % 8, bit as i32 / 8 % 8, bit as i32 / 64);
+                lo = lo.min(l);
+                hi = hi.max(l);
+                if lo == IVec3::ZERO && hi == IVec3::splat(7) {
+                    break;
+                }
+            }
+            let (lo, hi) = (min + lo, min + hi);
+            out = Some(match out {
+                None => (lo, hi),
+                Some((a, b)) => (a.min(lo), b.max(hi)),
+            });
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn box_masks_match_the_voxel_test() {
+        let boxes = [
+            (IVec3::new(3, 1, 5), IVec3::new(20, 17, 9)),
+            (IVec3::new(8, 8, 8), IVec3::new(15, 15, 15)),
+            (IVec3::new(-4, 2, 0), IVec3::new(0, 2, 30)),
+        ];
+        for (lo, hi) in boxes {
+            for b in 0..27 {
+                let min = IVec3::new(b % 3, b / 3 % 3, b / 9) * 8;
+                let mut want = Mask::EMPTY;
+                for i in 0..512 {
+                    let v = min + IVec3::new(i % 8, i / 8 % 8, i / 64);
+                    if v.cmpge(lo).all() && v.cmple(hi).all() {
+                        want.set(i as usize);
+                    }
+                }
+                assert_eq!(box_mask(min, lo, hi), want, "{lo} {hi} at {min}");
+            }
+        }
+    }
+
+    #[test]
+    fn boxes_add_and_subtract_exactly() {
+        let grid = IVec3::new(32, 16, 32);
+        let mut s = VoxelSet::new();
+        s.apply_box(IVec3::new(2, 2, 2), IVec3::new(20, 9, 11), grid, false);
+        s.apply_box(IVec3::new(5, -3, 5), IVec3::new(40, 4, 6), grid, true);
+        let mut count = 0;
+        for x in -2..34 {
+            for y in -2..18 {
+                for z in -2..34 {
+                    let v = IVec3::new(x, y, z);
+                    let inside = |lo: IVec3, hi: IVec3| v.cmpge(lo).all() && v.cmple(hi).all();
+                    let want = inside(IVec3::new(2, 2, 2), IVec3::new(20, 9, 11))
+                        && !inside(IVec3::new(5, -3, 5), IVec3::new(40, 4, 6));
+                    assert_eq!(s.contains(v), want, "{v}");
+                    count += want as u64;
+                }
+            }
+        }
+        assert_eq!(s.count(), count);
+        assert_eq!(
+            s.bounds(),
+            Some((IVec3::new(2, 2, 2), IVec3::new(20, 9, 11)))
+        );
+        s.apply_box(IVec3::ZERO, grid, grid, true);
+        assert!(s.is_empty() && s.bounds().is_none());
+    }
+}
