@@ -493,6 +493,20 @@ fn strokes_drawn_with_the_mouse_replay_headlessly_to_the_same_scene() {
     pause(1.0);
     xdotool(d, &["key", "x"]);
     drag(&[(560, 260), (565, 262)]);
+    // Selection: a box, copy, move it, paste the copy elsewhere, fill the pasted region.
+    xdotool(d, &["key", "m"]);
+    drag(&[(430, 250), (450, 260), (470, 270)]);
+    xdotool(d, &["key", "ctrl+c"]);
+    pause(1.0);
+    xdotool(d, &["key", "Right"]);
+    pause(1.0);
+    xdotool(d, &["key", "ctrl+v"]);
+    xdotool(d, &["mousemove", "520", "200"]);
+    pause(1.5);
+    xdotool(d, &["click", "1"]);
+    pause(1.0);
+    xdotool(d, &["key", "ctrl+f"]);
+    pause(1.0);
     xdotool(d, &["key", "ctrl+s"]);
     pause(2.0);
     xdotool(d, &["key", "ctrl+q"]);
@@ -524,6 +538,11 @@ fn strokes_drawn_with_the_mouse_replay_headlessly_to_the_same_scene() {
         "Undo",
         "Redo",
         "mode: Erase",
+        "Select(Replace",
+        "Copy",
+        "MoveSelection",
+        "Paste(",
+        "FillSelection",
         "Save(\"work.ron\")",
     ] {
         assert!(

@@ -94,7 +94,11 @@ impl Editor {
         self.panels.stats = text;
     }
 
-    pub(super) fn replace_document(&mut self, scene: Scene, path: Option<PathBuf>) {
+    pub(super) fn replace_document(&mut self, mut scene: Scene, path: Option<PathBuf>) {
+        // The clipboard outlives the document: copy in one scene, paste in the next.
+        scene.clipboard = self.read().scene.clipboard.clone();
+        self.pasting = false;
+        self.selecting = None;
         let mut doc = Document::new(scene, History::with_budget(DEFAULT_BUDGET));
         doc.folder = path
             .as_ref()

@@ -4,11 +4,13 @@
 //! history list (every step with the voxels it changed; click one to go back or forward to
 //! it; how many of the oldest steps the memory budget dropped).
 
+use super::input::Action;
 use super::panels::UiEvent;
-use super::tools::{Brush, MAX_SIZE};
+use super::selecting::Nudge;
+use super::tools::{Brush, MAX_SIZE, Tool};
 use crate::editor::Document;
 use crate::editor::command::{
-    BrushMode, BrushShape, KindSpec, MaterialSpec, NoiseSpec, TerrainSpec,
+    Axis, BrushMode, BrushShape, KindSpec, MaterialSpec, NoiseSpec, TerrainSpec,
 };
 use brickmap::{MaterialKind, MaterialTable};
 
@@ -71,7 +73,7 @@ pub fn draw(
             .open(&mut open)
             .default_pos(egui::pos2(8.0, 40.0))
             .resizable(false)
-            .show(ctx, |ui| tools(ui, brush, &table, doc));
+            .show(ctx, |ui| tools(ui, brush, &table, doc, out));
         state.tools_hidden = !open;
     }
     if state.palette_open {
@@ -100,15 +102,26 @@ pub fn draw(
     }
 }
 
-fn tools(ui: &mut egui::Ui, brush: &mut Brush, table: &MaterialTable, doc: &Document) {
+fn tools(
+    ui: &mut egui::Ui,
+    brush: &mut Brush,
+    table: &MaterialTable,
+    doc: &Document,
+    out: &mut Vec<UiEvent>,
+) {
     ui.horizontal(|ui| {
         for (m, name) in [
             (BrushMode::Attach, "Attach  T"),
             (BrushMode::Erase, "Erase  X"),
             (BrushMode::Paint, "Paint  P"),
         ] {
-            ui.selectable_value(&mut brush.mode, m, name);
+            let on = brush.tool == Tool::Brush && brush.mode == m;
+            if ui.selectable_label(on, name).clicked() {
+                brush.mode = m;
+                brush.tool = Tool::Brush;
+            }
         }
+        ui.selectable_value(&mut brush.tool, Tool::Select, "Select  M");
     });
     ui.horizontal_wrapped(|ui| {
         for (s, name) in [
@@ -127,6 +140,14 @@ fn tools(ui: &mut egui::Ui, brush: &mut Brush, table: &MaterialTable, doc: &Docu
             .step_by(1.0)
             .text("size  [ ]"),
     );
+    if brush.shape == BrushShape::Cylinder {
+        ui.horizontal(|ui| {
+            ui.label("cylinder axis");
+            for (a, name) in [(Axis::X, "X"), (Axis::Y, "Y"), (Axis::Z, "Z")] {
+                ui.selectable_value(&mut brush.axis, a, name);
+            }
+        });
+    }
     ui.horizontal(|ui| {
         ui.label("mirror");
         ui.checkbox(&mut brush.mirror[0], "X");
@@ -157,6 +178,8 @@ fn tools(ui: &mut egui::Ui, brush: &mut Brush, table: &MaterialTable, doc: &Docu
         });
     }
     ui.separator();
+    selection(ui, brush, doc, out);
+    ui.separator();
     ui.label("material (Alt + click picks one)");
     ui.horizontal_wrapped(|ui| {
         for i in 0..table.len() {
@@ -167,6 +190,77 @@ fn tools(ui: &mut egui::Ui, brush: &mut Brush, table: &MaterialTable, doc: &Docu
                 brush.material = i as u8;
             }
         }
+    });
+}
+
+/// The selection section: what is selected, the tool's depth, and the operations.
+fn selection(ui: &mut egui::Ui, brush: &mut Brush, doc: &Document, out: &mut Vec<UiEvent>) {
+    let selected = doc.scene.selection.as_ref();
+    match selected.and_then(|s| s.voxels.bounds().map(|b| (b, s.voxels.count()))) {
+        Some(((lo, hi), n)) => {
+            ui.label(format!("selection: {n} voxels in {lo} … {hi}"));
+        }
+        None => {
+            ui.label("selection: none (M, then drag a box on a face)");
+        }
+    }
+    if brush.tool == Tool::Select {
+        ui.add(egui::Slider::new(&mut brush.select_depth, 1..=256).text("box depth"));
+    }
+    ui.checkbox(&mut brush.in_selection, "brush only inside the selection");
+    let has = selected.is_some();
+    let has_copy = doc.scene.clipboard.is_some();
+    ui.horizontal_wrapped(|ui| {
+        let mut button = |ui: &mut egui::Ui, enabled: bool, name: &str, hint: &str, a| {
+            if ui
+                .add_enabled(enabled, egui::Button::new(name))
+                .on_hover_text(hint)
+                .clicked()
+            {
+                out.push(UiEvent::Action(a));
+            }
+        };
+        button(ui, true, "All", "Ctrl+A", Action::SelectAll);
+        button(ui, has, "None", "Ctrl+D", Action::SelectNone);
+        button(ui, has, "Delete", "Delete", Action::DeleteSelection);
+        button(
+            ui,
+            has,
+            "Fill",
+            "Ctrl+F: the current material",
+            Action::FillSelection,
+        );
+        button(
+            ui,
+            has,
+            "Paint",
+            "Ctrl+P: the current material",
+            Action::PaintSelection,
+        );
+        button(ui, has, "Copy", "Ctrl+C", Action::Copy);
+        button(ui, has, "Cut", "Ctrl+X", Action::Cut);
+        button(ui, has_copy, "Paste", "Ctrl+V, then click", Action::Paste);
+    });
+    ui.add_enabled_ui(has, |ui| {
+        ui.horizontal(|ui| {
+            ui.label("move");
+            for (name, n) in [
+                ("left", Nudge::Left),
+                ("right", Nudge::Right),
+                ("away", Nudge::Away),
+                ("near", Nudge::Towards),
+                ("up", Nudge::Up),
+                ("down", Nudge::Down),
+            ] {
+                if ui
+                    .button(name)
+                    .on_hover_text("arrow keys, Page Up / Down")
+                    .clicked()
+                {
+                    out.push(UiEvent::Action(Action::Nudge(n)));
+                }
+            }
+        });
     });
 }
 

@@ -166,6 +166,8 @@ impl Editor {
                 self.preview
                     .update(&self.doc, stroke.as_ref(), doc.revision);
             }
+            let paste = self.paste_target(&doc);
+            let dragged = self.dragged_box();
             egui_ctx.run_ui(raw, |ui| {
                 // Under every panel and window, over the viewport image.
                 let painter = ui.ctx().layer_painter(egui::LayerId::background());
@@ -173,6 +175,15 @@ impl Editor {
                 self.preview.paint(&painter, &self.view, rect);
                 let brush = &self.settings.brush;
                 let dims = doc.scene.world.dims().voxels();
+                selecting::paint(
+                    &painter,
+                    &self.view,
+                    rect,
+                    doc.scene.selection.as_ref(),
+                    dims,
+                    dragged,
+                    paste,
+                );
                 preview::paint_mirror(
                     &painter,
                     &self.view,

@@ -53,6 +53,26 @@ pub enum Action {
     StoreView(u8),
     /// Recall camera slot n.
     RecallView(u8),
+    /// The selection tool.
+    SelectTool,
+    /// Select the whole grid.
+    SelectAll,
+    /// Select nothing.
+    SelectNone,
+    /// Empty the selected voxels.
+    DeleteSelection,
+    /// Fill the selection with the current material.
+    FillSelection,
+    /// Paint the selection's solid voxels with the current material.
+    PaintSelection,
+    /// Copy the selection's solid voxels.
+    Copy,
+    /// Copy, then delete.
+    Cut,
+    /// Place the copy: it follows the cursor until a click.
+    Paste,
+    /// Move the selection a voxel (Shift: a brick).
+    Nudge(super::selecting::Nudge),
     /// Show or hide the shortcut list.
     Help,
     /// Quit (asks about unsaved changes).
@@ -106,6 +126,23 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "flood-fill the connected surface of that material",
     ),
     ("Esc (while drawing)", "cancel the stroke"),
+    (
+        "M",
+        "selection tool (drag a box on a face; Shift adds, Ctrl subtracts)",
+    ),
+    ("Ctrl+A / Ctrl+D", "select all / nothing"),
+    (
+        "Delete, Ctrl+F, Ctrl+P",
+        "delete / fill / paint the selection",
+    ),
+    (
+        "Ctrl+C / Ctrl+X / Ctrl+V",
+        "copy / cut / paste (click to put the paste down)",
+    ),
+    (
+        "Arrows, Page Up / Down",
+        "move the selection (Shift: by a brick)",
+    ),
     ("T / X / P", "attach / erase / paint"),
     (
         "V / B / C / Y / L / R",

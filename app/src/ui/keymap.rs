@@ -1,7 +1,8 @@
 //! The key map: which key chord does which [`Action`]. The defaults follow MagicaVoxel where
 //! it has a shortcut; `keys.ron` in the config folder (written with the defaults on the
 //! first start, so there is a file to edit) replaces them. A chord is written as in menus:
-//! `"Ctrl+Shift+Z"`, `"F"`, `"["`, `"Numpad5"`, `"F1"`. A file that does not parse, or
+//! `"Ctrl+Shift+Z"`, `"F"`, `"["`, `"Numpad5"`, `"F1"`; actions the file leaves out keep
+//! their default chords where the file does not use them. A file that does not parse, or
 //! names a key that does not exist, is an error naming the binding; the defaults are used
 //! and the file is left as it is. Flying (W A S D, Q / E, held) is not an action and not
 //! remapped.
@@ -80,9 +81,19 @@ impl KeyMap {
         text + "]\n"
     }
 
-    /// Parses keys.ron's text.
+    /// Parses keys.ron's text. An action the file does not bind keeps its default chord when
+    /// the file does not use that chord for something else (a file written by an older
+    /// version still gets the shortcuts added since).
     pub fn parse(text: &str) -> Result<Self, String> {
-        let bindings: Vec<Binding> = ron::from_str(text).map_err(|e| e.to_string())?;
+        let mut bindings: Vec<Binding> = ron::from_str(text).map_err(|e| e.to_string())?;
+        let user = Self::from_bindings(&bindings)?;
+        for d in default_bindings() {
+            let chord = parse_chord(&d.keys)?;
+            let taken = user.chords.iter().any(|(c, _)| *c == chord);
+            if !taken && !bindings.iter().any(|b| b.action == d.action) {
+                bindings.push(d);
+            }
+        }
         Self::from_bindings(&bindings)
     }
 }
@@ -114,11 +125,32 @@ pub fn default_bindings() -> Vec<Binding> {
         ("Y", Action::Shape(BrushShape::Cylinder)),
         ("L", Action::Shape(BrushShape::Line)),
         ("R", Action::Shape(BrushShape::Box)),
+        ("M", Action::SelectTool),
+        ("Ctrl+A", Action::SelectAll),
+        ("Ctrl+D", Action::SelectNone),
+        ("Delete", Action::DeleteSelection),
+        ("Ctrl+F", Action::FillSelection),
+        ("Ctrl+P", Action::PaintSelection),
+        ("Ctrl+C", Action::Copy),
+        ("Ctrl+X", Action::Cut),
+        ("Ctrl+V", Action::Paste),
         ("F1", Action::Help),
     ]
     .into_iter()
     .map(|(k, a)| (k.to_string(), a))
     .collect();
+    use super::selecting::Nudge;
+    for (key, n) in [
+        ("ArrowLeft", Nudge::Left),
+        ("ArrowRight", Nudge::Right),
+        ("ArrowUp", Nudge::Away),
+        ("ArrowDown", Nudge::Towards),
+        ("PageUp", Nudge::Up),
+        ("PageDown", Nudge::Down),
+    ] {
+        b.push((key.to_string(), Action::Nudge(n)));
+        b.push((format!("Shift+{key}"), Action::Nudge(n)));
+    }
     for n in 1..=9u8 {
         b.push((format!("Ctrl+{n}"), Action::StoreView(n)));
         b.push((format!("{n}"), Action::RecallView(n)));
@@ -262,6 +294,33 @@ mod tests {
             Some(Action::StoreView(7))
         );
         assert_eq!(map.action(KeyCode::KeyZ, Mods::default()), None);
+        // No chord does two things.
+        let chords: Vec<Chord> = map.chords.iter().map(|(c, _)| *c).collect();
+        for (i, c) in chords.iter().enumerate() {
+            assert!(
+                !chords[..i].contains(c),
+                "{:?} bound twice",
+                map.bindings()[i]
+            );
+        }
+    }
+
+    #[test]
+    fn an_older_file_keeps_its_bindings_and_gets_the_new_defaults() {
+        // Binds Copy elsewhere and takes Ctrl+V for Undo: neither default comes back.
+        let map =
+            KeyMap::parse(r#"[(keys: "Ctrl+K", action: Copy), (keys: "Ctrl+V", action: Undo)]"#)
+                .unwrap();
+        assert_eq!(map.action(KeyCode::KeyK, CTRL), Some(Action::Copy));
+        assert_eq!(map.action(KeyCode::KeyC, CTRL), None);
+        assert_eq!(map.action(KeyCode::KeyV, CTRL), Some(Action::Undo));
+        assert_eq!(map.action(KeyCode::KeyZ, CTRL), None, "Undo is the file's");
+        // Left out: the default.
+        assert_eq!(map.action(KeyCode::KeyA, CTRL), Some(Action::SelectAll));
+        assert_eq!(
+            map.action(KeyCode::KeyM, Mods::default()),
+            Some(Action::SelectTool)
+        );
     }
 
     #[test]

@@ -14,6 +14,7 @@ pub mod jobs;
 pub mod keymap;
 pub mod panels;
 mod preview;
+mod selecting;
 pub mod tools;
 
 use crate::Scene;
@@ -21,6 +22,7 @@ use crate::editor::Document;
 use crate::editor::command::Command;
 use crate::editor::history::{DEFAULT_BUDGET, History};
 use crate::editor::script::{self, ReplayOptions, Script, ScriptRun};
+use crate::selection::SelectOp;
 use anyhow::{Context, Result, anyhow};
 use camera::ViewCamera;
 use files::{ConfigDir, Done, FileWorker, Purpose, SharedDocument};
@@ -36,6 +38,7 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, RwLock};
 use std::time::{Duration, Instant};
+use tools::Tool;
 use winit::application::ApplicationHandler;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
@@ -203,6 +206,10 @@ pub struct Editor {
     drawing: Option<Drawing>,
     /// What a click would change, under the cursor.
     preview: preview::Preview,
+    /// The selection box being dragged.
+    selecting: Option<selecting::SelectDrag>,
+    /// A paste follows the cursor until a click.
+    pasting: bool,
     /// Tests only: the frame that fails as if the device were lost
     /// (`VOXBRICK_TEST_GPU_FAILURE_AT_FRAME`), to check nothing is lost when the GPU fails.
     fail_at_frame: Option<u64>,
@@ -302,6 +309,8 @@ impl Editor {
             window_size: (16, 9),
             drawing: None,
             preview: preview::Preview::new(wake_preview),
+            selecting: None,
+            pasting: false,
             fail_at_frame: std::env::var("VOXBRICK_TEST_GPU_FAILURE_AT_FRAME")
                 .ok()
                 .and_then(|v| v.parse().ok()),
@@ -373,8 +382,30 @@ impl Editor {
             }
             Action::BrushSmaller => self.settings.brush.resize(-1.0),
             Action::BrushLarger => self.settings.brush.resize(1.0),
-            Action::Mode(m) => self.settings.brush.mode = m,
-            Action::Shape(s) => self.settings.brush.shape = s,
+            Action::Mode(m) => {
+                self.settings.brush.mode = m;
+                self.settings.brush.tool = Tool::Brush;
+            }
+            Action::Shape(s) => {
+                self.settings.brush.shape = s;
+                self.settings.brush.tool = Tool::Brush;
+            }
+            Action::SelectTool => self.settings.brush.tool = Tool::Select,
+            Action::SelectAll => self.select(SelectOp::All),
+            Action::SelectNone => self.select(SelectOp::None),
+            Action::DeleteSelection => self.execute(Command::DeleteSelection),
+            Action::FillSelection => {
+                self.execute(Command::FillSelection(self.settings.brush.material))
+            }
+            Action::PaintSelection => {
+                self.execute(Command::PaintSelection(self.settings.brush.material))
+            }
+            Action::Copy => self.execute(Command::Copy),
+            Action::Cut => self.execute(Command::Cut),
+            // The copy is on the document once queued edits (a copy just asked for) ran;
+            // until then the placement shows nothing and a click pastes nothing.
+            Action::Paste => self.pasting = true,
+            Action::Nudge(n) => self.nudge(n),
             Action::Help => self.panels.help_open = !self.panels.help_open,
             Action::Quit => self.guard_unsaved(Pending::Quit),
         }
@@ -479,8 +510,17 @@ impl Editor {
         self.view.ray(u, v, self.aspect())
     }
 
-    /// Left button down: the eyedropper (Alt) or a new stroke under the cursor.
+    /// Left button down: a paste being placed goes down, the eyedropper (Alt), the selection
+    /// tool, or a new stroke under the cursor.
     fn press(&mut self) {
+        if self.pasting {
+            self.paste_press();
+            return;
+        }
+        if self.settings.brush.tool == Tool::Select && !self.mods.alt {
+            self.select_press();
+            return;
+        }
         let (origin, dir) = self.cursor_ray();
         let doc = self.doc.clone();
         let doc = doc.read().unwrap_or_else(|p| p.into_inner());
@@ -546,6 +586,9 @@ impl Editor {
     ) -> Option<crate::editor::command::Stroke> {
         let brush = &self.settings.brush;
         let dims = view.dims().voxels();
+        if brush.tool == Tool::Select || self.pasting {
+            return None;
+        }
         match &self.drawing {
             Some(d) if brush.shape == crate::editor::command::BrushShape::Box => {
                 Some(brush.stroke(vec![tools::centre(d.first), tools::centre(d.last)], dims))
@@ -740,6 +783,11 @@ impl Editor {
                     self.edits.submit(&self.doc, Edit::StrokeAbort);
                     return;
                 }
+                if code == KeyCode::Escape && (self.pasting || self.selecting.is_some()) {
+                    self.pasting = false;
+                    self.selecting = None;
+                    return;
+                }
                 if let Some(a) = self.keymap.action(code, self.mods) {
                     if !event.repeat {
                         self.action(a);
@@ -758,6 +806,9 @@ impl Editor {
                     (ElementState::Released, MouseButton::Left) if self.drawing.is_some() => {
                         self.drawing = None;
                         self.edits.submit(&self.doc, Edit::StrokeEnd);
+                    }
+                    (ElementState::Released, MouseButton::Left) if self.selecting.is_some() => {
+                        self.select_release()
                     }
                     (ElementState::Pressed, _) if free => {
                         self.drag =
@@ -785,6 +836,7 @@ impl Editor {
                     self.moved();
                 }
                 self.stroke_to_cursor();
+                self.select_to_cursor();
             }
             WindowEvent::MouseWheel { delta, .. } => {
                 if consumed || self.egui.egui_wants_pointer_input() {

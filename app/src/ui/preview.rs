@@ -136,22 +136,37 @@ impl Preview {
         }
         if let Some((lo, hi)) = shown.bounds {
             let stroke = egui::Stroke::new(1.5, colour.to_opaque());
-            let corner = |i: usize| {
-                DVec3::new(
-                    if i & 1 == 0 { lo.x } else { hi.x },
-                    if i & 2 == 0 { lo.y } else { hi.y },
-                    if i & 4 == 0 { lo.z } else { hi.z },
+            paint_box(painter, view, rect, lo, hi, stroke);
+        }
+    }
+}
+
+/// Draws the twelve edges of the box `lo..hi` (world corners).
+pub fn paint_box(
+    painter: &egui::Painter,
+    view: &ViewCamera,
+    rect: egui::Rect,
+    lo: DVec3,
+    hi: DVec3,
+    stroke: egui::Stroke,
+) {
+    let corner = |i: usize| {
+        DVec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
+    for a in 0..8usize {
+        for bit in [1, 2, 4] {
+            let b = a | bit;
+            if b != a
+                && let (Some(p), Some(q)) = (
+                    screen_point(view, rect, corner(a)),
+                    screen_point(view, rect, corner(b)),
                 )
-            };
-            for a in 0..8usize {
-                for bit in [1, 2, 4] {
-                    let b = a | bit;
-                    if b != a
-                        && let (Some(p), Some(q)) = (to_screen(corner(a)), to_screen(corner(b)))
-                    {
-                        painter.line_segment([p, q], stroke);
-                    }
-                }
+            {
+                painter.line_segment([p, q], stroke);
             }
         }
     }

@@ -29,6 +29,20 @@ pub struct Brush {
     pub axis: Axis,
     /// Change only selected voxels (when something is selected).
     pub in_selection: bool,
+    /// The brush or the selection tool.
+    pub tool: Tool,
+    /// How deep a selection box goes into the surface, in voxels.
+    pub select_depth: i32,
+}
+
+/// What the left button does in the viewport.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Tool {
+    /// Draw with the brush.
+    #[default]
+    Brush,
+    /// Drag selection boxes.
+    Select,
 }
 
 impl Default for Brush {
@@ -42,6 +56,8 @@ impl Default for Brush {
             mirror_centre: None,
             axis: Axis::Y,
             in_selection: false,
+            tool: Tool::Brush,
+            select_depth: 16,
         }
     }
 }
