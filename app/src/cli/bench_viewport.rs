@@ -425,25 +425,7 @@ pub fn edits(
                     continue;
                 }
                 changed_before = doc.live_stroke().map_or(0, |l| l.changed_voxels);
-                // The first frame that shows the whole edit: it restarted the accumulation
-                // and nothing of the edit is left for later frames' uploads.
-                let mut n = 0;
-                let mut restarted = false;
-                loop {
-                    let Some(f) = vp.begin_frame()? else {
-                        std::thread::yield_now();
-                        continue;
-                    };
-                    n += 1;
-                    let status = vp.trace_frame(&f, &doc.scene.world, &req)?;
-                    vp.submit_frame(f, &[], &[])?;
-                    restarted |= status.restarted;
-                    if restarted && status.upload.deferred_bytes == 0 {
-                        break;
-                    }
-                    anyhow::ensure!(n < 10_000, "the edit never showed");
-                }
-                vp.wait_idle()?;
+                let (n, _) = frames_until_shown(&mut vp, &doc.scene.world, &req)?;
                 ms.push(event.elapsed().as_secs_f64() * 1e3);
                 frames.push(n as f64);
                 if let Some(g) = vp.last_gpu_seconds() {
@@ -463,6 +445,113 @@ pub fn edits(
                 "{r:<7} {scale:<5}  {a50:.3} ({a99:.3})               {f50:.0} ({fmax:.0}), {m50:.3} ({m99:.3})                       {g50:.3} ({g99:.3})                              {p50:.3} ({pmax:.3})\n"
             );
         }
+    }
+    text += &selection_edits(&mut vp, &mut doc, size, &params)?;
+    Ok(text)
+}
+
+/// Frames (submitted back to back, as the window does) until one shows the whole of the
+/// latest change: it restarted the accumulation and nothing is left for later uploads.
+/// Returns the frames and the bytes uploaded.
+fn frames_until_shown(
+    vp: &mut Viewport,
+    world: &brickmap::World,
+    req: &FrameRequest<'_>,
+) -> Result<(u32, u64)> {
+    let mut n = 0;
+    let mut restarted = false;
+    let mut bytes = 0;
+    loop {
+        let Some(f) = vp.begin_frame()? else {
+            std::thread::yield_now();
+            continue;
+        };
+        n += 1;
+        let status = vp.trace_frame(&f, world, req)?;
+        vp.submit_frame(f, &[], &[])?;
+        restarted |= status.restarted;
+        bytes += status.upload.uploaded_bytes;
+        if restarted && status.upload.deferred_bytes == 0 {
+            break;
+        }
+        anyhow::ensure!(n < 10_000, "the edit never showed");
+    }
+    vp.wait_idle()?;
+    Ok((n, bytes))
+}
+
+/// A 256 × 64 × 256 selection of the default scene (through its surface): select, copy,
+/// paste, move by a voxel and by a brick, delete; each applied (timed), shown (timed, to
+/// the first frame with all of it uploaded), undone (not timed), several times.
+fn selection_edits(
+    vp: &mut Viewport,
+    doc: &mut app::editor::Document,
+    size: (u32, u32),
+    params: &render::SceneParams,
+) -> Result<String> {
+    use app::editor::command::Command;
+    use app::selection::SelectOp;
+    use glam::IVec3;
+    const REPEATS: usize = 7;
+    let req = FrameRequest {
+        params,
+        internal: scaled(size, 0.5),
+        output: size,
+        spp: 1,
+        target_spp: u32::MAX,
+        exposure: 0.0,
+        bgra: true,
+    };
+    let (min, max) = (IVec3::new(64, 48, 64), IVec3::new(319, 111, 319));
+    // `undo`: the operation changes voxels, is shown, then undone for the next run.
+    let select = Command::Select(SelectOp::Replace { min, max });
+    let mut text = format!(
+        "\nselection {min} … {max} (256 x 64 x 256), internal scale 0.5, {REPEATS} runs each\noperation                 voxels changed   apply ms median (max)   edit → frame ms median (max), frames   uploaded MB\n"
+    );
+    let cases = [
+        ("select", select.clone(), false),
+        ("copy", Command::Copy, false),
+        ("paste at (200,100,200)", Command::Paste { at: IVec3::new(200, 100, 200) }, true),
+        ("move by (1,0,1)", Command::MoveSelection(IVec3::new(1, 0, 1)), true),
+        ("move by (8,0,8)", Command::MoveSelection(IVec3::new(8, 0, 8)), true),
+        ("delete", Command::DeleteSelection, true),
+    ];
+    doc.execute(select)?;
+    doc.execute(Command::Copy)?;
+    frames_until_shown(vp, &doc.scene.world, &req)?;
+    for (name, command, undo) in cases {
+        let (mut apply, mut shown, mut frames, mut mb, mut changed) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), 0);
+        for _ in 0..REPEATS {
+            let event = Instant::now();
+            let done = doc.execute(command.clone())?;
+            apply.push(event.elapsed().as_secs_f64() * 1e3);
+            changed = done.changed_voxels;
+            if !undo {
+                // Selecting and copying change no voxel: nothing to show.
+                continue;
+            }
+            let (n, bytes) = frames_until_shown(vp, &doc.scene.world, &req)?;
+            shown.push(event.elapsed().as_secs_f64() * 1e3);
+            frames.push(n as f64);
+            mb.push(bytes as f64 / 1e6);
+            {
+                doc.undo()?;
+                frames_until_shown(vp, &doc.scene.world, &req)?;
+            }
+        }
+        let (_, a50, _, amax) = stats(apply);
+        let shown_text = if undo {
+            let (_, s50, _, smax) = stats(shown);
+            let (_, f50, _, _) = stats(frames);
+            let (_, m50, _, _) = stats(mb);
+            format!("{s50:.1} ({smax:.1}), {f50:.0}                 {m50:.2}")
+        } else {
+            "- (no voxel changes)".into()
+        };
+        text += &format!(
+            "{name:<25} {changed:<16} {a50:.1} ({amax:.1})            {shown_text}\n"
+        );
     }
     Ok(text)
 }

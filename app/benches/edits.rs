@@ -1,0 +1,112 @@
+//! CPU time of the editor's edits on the default scene (512 × 256 × 512 terrain): sphere
+//! strokes of radius 16 and 64 (attach and erase), and a 256 × 64 × 256 selection through the
+//! surface: select, copy, paste, move by a voxel and by a brick, delete, fill. Each timed run
+//! is one command as the editor executes it (world edit on the workers, inverse, history);
+//! the undo that puts the scene back between runs is not timed.
+//!
+//! Run: `cargo bench -p app --bench edits`.
+
+use app::editor::Document;
+use app::editor::command::{BrushMode, BrushShape, Command, Mirror, Stroke};
+use app::editor::history::History;
+use app::scene::{SceneSize, default_scene};
+use app::selection::SelectOp;
+use divan::Bencher;
+use glam::{DVec3, IVec3};
+use std::cell::RefCell;
+
+fn main() {
+    divan::main();
+}
+
+fn document() -> Document {
+    Document::new(default_scene(SceneSize::Full, 0).unwrap(), History::default())
+}
+
+/// The selection every selection benchmark starts from.
+const BOX: (IVec3, IVec3) = (IVec3::new(64, 48, 64), IVec3::new(319, 111, 319));
+
+fn selected() -> Document {
+    let mut doc = document();
+    doc.execute(Command::Select(SelectOp::Replace {
+        min: BOX.0,
+        max: BOX.1,
+    }))
+    .unwrap();
+    doc.execute(Command::Copy).unwrap();
+    doc
+}
+
+/// Times `command` on `doc`, undoing it (untimed) before each next run.
+fn run(bencher: Bencher, doc: Document, command: Command) {
+    let doc = RefCell::new(doc);
+    let steps = doc.borrow().history.undo_len();
+    bencher
+        .with_inputs(|| {
+            let mut d = doc.borrow_mut();
+            if d.history.undo_len() > steps {
+                d.undo().unwrap();
+            }
+        })
+        .bench_local_values(|()| doc.borrow_mut().execute(command.clone()).unwrap());
+}
+
+fn sphere(mode: BrushMode, radius: f64) -> Command {
+    Command::Stroke(Stroke {
+        mode,
+        shape: BrushShape::Sphere,
+        size: radius,
+        material: 1,
+        mirror: Mirror::default(),
+        points: vec![DVec3::new(256.0, 77.0, 256.0)],
+        axis: Default::default(),
+        in_selection: false,
+    })
+}
+
+#[divan::bench(args = [16.0, 64.0], sample_count = 20, sample_size = 1)]
+fn attach_sphere(bencher: Bencher, radius: f64) {
+    run(bencher, document(), sphere(BrushMode::Attach, radius));
+}
+
+#[divan::bench(args = [16.0, 64.0], sample_count = 20, sample_size = 1)]
+fn erase_sphere(bencher: Bencher, radius: f64) {
+    run(bencher, document(), sphere(BrushMode::Erase, radius));
+}
+
+#[divan::bench(sample_count = 20, sample_size = 1)]
+fn select_box(bencher: Bencher) {
+    let command = Command::Select(SelectOp::Replace {
+        min: BOX.0,
+        max: BOX.1,
+    });
+    run(bencher, document(), command);
+}
+
+#[divan::bench(sample_count = 20, sample_size = 1)]
+fn copy(bencher: Bencher) {
+    let doc = RefCell::new(selected());
+    bencher.bench_local(|| doc.borrow_mut().execute(Command::Copy).unwrap());
+}
+
+#[divan::bench(sample_count = 20, sample_size = 1)]
+fn paste(bencher: Bencher) {
+    let at = IVec3::new(200, 100, 200);
+    run(bencher, selected(), Command::Paste { at });
+}
+
+#[divan::bench(args = [1, 8], sample_count = 20, sample_size = 1)]
+fn move_selection(bencher: Bencher, step: i32) {
+    let by = IVec3::new(step, 0, step);
+    run(bencher, selected(), Command::MoveSelection(by));
+}
+
+#[divan::bench(sample_count = 20, sample_size = 1)]
+fn delete_selection(bencher: Bencher) {
+    run(bencher, selected(), Command::DeleteSelection);
+}
+
+#[divan::bench(sample_count = 20, sample_size = 1)]
+fn fill_selection(bencher: Bencher) {
+    run(bencher, selected(), Command::FillSelection(1));
+}
