@@ -20,7 +20,10 @@ fn main() {
 }
 
 fn document() -> Document {
-    Document::new(default_scene(SceneSize::Full, 0).unwrap(), History::default())
+    Document::new(
+        default_scene(SceneSize::Full, 0).unwrap(),
+        History::default(),
+    )
 }
 
 /// The selection every selection benchmark starts from.

@@ -483,6 +483,12 @@ fn strokes_drawn_with_the_mouse_replay_headlessly_to_the_same_scene() {
         xdotool(d, &["mouseup", "1"]);
         pause(1.0);
     };
+    // A click that closes a menu draws nothing.
+    xdotool(d, &["mousemove", "20", "11"]);
+    pause(1.0);
+    xdotool(d, &["click", "1"]);
+    pause(1.5);
+    drag(&[(480, 220)]);
     // Attach, paint, undo, redo, erase, save, quit.
     drag(&[(480, 220), (490, 230), (500, 230), (510, 230), (520, 230)]);
     xdotool(d, &["key", "p"]);
@@ -550,6 +556,11 @@ fn strokes_drawn_with_the_mouse_replay_headlessly_to_the_same_scene() {
             "{what} missing from the session:\n{text}"
         );
     }
+    assert_eq!(
+        text.matches("Stroke(").count(),
+        3,
+        "attach, paint and erase; the click that closed the menu drew nothing:\n{text}"
+    );
     // The same actions replayed headlessly give the scene the window saved.
     let replayed = dir.join("replayed");
     let replay = Command::new(env!("CARGO_BIN_EXE_voxbrick"))

@@ -511,9 +511,23 @@ fn selection_edits(
     let cases = [
         ("select", select.clone(), false),
         ("copy", Command::Copy, false),
-        ("paste at (200,100,200)", Command::Paste { at: IVec3::new(200, 100, 200) }, true),
-        ("move by (1,0,1)", Command::MoveSelection(IVec3::new(1, 0, 1)), true),
-        ("move by (8,0,8)", Command::MoveSelection(IVec3::new(8, 0, 8)), true),
+        (
+            "paste at (200,100,200)",
+            Command::Paste {
+                at: IVec3::new(200, 100, 200),
+            },
+            true,
+        ),
+        (
+            "move by (1,0,1)",
+            Command::MoveSelection(IVec3::new(1, 0, 1)),
+            true,
+        ),
+        (
+            "move by (8,0,8)",
+            Command::MoveSelection(IVec3::new(8, 0, 8)),
+            true,
+        ),
         ("delete", Command::DeleteSelection, true),
     ];
     doc.execute(select)?;
@@ -549,9 +563,7 @@ fn selection_edits(
         } else {
             "- (no voxel changes)".into()
         };
-        text += &format!(
-            "{name:<25} {changed:<16} {a50:.1} ({amax:.1})            {shown_text}\n"
-        );
+        text += &format!("{name:<25} {changed:<16} {a50:.1} ({amax:.1})            {shown_text}\n");
     }
     Ok(text)
 }

@@ -5,7 +5,7 @@
 //! it; how many of the oldest steps the memory budget dropped).
 
 use super::input::Action;
-use super::panels::UiEvent;
+use super::panels::{UiEvent, window};
 use super::selecting::Nudge;
 use super::tools::{Brush, MAX_SIZE, Tool};
 use crate::editor::Document;
@@ -61,6 +61,7 @@ fn kind_name(k: MaterialKind) -> &'static str {
 /// Draws the editing windows.
 pub fn draw(
     ctx: &egui::Context,
+    area: egui::Rect,
     state: &mut EditingState,
     doc: &Document,
     brush: &mut Brush,
@@ -69,7 +70,7 @@ pub fn draw(
     let table = doc.scene.world.materials();
     if !state.tools_hidden {
         let mut open = true;
-        egui::Window::new("Tools")
+        window(area, "Tools")
             .open(&mut open)
             .default_pos(egui::pos2(8.0, 40.0))
             .resizable(false)
@@ -78,7 +79,7 @@ pub fn draw(
     }
     if state.palette_open {
         let mut open = true;
-        egui::Window::new("Palette and materials")
+        window(area, "Palette and materials")
             .open(&mut open)
             .show(ctx, |ui| palette(ui, state, brush, &table, out));
         state.palette_open = open;
@@ -86,7 +87,7 @@ pub fn draw(
     if let Some(spec) = &mut state.terrain {
         let mut open = true;
         let height = doc.scene.world.dims().voxels().y as u32;
-        egui::Window::new("Terrain and water")
+        window(area, "Terrain and water")
             .open(&mut open)
             .show(ctx, |ui| terrain(ui, spec, height, out));
         if !open {
@@ -95,7 +96,7 @@ pub fn draw(
     }
     if state.history_open {
         let mut open = true;
-        egui::Window::new("History")
+        window(area, "History")
             .open(&mut open)
             .show(ctx, |ui| history(ui, doc, out));
         state.history_open = open;

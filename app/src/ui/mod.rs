@@ -800,7 +800,10 @@ impl Editor {
             }
             WindowEvent::MouseInput { state, button, .. } => {
                 gfx.window.request_redraw();
-                let free = !consumed && !self.egui.egui_wants_pointer_input();
+                // A click that closes an open menu only closes it (egui closes the menu when
+                // it sees the click in its next pass; the menu is still open now).
+                let menu_open = egui::Popup::is_any_open(&self.egui);
+                let free = !consumed && !self.egui.egui_wants_pointer_input() && !menu_open;
                 match (state, button) {
                     (ElementState::Pressed, MouseButton::Left) if free => self.press(),
                     (ElementState::Released, MouseButton::Left) if self.drawing.is_some() => {

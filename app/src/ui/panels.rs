@@ -264,10 +264,20 @@ pub fn draw(
     egui::Panel::bottom("status").show(root, |ui| {
         ui.label(&state.status);
     });
-    super::editing::draw(ctx, &mut state.editing, doc, &mut view.brush, &mut out);
+    // Windows stay between the menu bar and the status line (in a small window egui would
+    // otherwise push a tall one up over the menus).
+    let area = root.available_rect_before_wrap();
+    super::editing::draw(
+        ctx,
+        area,
+        &mut state.editing,
+        doc,
+        &mut view.brush,
+        &mut out,
+    );
     if state.render_open {
         let mut open = true;
-        egui::Window::new("Render settings")
+        window(area, "Render settings")
             .open(&mut open)
             .show(ctx, |ui| {
                 ui.add(
@@ -300,16 +310,14 @@ pub fn draw(
     }
     if state.sun_open {
         let mut open = true;
-        egui::Window::new("Sun and sky")
-            .open(&mut open)
-            .show(ctx, |ui| {
-                sun_and_sky(ui, doc, &mut out);
-            });
+        window(area, "Sun and sky").open(&mut open).show(ctx, |ui| {
+            sun_and_sky(ui, doc, &mut out);
+        });
         state.sun_open = open;
     }
     if state.stats_open {
         let mut open = true;
-        egui::Window::new("Scene statistics")
+        window(area, "Scene statistics")
             .open(&mut open)
             .show(ctx, |ui| {
                 ui.monospace(&state.stats);
@@ -318,53 +326,49 @@ pub fn draw(
     }
     if state.help_open {
         let mut open = true;
-        egui::Window::new("Shortcuts")
-            .open(&mut open)
-            .show(ctx, |ui| {
-                // Scrolls when the window is small (or the UI scale large).
-                egui::ScrollArea::both().show(ui, |ui| {
-                    egui::Grid::new("keys").striped(true).show(ui, |ui| {
-                        for (keys, what) in SHORTCUTS {
-                            ui.monospace(*keys);
-                            ui.label(*what);
+        window(area, "Shortcuts").open(&mut open).show(ctx, |ui| {
+            // Scrolls when the window is small (or the UI scale large).
+            egui::ScrollArea::both().show(ui, |ui| {
+                egui::Grid::new("keys").striped(true).show(ui, |ui| {
+                    for (keys, what) in SHORTCUTS {
+                        ui.monospace(*keys);
+                        ui.label(*what);
+                        ui.end_row();
+                    }
+                });
+                if !state.keys.is_empty() {
+                    ui.separator();
+                    ui.label("The key map in force (keys.ron in the config folder):");
+                    egui::Grid::new("keymap").striped(true).show(ui, |ui| {
+                        for (keys, action) in &state.keys {
+                            ui.monospace(keys);
+                            ui.label(action);
                             ui.end_row();
                         }
                     });
-                    if !state.keys.is_empty() {
-                        ui.separator();
-                        ui.label("The key map in force (keys.ron in the config folder):");
-                        egui::Grid::new("keymap").striped(true).show(ui, |ui| {
-                            for (keys, action) in &state.keys {
-                                ui.monospace(keys);
-                                ui.label(action);
-                                ui.end_row();
-                            }
-                        });
-                    }
-                });
+                }
             });
+        });
         state.help_open = open;
     }
     if state.new_open {
         let mut open = true;
-        egui::Window::new("New scene")
-            .open(&mut open)
-            .show(ctx, |ui| {
-                let (x, y, z) = &mut state.new_size;
-                ui.horizontal(|ui| {
-                    ui.add(egui::DragValue::new(x).range(8..=4096).prefix("x "));
-                    ui.add(egui::DragValue::new(y).range(8..=1024).prefix("y "));
-                    ui.add(egui::DragValue::new(z).range(8..=4096).prefix("z "));
-                });
-                ui.checkbox(&mut state.new_terrain, "noise terrain with water");
-                if ui.button("Create").clicked() {
-                    out.push(UiEvent::NewScene {
-                        size: state.new_size,
-                        terrain: state.new_terrain,
-                    });
-                    state.new_open = false;
-                }
+        window(area, "New scene").open(&mut open).show(ctx, |ui| {
+            let (x, y, z) = &mut state.new_size;
+            ui.horizontal(|ui| {
+                ui.add(egui::DragValue::new(x).range(8..=4096).prefix("x "));
+                ui.add(egui::DragValue::new(y).range(8..=1024).prefix("y "));
+                ui.add(egui::DragValue::new(z).range(8..=4096).prefix("z "));
             });
+            ui.checkbox(&mut state.new_terrain, "noise terrain with water");
+            if ui.button("Create").clicked() {
+                out.push(UiEvent::NewScene {
+                    size: state.new_size,
+                    terrain: state.new_terrain,
+                });
+                state.new_open = false;
+            }
+        });
         state.new_open &= open;
     }
     if let Some((path, offset)) = &mut state.import {
@@ -433,14 +437,12 @@ pub fn draw(
     }
     if !state.errors.is_empty() {
         let mut dismiss = false;
-        egui::Window::new("Error")
-            .collapsible(false)
-            .show(ctx, |ui| {
-                for e in &state.errors {
-                    ui.colored_label(egui::Color32::LIGHT_RED, e);
-                }
-                dismiss = ui.button("OK").clicked();
-            });
+        window(area, "Error").collapsible(false).show(ctx, |ui| {
+            for e in &state.errors {
+                ui.colored_label(egui::Color32::LIGHT_RED, e);
+            }
+            dismiss = ui.button("OK").clicked();
+        });
         if dismiss {
             state.errors.clear();
         }
@@ -510,4 +512,12 @@ fn sun_and_sky(ui: &mut egui::Ui, doc: &Document, out: &mut Vec<UiEvent>) {
     if sky_changed && sky.validate().is_ok() {
         out.push(UiEvent::SetSky(sky));
     }
+}
+
+/// A window kept inside `area` (the viewport between the panels), scrolling when taller.
+pub(super) fn window(area: egui::Rect, title: &str) -> egui::Window<'_> {
+    egui::Window::new(title)
+        .constrain_to(area)
+        .max_height(area.height() - 40.0)
+        .vscroll(true)
 }
