@@ -78,8 +78,15 @@ pub struct Viewport {
     frames: Vec<FrameSlot>,
     next: usize,
     last_gpu_seconds: Option<f64>,
+    /// Frames in a row that showed the previous image while an upload was incomplete.
+    held: u32,
     ctx: Arc<GpuContext>,
 }
+
+/// The most frames in a row an incomplete upload holds the previous image (an edit larger
+/// than that many staging slots then shows in parts, rather than the view freezing while a
+/// long stroke keeps adding to the upload).
+pub const MAX_HELD_FRAMES: u32 = 8;
 
 impl Frame {
     /// The frame slot (0..[`FRAMES_IN_FLIGHT`]).
@@ -91,7 +98,23 @@ impl Frame {
 impl Viewport {
     /// Uploads the world and builds the tracer and the display pass.
     pub fn new(ctx: Arc<GpuContext>, view: &WorldView<'_>) -> Result<Self, GpuError> {
-        let world = GpuWorld::upload(&ctx, view)?;
+        Self::with_staging(
+            ctx,
+            view,
+            crate::vulkan::world::RING_SLOTS,
+            crate::vulkan::world::RING_SLOT_BYTES,
+        )
+    }
+
+    /// [`Viewport::new`] with `slots` staging buffers of `slot_bytes` (what one frame
+    /// uploads at most; tests make edits span frames with a small one).
+    pub fn with_staging(
+        ctx: Arc<GpuContext>,
+        view: &WorldView<'_>,
+        slots: usize,
+        slot_bytes: u64,
+    ) -> Result<Self, GpuError> {
+        let world = GpuWorld::with_ring(&ctx, view, slots, slot_bytes)?;
         let tracer = match PathTracer::new(&ctx) {
             Ok(t) => t,
             Err(e) => {
@@ -116,6 +139,7 @@ impl Viewport {
             frames: Vec::new(),
             next: 0,
             last_gpu_seconds: None,
+            held: 0,
             ctx,
         })
     }
@@ -266,6 +290,10 @@ impl Viewport {
         if upload.changed() {
             live.restart();
         }
+        // An edit whose upload spans frames: until the rest is on the GPU the frame shows the
+        // previous image (the accumulation is untouched) instead of a half-applied edit.
+        let hold = upload.deferred_bytes > 0 && self.held < MAX_HELD_FRAMES && live.has_image();
+        self.held = if hold { self.held + 1 } else { 0 };
         // The frame's parameters under a short read lock.
         let (base, variant) = {
             let view = world.read();
@@ -277,17 +305,21 @@ impl Viewport {
         // SAFETY: recording; earlier frames' and the staging ring's writes (same queue,
         // earlier in submission order) come before this frame's reads and writes.
         unsafe { after_earlier_passes(&ctx, frame.cmd) };
-        let (added, restarted) = live.record_batch(
-            &ctx,
-            frame.cmd,
-            &mut self.tracer,
-            &self.world,
-            base,
-            variant,
-            (req.spp, req.target_spp),
-            &mut slot.uniforms,
-            &mut slot.sets,
-        )?;
+        let (added, restarted) = if hold {
+            (0, false)
+        } else {
+            live.record_batch(
+                &ctx,
+                frame.cmd,
+                &mut self.tracer,
+                &self.world,
+                base,
+                variant,
+                (req.spp, req.target_spp),
+                &mut slot.uniforms,
+                &mut slot.sets,
+            )?
+        };
         // SAFETY: recording: the trace's writes before the display pass reads them.
         unsafe {
             barrier(

@@ -153,3 +153,62 @@ fn an_edit_or_a_camera_move_restarts_and_the_edit_is_visible_the_next_frame() {
     assert!(moved[0].restarted, "{moved:?}");
     assert_eq!(ctx.validation_errors(), 0, "validation errors");
 }
+
+#[test]
+fn an_edit_whose_upload_spans_frames_shows_only_once_it_is_all_there() {
+    let Some(ctx) = context() else { return };
+    let (world, params) = common::showcase();
+    // One 1 KiB staging slot: an edit of a few bricks takes several frames to upload.
+    let mut vp = Viewport::with_staging(ctx.clone(), &world.read(), 1, 1024).unwrap();
+    let size = (32, 24);
+    let req = FrameRequest {
+        params: &params,
+        internal: size,
+        output: size,
+        spp: 2,
+        target_spp: 8,
+        exposure: 0.0,
+        bgra: false,
+    };
+    frames(&mut vp, &world, &req, 8, |v| v.samples() >= 8);
+    let before = vp.live_hdr().unwrap().unwrap();
+    world
+        .apply(EditOp::Shape {
+            shape: Shape::Sphere {
+                centre: DVec3::new(24.0, 12.0, 24.0),
+                radius: 9.0,
+            },
+            mode: Mode::Add(0),
+        })
+        .unwrap();
+    let first = frames(&mut vp, &world, &req, 1, |_| false);
+    assert!(
+        first[0].upload.deferred_bytes > 0,
+        "the upload spans frames: {first:?}"
+    );
+    // While held, the previous image stays on display: the accumulation did not change.
+    let during = vp.live_hdr().unwrap().unwrap();
+    assert_eq!(during.pixels, before.pixels, "a partial upload was traced");
+    let mut statuses = first;
+    statuses.extend(frames(&mut vp, &world, &req, 24, |_| false));
+    let held: Vec<_> = statuses
+        .iter()
+        .take_while(|s| s.upload.deferred_bytes > 0)
+        .collect();
+    assert!(held.len() >= 2, "the upload spans frames: {statuses:?}");
+    for s in held.iter().take(render::viewport::MAX_HELD_FRAMES as usize) {
+        assert!(
+            s.added == 0 && !s.restarted,
+            "a partial upload was traced: {s:?}"
+        );
+    }
+    if held.len() <= render::viewport::MAX_HELD_FRAMES as usize {
+        let shown = &statuses[held.len()];
+        assert!(
+            shown.restarted && shown.upload.deferred_bytes == 0,
+            "{shown:?}"
+        );
+        assert!(shown.added > 0);
+    }
+    assert_eq!(ctx.validation_errors(), 0, "validation errors");
+}

@@ -37,6 +37,8 @@ pub struct Progressive {
     key: Option<u64>,
     samples: u32,
     seed: u64,
+    /// Some batch was recorded into the buffer (it holds an image to display).
+    traced: bool,
 }
 
 impl Progressive {
@@ -71,6 +73,7 @@ impl Progressive {
             key: None,
             samples: 0,
             seed,
+            traced: false,
         })
     }
 
@@ -87,6 +90,12 @@ impl Progressive {
     /// Output (displayed) resolution.
     pub fn output(&self) -> (u32, u32) {
         self.output
+    }
+
+    /// Whether the buffer holds an image (a batch was recorded since it was made; a restart
+    /// keeps the old samples until the next batch overwrites them).
+    pub fn has_image(&self) -> bool {
+        self.traced
     }
 
     /// Drops the accumulated samples; the next frame starts over.
@@ -227,6 +236,7 @@ impl Progressive {
             tracer.sample_slices(pixels),
         );
         let p = base.batch(per, self.samples, self.samples > 0);
+        self.traced = true;
         tracer.record(
             ctx,
             cmd,
