@@ -52,6 +52,9 @@ pub enum BrickmapError {
     /// The material table already holds 256 entries.
     #[error("the material table is full (256 entries)")]
     MaterialTableFull,
+    /// A material table without entries.
+    #[error("a material table needs at least one material")]
+    EmptyTable,
     /// A parameter-table index beyond its 64 entries.
     #[error("parameter index {0} is beyond the 64-entry parameter table")]
     ParamIndex(u32),

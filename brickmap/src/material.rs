@@ -157,6 +157,23 @@ impl MaterialTable {
             })
         }
     }
+    /// The table of only the entries `keep` marks (at least one), in order, with the same
+    /// colours and parameters; entry i of the result is the i-th kept one.
+    pub fn retain(&self, keep: &[bool; 256]) -> Result<MaterialTable> {
+        let mut out = self.clone();
+        out.gpu.materials = [0; 128];
+        out.len = 0;
+        for i in (0..self.len).filter(|&i| keep[i]) {
+            out.len += 1;
+            out.write_entry((out.len - 1) as u8, self.get(i as u8)?)?;
+        }
+        if out.len == 0 {
+            return Err(BrickmapError::EmptyTable);
+        }
+        out.mark_all_dirty();
+        Ok(out)
+    }
+
     /// Appends a material, returning its index.
     pub fn push(&mut self, m: Material) -> Result<u8> {
         if self.len == 256 {

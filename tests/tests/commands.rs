@@ -358,3 +358,75 @@ fn history_memory_is_bounded_and_reports_drops() {
     }
     doc.scene.world.read().validate().unwrap();
 }
+
+/// Every solid voxel's material as it looks (kind, parameter value, colour), not its index.
+fn appearance(doc: &Document) -> Vec<(IVec3, String)> {
+    let view = doc.scene.world.read();
+    let table = view.materials();
+    let mut out = Vec::new();
+    view.for_each_brick(|b, mask, _| {
+        for bit in mask.ones() {
+            let v =
+                b.as_ivec3() * 8 + IVec3::new(bit as i32 % 8, bit as i32 / 8 % 8, bit as i32 / 64);
+            let m = table.get(view.voxel(v).unwrap().unwrap()).unwrap();
+            let param = table.param(m.kind, m.param).unwrap();
+            out.push((
+                v,
+                format!("{:?} {param} {:?}", m.kind, table.colour(m.colour)),
+            ));
+        }
+    });
+    out.sort_by_key(|(v, _)| (v.x, v.y, v.z));
+    out
+}
+
+#[test]
+fn removing_unused_materials_keeps_every_voxels_look_and_undoes_exactly() {
+    let mut doc = document();
+    let spec = |colour| MaterialSpec {
+        kind: KindSpec::Metal,
+        param: 7,
+        colour,
+    };
+    doc.execute(Command::AddMaterial(spec(50))).unwrap();
+    doc.execute(Command::AddMaterial(spec(90))).unwrap();
+    let len = doc.scene.world.materials().len();
+    // Material 1 of the terrain is left unused, and the last one paints a ball.
+    let used_by_terrain: Vec<u8> = {
+        let view = doc.scene.world.read();
+        let mut seen = [false; 256];
+        view.for_each_brick(|_, mask, mats| match mats {
+            brickmap::BrickMaterials::Uniform(m) => seen[m as usize] = true,
+            brickmap::BrickMaterials::PerVoxel(v) => v[..mask.count() as usize]
+                .iter()
+                .for_each(|m| seen[*m as usize] = true),
+        });
+        (0..len as u8).filter(|m| seen[*m as usize]).collect()
+    };
+    let mut paint = stroke(
+        BrushMode::Paint,
+        BrushShape::Sphere,
+        9.0,
+        &[[64.0, 30.0, 64.0]],
+    );
+    if let Command::Stroke(s) = &mut paint {
+        s.material = (len - 1) as u8;
+    }
+    doc.execute(paint).unwrap();
+    let unused = len - 1 - used_by_terrain.len();
+    assert!(unused >= 1, "the test leaves a material unused");
+    let before = (state(&doc), appearance(&doc));
+    doc.execute(Command::RemoveUnusedMaterials).unwrap();
+    assert_eq!(doc.scene.world.materials().len(), len - unused);
+    assert_eq!(appearance(&doc), before.1, "every voxel looks as before");
+    doc.scene.world.read().validate().unwrap();
+    let after = state(&doc);
+    doc.undo().unwrap();
+    assert_eq!((state(&doc), appearance(&doc)), before, "undo");
+    doc.redo().unwrap();
+    assert_eq!(state(&doc), after, "redo");
+    // Nothing left to remove: refused, nothing changes.
+    let steps = doc.history.undo_len();
+    assert!(doc.execute(Command::RemoveUnusedMaterials).is_err());
+    assert_eq!((state(&doc), doc.history.undo_len()), (after, steps));
+}

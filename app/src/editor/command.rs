@@ -133,6 +133,8 @@ pub enum Command {
     },
     /// Remove every voxel.
     Clear,
+    /// Remove the materials no voxel uses (the ones after them move down; voxels follow).
+    RemoveUnusedMaterials,
     /// Change the selection.
     Select(SelectOp),
     /// Empty every selected voxel.
@@ -246,6 +248,7 @@ impl Command {
             Command::GenerateTerrain(t) => format!("Generate terrain (seed {})", t.seed),
             Command::ImportVox { path, .. } => format!("Import {path}"),
             Command::Clear => "Clear".into(),
+            Command::RemoveUnusedMaterials => "Remove unused materials".into(),
             Command::Select(op) => match op {
                 SelectOp::Replace { .. } => "Select box".into(),
                 SelectOp::Add { .. } => "Add box to selection".into(),
@@ -292,6 +295,7 @@ impl Command {
         };
         Ok(match self {
             Command::Stroke(s) => apply_all(scene, stroke_edits(s, scene.selection.as_ref())?)?,
+            Command::RemoveUnusedMaterials => remove_unused_materials(scene)?,
             Command::Select(op) => {
                 let next = select(scene.selection.as_ref(), *op, world.dims().voxels());
                 unchanged(Inverse::Selection(std::mem::replace(
@@ -478,5 +482,78 @@ fn with_selection(scene: &mut Scene, edit: EditOp, next: Option<Selection>) -> R
     Ok(Applied {
         inverse: Inverse::Compound(vec![applied.inverse, Inverse::Selection(before)]),
         changed_voxels: applied.changed_voxels,
+    })
+}
+
+/// Drops the unused materials: the voxels of every brick with a material whose index
+/// changes are rewritten (one `Restore` edit), then the shorter table goes in. The inverse
+/// puts the old table back first, then the voxels.
+fn remove_unused_materials(scene: &Scene) -> Result<Applied> {
+    use brickmap::{BrickMaterials, BrickUndo, EditInverse, PriorMaterials};
+    let world = &scene.world;
+    let before = world.materials().clone();
+    let mut used = [false; 256];
+    let mut bricks = Vec::new();
+    {
+        let view = world.read();
+        view.for_each_brick(|_, mask, mats| match mats {
+            BrickMaterials::Uniform(m) => used[m as usize] = true,
+            BrickMaterials::PerVoxel(v) => {
+                for m in &v[..mask.count() as usize] {
+                    used[*m as usize] = true;
+                }
+            }
+        });
+        if (0..before.len()).all(|i| used[i]) {
+            return Err(super::error::invalid("every material is in use"));
+        }
+        if !used.iter().any(|u| *u) {
+            // An empty scene keeps its first material (brushes need one).
+            used[0] = true;
+        }
+        let mut remap = [0u8; 256];
+        let mut next = 0u8;
+        for i in 0..before.len() {
+            if used[i] {
+                remap[i] = next;
+                next = next.wrapping_add(1);
+            }
+        }
+        view.for_each_brick(|b, mask, mats| {
+            let prior = match mats {
+                BrickMaterials::Uniform(m) if remap[m as usize] != m => {
+                    PriorMaterials::Uniform(remap[m as usize])
+                }
+                BrickMaterials::PerVoxel(v)
+                    if v[..mask.count() as usize]
+                        .iter()
+                        .any(|m| remap[*m as usize] != *m) =>
+                {
+                    PriorMaterials::PerVoxel(
+                        v[..mask.count() as usize]
+                            .iter()
+                            .map(|m| remap[*m as usize])
+                            .collect(),
+                    )
+                }
+                _ => return,
+            };
+            bricks.push(BrickUndo {
+                brick: b,
+                prior_mask: *mask,
+                touched: *mask,
+                prior,
+            });
+        });
+    }
+    let table = before.retain(&used)?;
+    let out = world.apply(EditOp::Restore(EditInverse { bricks }))?;
+    if let Err(e) = world.replace_materials(table) {
+        world.apply(EditOp::Restore(out.inverse))?;
+        return Err(e.into());
+    }
+    Ok(Applied {
+        inverse: Inverse::Voxels(vec![out.inverse], Some(Box::new(before))),
+        changed_voxels: out.changed_voxels,
     })
 }

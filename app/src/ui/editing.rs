@@ -68,6 +68,9 @@ pub fn draw(
     out: &mut Vec<UiEvent>,
 ) {
     let table = doc.scene.world.materials();
+    // The table can shrink (an undone addition, unused materials removed): the current
+    // material stays an entry of it.
+    brush.material = brush.material.min((table.len() - 1) as u8);
     if !state.tools_hidden {
         let mut open = true;
         window(area, "Tools")
@@ -363,10 +366,20 @@ fn palette(
             material: spec,
         });
     }
-    if table.len() < 256 && ui.button("duplicate as a new material").clicked() {
-        out.push(UiEvent::AddMaterial(spec));
-        brush.material = table.len() as u8;
-    }
+    ui.horizontal(|ui| {
+        if table.len() < 256 && ui.button("duplicate as a new material").clicked() {
+            out.push(UiEvent::AddMaterial(spec));
+            brush.material = table.len() as u8;
+        }
+        if table.len() > 1
+            && ui
+                .button("remove unused")
+                .on_hover_text("drop the materials no voxel uses; later ones move down")
+                .clicked()
+        {
+            out.push(UiEvent::Action(Action::RemoveUnusedMaterials));
+        }
+    });
 }
 
 fn history(ui: &mut egui::Ui, doc: &Document, out: &mut Vec<UiEvent>) {

@@ -53,6 +53,8 @@ pub enum Action {
     StoreView(u8),
     /// Recall camera slot n.
     RecallView(u8),
+    /// Drop the materials no voxel uses.
+    RemoveUnusedMaterials,
     /// The selection tool.
     SelectTool,
     /// Select the whole grid.

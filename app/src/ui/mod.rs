@@ -391,6 +391,7 @@ impl Editor {
                 self.settings.brush.tool = Tool::Brush;
             }
             Action::SelectTool => self.settings.brush.tool = Tool::Select,
+            Action::RemoveUnusedMaterials => self.execute(Command::RemoveUnusedMaterials),
             Action::SelectAll => self.select(SelectOp::All),
             Action::SelectNone => self.select(SelectOp::None),
             Action::DeleteSelection => self.execute(Command::DeleteSelection),
