@@ -160,6 +160,11 @@ fn every_command() -> Vec<Command> {
             height_range: (10, 50),
             water_level: 24,
             noise: app::editor::command::NoiseSpec::OpenSimplex,
+            bands: app::editor::command::Bands {
+                rock_line: 0.3,
+                snow_line: 0.5,
+                soil_depth: 6,
+            },
         }),
         Command::ImportVox {
             path: "../assets/vox/mmmm_chr_robot.vox".into(),
@@ -273,6 +278,7 @@ fn failed_commands_change_nothing() {
             height_range: (1, 5),
             water_level: 0,
             noise: Default::default(),
+            bands: Default::default(),
         }),
         Command::ImportVox {
             path: "no/such.vox".into(),
@@ -429,4 +435,46 @@ fn removing_unused_materials_keeps_every_voxels_look_and_undoes_exactly() {
     let steps = doc.history.undo_len();
     assert!(doc.execute(Command::RemoveUnusedMaterials).is_err());
     assert_eq!((state(&doc), doc.history.undo_len()), (after, steps));
+}
+
+#[test]
+fn terrain_bands_decide_the_surface_material() {
+    let mut doc = document();
+    let spec = |rock_line, snow_line| TerrainSpec {
+        bands: app::editor::command::Bands {
+            rock_line,
+            snow_line,
+            soil_depth: 3,
+        },
+        ..TerrainSpec::for_size((128, 64, 128))
+    };
+    doc.execute(Command::GenerateTerrain(spec(0.0, 0.0)))
+        .unwrap();
+    let view = doc.scene.world.read();
+    let table = view.materials();
+    let (mut snow, mut other) = (0, 0);
+    for x in 0..128 {
+        for z in 0..128 {
+            let top = (0..64)
+                .rev()
+                .find_map(|y| view.voxel(IVec3::new(x, y, z)).unwrap())
+                .unwrap();
+            let m = table.get(top).unwrap();
+            let colour = table.colour(m.colour);
+            if m.kind == brickmap::MaterialKind::Dielectric || colour == [218, 202, 150] {
+                continue; // water, or the sand at its edge
+            }
+            if colour == [240, 244, 250] {
+                snow += 1;
+            } else {
+                other += 1;
+            }
+        }
+    }
+    assert!(snow > 1000 && other == 0, "snow {snow}, other {other}");
+    drop(view);
+    let snowy = doc.scene.world.read().content_hash();
+    doc.execute(Command::GenerateTerrain(spec(0.62, 0.86)))
+        .unwrap();
+    assert_ne!(doc.scene.world.read().content_hash(), snowy);
 }

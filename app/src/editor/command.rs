@@ -33,6 +33,31 @@ pub struct TerrainSpec {
     /// Noise function (Perlin when absent).
     #[serde(default)]
     pub noise: NoiseSpec,
+    /// Where each material goes (the thesis scene's bands when absent).
+    #[serde(default)]
+    pub bands: Bands,
+}
+
+/// The terrain's material bands: sand at the water's edge, grass over dirt, then rock, then
+/// snow over rock, by surface height; rock below the soil everywhere.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Bands {
+    /// Surfaces above this fraction of the height range are rock (0..=1).
+    pub rock_line: f64,
+    /// Surfaces above this fraction are snow (rock_line..=1).
+    pub snow_line: f64,
+    /// Voxels of grass and dirt over the rock.
+    pub soil_depth: u32,
+}
+
+impl Default for Bands {
+    fn default() -> Self {
+        Bands {
+            rock_line: 0.62,
+            snow_line: 0.86,
+            soil_depth: 3,
+        }
+    }
 }
 
 impl TerrainSpec {
@@ -46,6 +71,7 @@ impl TerrainSpec {
             height_range: (size.1 / 8, size.1 * 5 / 8),
             water_level: size.1 / 4,
             noise: NoiseSpec::Perlin,
+            bands: Bands::default(),
         }
     }
 }
@@ -423,6 +449,8 @@ impl Command {
                     (params.seed, params.noise, params.scale, params.octaves) =
                         (t.seed, t.noise.into(), t.scale, t.octaves);
                     (params.height_range, params.water_level) = (t.height_range, t.water_level);
+                    (params.rock_line, params.snow_line, params.soil_depth) =
+                        (t.bands.rock_line, t.bands.snow_line, t.bands.soil_depth);
                     let edit = NoiseTerrain::new(params, world.dims())?.edit();
                     Ok::<_, EditError>(world.apply(edit)?)
                 })();

@@ -453,6 +453,13 @@ fn terrain(ui: &mut egui::Ui, spec: &mut TerrainSpec, height: u32, out: &mut Vec
     ui.add(egui::Slider::new(&mut spec.height_range.1, 0..=top).text("highest ground"));
     spec.height_range.1 = spec.height_range.1.max(spec.height_range.0);
     ui.add(egui::Slider::new(&mut spec.water_level, 0..=top).text("water level (0: none)"));
+    ui.label("material bands (by surface height, from lowest to highest ground)");
+    let b = &mut spec.bands;
+    ui.add(egui::Slider::new(&mut b.rock_line, 0.0..=1.0).text("rock above"));
+    ui.add(egui::Slider::new(&mut b.snow_line, 0.0..=1.0).text("snow above"));
+    b.snow_line = b.snow_line.max(b.rock_line);
+    ui.add(egui::Slider::new(&mut b.soil_depth, 0..=32).text("soil depth (grass, dirt)"));
+    ui.label("Sand lines the water; colours are in the palette after generating.");
     ui.label("Replaces every voxel of the scene (one undoable step), on the workers.");
     if ui.button("Generate").clicked() {
         out.push(UiEvent::Generate(spec.clone()));
