@@ -210,38 +210,58 @@ impl Writes {
     }
 
     /// Puts the voxels `mask` (materials by voxel index) of the brick whose minimum voxel is
-    /// `min` down shifted by `offset`, dropping those outside a grid of `voxels`. A shifted
-    /// brick straddles at most 2 × 2 × 2 target bricks: they are gathered locally, then
-    /// merged into the targets once each.
+    /// `min` down shifted by `offset`, dropping those outside a grid of `voxels` (whole
+    /// bricks: a grid is a whole number of them). A shifted brick straddles at most 2 × 2 × 2
+    /// target bricks; each gets its part a row of 8 voxels at a time (mask bits shifted,
+    /// material bytes copied as a slice).
     fn put(&mut self, min: IVec3, mask: &Mask, mats: &[u8; 512], offset: IVec3, voxels: IVec3) {
         let base = min + offset;
         let first = base.div_euclid(IVec3::splat(8));
-        let mut local: [(Mask, [u8; 512]); 8] = [(Mask::EMPTY, [0; 512]); 8];
-        for bit in mask.ones() {
-            let l = IVec3::new(bit as i32 % 8, bit as i32 / 8 % 8, bit as i32 / 64);
-            let v = base + l;
-            if v.cmplt(IVec3::ZERO).any() || v.cmpge(voxels).any() {
+        let r = base.rem_euclid(IVec3::splat(8));
+        let bricks = voxels / 8;
+        let row = |y: i32, z: i32| (mask.0[(2 * z + y / 4) as usize] >> (8 * (y & 3))) & 0xFF;
+        // The source rows (or columns) that land in the lower (0) or upper (1) target brick.
+        let span = |k: i32, r: i32| if k == 0 { 0..8 - r } else { 8 - r..8 };
+        for k in 0..8 {
+            let k = IVec3::new(k & 1, k >> 1 & 1, k >> 2);
+            let tb = first + k;
+            let empty = (k.cmpeq(IVec3::ONE) & r.cmpeq(IVec3::ZERO)).any();
+            if empty || tb.cmplt(IVec3::ZERO).any() || tb.cmpge(bricks).any() {
                 continue;
             }
-            let k = v.div_euclid(IVec3::splat(8)) - first;
-            let slot = &mut local[(k.x + 2 * k.y + 4 * k.z) as usize];
-            let lv = v.rem_euclid(IVec3::splat(8));
-            let tb = brickmap::brick::voxel_bit(lv.x, lv.y, lv.z);
-            slot.0.set(tb);
-            slot.1[tb] = mats[bit];
-        }
-        for (i, (m, d)) in local.iter().enumerate() {
-            if m.is_empty() {
+            // Each row's target bits and where its bytes go.
+            let rows = |f: &mut dyn FnMut(u32, usize, usize, usize, usize)| {
+                for z in span(k.z, r.z) {
+                    let tz = z + r.z - 8 * k.z;
+                    for y in span(k.y, r.y) {
+                        let src = row(y, z);
+                        let ty = y + r.y - 8 * k.y;
+                        let (bits, from, to, n) = if k.x == 0 {
+                            ((src << r.x) & 0xFF, 0, r.x, 8 - r.x)
+                        } else {
+                            (src >> (8 - r.x), 8 - r.x, 0, r.x)
+                        };
+                        if bits != 0 {
+                            let word = (2 * tz + ty / 4) as usize;
+                            let s = (8 * y + 64 * z + from) as usize;
+                            let t = (8 * ty + 64 * tz + to) as usize;
+                            f(bits << (8 * (ty & 3)), word, s, t, n as usize);
+                        }
+                    }
+                }
+            };
+            let mut part = Mask::EMPTY;
+            rows(&mut |bits, word, _, _, _| part.0[word] |= bits);
+            if part.is_empty() {
                 continue;
             }
-            let k = IVec3::new(i as i32 & 1, i as i32 >> 1 & 1, i as i32 >> 2);
-            let t = self.target((first + k).as_uvec3());
-            t.touched = t.touched.or(m);
-            t.solid = t.solid.or(m);
+            let t = self.target(tb.as_uvec3());
+            t.touched = t.touched.or(&part);
+            t.solid = t.solid.or(&part);
+            // Sources never overlap in a target: whole row slices are copied (bytes of empty
+            // source voxels land on voxels no other source writes, and are never read).
             let dense = t.dense.get_or_insert_with(|| Box::new([0; 512]));
-            for b in m.ones() {
-                dense[b] = d[b];
-            }
+            rows(&mut |_, _, s, t, n| dense[t..t + n].copy_from_slice(&mats[s..s + n]));
         }
     }
 
@@ -251,6 +271,11 @@ impl Writes {
             .into_iter()
             .map(|((x, y, z), t)| {
                 let prior = match &t.dense {
+                    // Whole bricks of one material are common (terrain interiors): one byte.
+                    Some(d) if t.solid.is_full() && d.iter().all(|m| *m == d[0]) => {
+                        PriorMaterials::Uniform(d[0])
+                    }
+                    Some(d) if t.solid.is_full() => PriorMaterials::PerVoxel(d.to_vec()),
                     Some(d) => PriorMaterials::PerVoxel(t.solid.ones().map(|b| d[b]).collect()),
                     None => PriorMaterials::PerVoxel(Vec::new()),
                 };
