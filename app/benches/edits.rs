@@ -1,6 +1,7 @@
 //! CPU time of the editor's edits on the default scene (512 × 256 × 512 terrain): sphere
 //! strokes of radius 16 and 64 (attach and erase), and a 256 × 64 × 256 selection through the
-//! surface: select, copy, paste, move by a voxel and by a brick, delete, fill. Each timed run
+//! surface: select, copy, paste, move by a voxel and by a brick, delete, fill; and the brush
+//! preview (the voxels a click would change) for both spheres. Each timed run
 //! is one command as the editor executes it (world edit on the workers, inverse, history);
 //! the undo that puts the scene back between runs is not timed.
 //!
@@ -112,4 +113,18 @@ fn delete_selection(bencher: Bencher) {
 #[divan::bench(sample_count = 20, sample_size = 1)]
 fn fill_selection(bencher: Bencher) {
     run(bencher, selected(), Command::FillSelection(1));
+}
+
+#[divan::bench(args = [16.0, 64.0], sample_count = 20, sample_size = 1)]
+fn preview_sphere(bencher: Bencher, radius: f64) {
+    let doc = document();
+    let Command::Stroke(stroke) = sphere(BrushMode::Attach, radius) else {
+        unreachable!()
+    };
+    bencher.bench_local(|| {
+        let view = doc.scene.world.read();
+        app::editor::command::preview(&view, &stroke, None)
+            .unwrap()
+            .map(|v| v.len())
+    });
 }

@@ -363,3 +363,33 @@ fn a_cylinder_follows_its_axis() {
         assert!(count > 300, "{axis:?}");
     }
 }
+
+#[test]
+fn the_preview_of_a_brush_limited_to_the_selection_is_what_it_changes() {
+    for mode in [BrushMode::Attach, BrushMode::Erase, BrushMode::Paint] {
+        let mut doc = document();
+        select_region(&mut doc);
+        let command = sphere(mode, DVec3::new(35.0, 36.0, 45.0), 12.0, true);
+        let Command::Stroke(stroke) = &command else {
+            unreachable!()
+        };
+        let preview = {
+            let view = doc.scene.world.read();
+            app::editor::command::preview(&view, stroke, doc.scene.selection.as_ref())
+                .unwrap()
+                .unwrap()
+        };
+        let before = snapshot(&doc);
+        doc.execute(command.clone()).unwrap();
+        let after = snapshot(&doc);
+        let changed: Vec<IVec3> = (0..before.len())
+            .filter(|&i| before[i] != after[i])
+            .map(|i| {
+                let (i, d) = (i as i32, DIMS);
+                IVec3::new(i / (d.y * d.z), i / d.z % d.y, i % d.z)
+            })
+            .collect();
+        assert!(!changed.is_empty(), "{mode:?}");
+        assert_eq!(preview, changed, "{mode:?}");
+    }
+}

@@ -199,15 +199,20 @@ pub const PREVIEW_LIMIT: u64 = 4 << 20;
 
 /// Exactly the voxels `stroke` would change in the world as it is now, sorted by x, then y,
 /// then z (the brush preview); None when the brush covers more than [`PREVIEW_LIMIT`] voxels.
+/// Examined a brick at a time: the shape's coverage skips bricks outside it, its mask and
+/// the brick's voxels give the changed ones by mask operations.
 pub fn preview(
     view: &brickmap::WorldView<'_>,
     stroke: &Stroke,
     selection: Option<&Selection>,
 ) -> Result<Option<Vec<IVec3>>> {
+    use brickmap::shape::Coverage;
     let edits = stroke_edits(stroke, selection)?;
     let dims = view.dims().voxels();
     let mut examined = 0u64;
-    let mut out = std::collections::BTreeSet::new();
+    // The changed voxels by brick (mirror images may lie far apart: sparse).
+    let mut changed: std::collections::HashMap<(i32, i32, i32), brickmap::Mask> =
+        Default::default();
     for edit in &edits {
         let EditOp::Shape { shape, mode } = edit else {
             continue;
@@ -222,29 +227,64 @@ pub fn preview(
         if examined > PREVIEW_LIMIT {
             return Ok(None);
         }
-        for x in lo.x..=hi.x {
-            for y in lo.y..=hi.y {
-                for z in lo.z..=hi.z {
-                    let v = IVec3::new(x, y, z);
-                    if !shape.contains(v) {
+        let (blo, bhi) = (lo / 8, hi / 8);
+        for bx in blo.x..=bhi.x {
+            for by in blo.y..=bhi.y {
+                for bz in blo.z..=bhi.z {
+                    let b = IVec3::new(bx, by, bz);
+                    let region = match shape.coverage(b * 8) {
+                        Coverage::Outside => continue,
+                        Coverage::Inside => brickmap::Mask::FULL,
+                        Coverage::Partial => shape.mask(b * 8),
+                    };
+                    if region.is_empty() {
                         continue;
                     }
-                    let now = view.voxel(v).map_err(EditError::World)?;
-                    let changes = match mode {
-                        Mode::Add(m) => now != Some(*m),
-                        Mode::Remove => now.is_some(),
-                        Mode::Paint(m) => now.is_some_and(|c| c != *m),
+                    let (solid, mats) = view.brick_voxels(b.as_uvec3());
+                    let with = |m: u8| {
+                        let mut same = brickmap::Mask::EMPTY;
+                        for bit in solid.and(&region).ones() {
+                            if mats[bit] == m {
+                                same.set(bit);
+                            }
+                        }
+                        same
                     };
-                    if changes {
-                        out.insert((x, y, z));
+                    let mask = match mode {
+                        Mode::Add(m) => region.and_not(&with(*m)),
+                        Mode::Remove => region.and(&solid),
+                        Mode::Paint(m) => region.and(&solid).and_not(&with(*m)),
+                    };
+                    if !mask.is_empty() {
+                        let e = changed.entry((bx, by, bz)).or_default();
+                        *e = e.or(&mask);
                     }
                 }
             }
         }
     }
-    Ok(Some(
-        out.into_iter()
-            .map(|(x, y, z)| IVec3::new(x, y, z))
-            .collect(),
-    ))
+    // In x, y, z order: bricks sorted, then for each x the rows of each brick row.
+    let mut bricks: Vec<((i32, i32, i32), brickmap::Mask)> = changed.into_iter().collect();
+    bricks.sort_unstable_by_key(|(b, _)| *b);
+    let mut out = Vec::new();
+    for slab in bricks.chunk_by(|a, b| a.0.0 == b.0.0) {
+        let bx = slab[0].0.0;
+        for x in 0..8 {
+            for column in slab.chunk_by(|a, b| a.0.1 == b.0.1) {
+                let by = column[0].0.1;
+                for y in 0..8 {
+                    let base = (x + 8 * y) as usize;
+                    for ((_, _, bz), m) in column {
+                        for z in 0..8 {
+                            if m.get(base + 64 * z) {
+                                let v = IVec3::new(bx * 8 + x, by * 8 + y, bz * 8 + z as i32);
+                                out.push(v);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Ok(Some(out))
 }
