@@ -7,11 +7,22 @@ use glam::{IVec3, UVec3};
 use std::collections::BTreeMap;
 
 /// Voxels, by brick. Bricks whose mask would be empty are never stored.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default)]
 pub struct VoxelSet {
     /// Brick coordinate (x, y, z) → the voxels of that brick in the set.
     bricks: BTreeMap<(u32, u32, u32), Mask>,
+    /// The bounds, computed once after the last change (every worker of an edit asks).
+    bounds: std::sync::OnceLock<Option<(IVec3, IVec3)>>,
 }
+
+impl PartialEq for VoxelSet {
+    fn eq(&self, other: &Self) -> bool {
+        // The same voxels, whether or not either has computed its bounds yet.
+        self.bricks == other.bricks
+    }
+}
+
+impl Eq for VoxelSet {}
 
 /// The voxels of the brick whose minimum voxel is `brick_min` that lie in the inclusive box
 /// `lo..=hi`, built a row at a time.
@@ -81,6 +92,7 @@ impl VoxelSet {
 
     /// Replaces the mask of brick `b` (an empty mask removes it).
     pub fn set_brick(&mut self, b: UVec3, mask: Mask) {
+        self.bounds = Default::default();
         if mask.is_empty() {
             self.bricks.remove(&(b.x, b.y, b.z));
         } else {
@@ -112,25 +124,33 @@ impl VoxelSet {
 
     /// Inclusive voxel bounds of the set, or None when it is empty.
     pub fn bounds(&self) -> Option<(IVec3, IVec3)> {
-        let mut out: Option<(IVec3, IVec3)> = None;
-        for (b, m) in self.iter() {
-            let min = b.as_ivec3() * 8;
-            let (mut lo, mut hi) = (IVec3::splat(8), IVec3::splat(-1));
-            for bit in m.ones() {
-                let l = IVec3::new(bit as i32 % 8, bit as i32 / 8 % 8, bit as i32 / 64);
-                lo = lo.min(l);
-                hi = hi.max(l);
-                if lo == IVec3::ZERO && hi == IVec3::splat(7) {
-                    break;
+        *self.bounds.get_or_init(|| {
+            let mut out: Option<(IVec3, IVec3)> = None;
+            for (b, m) in self.iter() {
+                // From the mask's rows of 8 voxels: x from the union of the rows, y and z
+                // from which rows hold anything.
+                let (mut xs, mut lo, mut hi) = (0u32, IVec3::splat(8), IVec3::splat(-1));
+                for z in 0..8 {
+                    for y in 0..8 {
+                        let row = (m.0[2 * z + y / 4] >> (8 * (y & 3))) & 0xFF;
+                        if row != 0 {
+                            xs |= row;
+                            let (y, z) = (y as i32, z as i32);
+                            (lo.y, hi.y) = (lo.y.min(y), hi.y.max(y));
+                            (lo.z, hi.z) = (lo.z.min(z), hi.z.max(z));
+                        }
+                    }
                 }
+                (lo.x, hi.x) = (xs.trailing_zeros() as i32, 31 - xs.leading_zeros() as i32);
+                let min = b.as_ivec3() * 8;
+                let (lo, hi) = (min + lo, min + hi);
+                out = Some(match out {
+                    None => (lo, hi),
+                    Some((a, b)) => (a.min(lo), b.max(hi)),
+                });
             }
-            let (lo, hi) = (min + lo, min + hi);
-            out = Some(match out {
-                None => (lo, hi),
-                Some((a, b)) => (a.min(lo), b.max(hi)),
-            });
-        }
-        out
+            out
+        })
     }
 }
 
