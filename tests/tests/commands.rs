@@ -450,6 +450,9 @@ fn terrain_bands_decide_the_surface_material() {
     };
     doc.execute(Command::GenerateTerrain(spec(0.0, 0.0)))
         .unwrap();
+    // Every column was counted for the progress shown, which is over now.
+    assert_eq!(doc.progress.done(), 16 * 16, "the grid's brick columns");
+    assert_eq!(doc.progress.fraction(), None);
     let view = doc.scene.world.read();
     let table = view.materials();
     let (mut snow, mut other) = (0, 0);

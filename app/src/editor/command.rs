@@ -314,6 +314,17 @@ impl Command {
 
     /// Executes the command. On error the scene is as it was.
     pub fn apply(&self, scene: &mut Scene, folder: &std::path::Path) -> Result<Applied> {
+        self.apply_with(scene, folder, &Default::default())
+    }
+
+    /// [`Command::apply`], reporting how far a terrain generation got to `progress`
+    /// (columns generated of the grid's columns).
+    pub fn apply_with(
+        &self,
+        scene: &mut Scene,
+        folder: &std::path::Path,
+        progress: &std::sync::Arc<super::progress::Progress>,
+    ) -> Result<Applied> {
         let world = &scene.world;
         let unchanged = |inverse| Applied {
             inverse,
@@ -451,8 +462,20 @@ impl Command {
                     (params.height_range, params.water_level) = (t.height_range, t.water_level);
                     (params.rock_line, params.snow_line, params.soil_depth) =
                         (t.bands.rock_line, t.bands.snow_line, t.bands.soil_depth);
-                    let edit = NoiseTerrain::new(params, world.dims())?.edit();
-                    Ok::<_, EditError>(world.apply(edit)?)
+                    let edit = match NoiseTerrain::new(params, world.dims())?.edit() {
+                        EditOp::Generate(g) => EditOp::Generate(brickmap::edit::Generator(
+                            std::sync::Arc::new(super::progress::Counted {
+                                inner: g.0,
+                                progress: progress.clone(),
+                            }),
+                        )),
+                        other => other,
+                    };
+                    let b = world.dims().bricks();
+                    progress.start(b.x as u64 * b.z as u64);
+                    let out = world.apply(edit);
+                    progress.finish();
+                    Ok::<_, EditError>(out?)
                 })();
                 match result {
                     Ok(out) => Applied {

@@ -8,6 +8,7 @@ mod fill;
 pub mod history;
 mod inverse;
 pub mod live;
+pub mod progress;
 pub mod script;
 
 pub use error::{EditError, Result};
@@ -46,6 +47,8 @@ pub struct Document {
     pub recorder: Option<script::Recorder>,
     /// The stroke being drawn, if any (see [`live`]).
     live: Option<live::LiveStroke>,
+    /// How far the running long edit (terrain generation) has got.
+    pub progress: std::sync::Arc<progress::Progress>,
 }
 
 impl Document {
@@ -60,6 +63,7 @@ impl Document {
             folder: PathBuf::from("."),
             recorder: None,
             live: None,
+            progress: Default::default(),
         }
     }
 
@@ -127,7 +131,7 @@ impl Document {
     /// Executes a command and records it; on error nothing changed (world, tables, history).
     pub fn execute(&mut self, command: Command) -> Result<Executed> {
         self.end_stroke()?;
-        let applied = command.apply(&mut self.scene, &self.folder)?;
+        let applied = command.apply_with(&mut self.scene, &self.folder, &self.progress)?;
         if !command.changes_document() {
             if let Some(r) = &mut self.recorder {
                 r.record(script::Step::Do(command));

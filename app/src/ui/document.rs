@@ -118,6 +118,7 @@ impl Editor {
         }
         doc.path = path.filter(|_| is_project);
         self.view = scene_view(&doc.scene);
+        self.progress = doc.progress.clone();
         self.doc = Arc::new(RwLock::new(doc));
         self.generation += 1;
         self.refresh_stats();

@@ -65,6 +65,15 @@ impl Editor {
     pub(super) fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
         let gate = self.edits.gate.clone();
         let Ok(_frame) = gate.try_lock() else {
+            // No frame can be drawn while an edit holds the document; a long one (terrain)
+            // shows its progress in the title, refreshed by `about_to_wait`'s timer.
+            if let (Some(f), Some(g)) = (self.progress.fraction(), &self.gfx) {
+                let title = format!("voxbrick — generating terrain {:.0} %", f * 100.0);
+                if title != self.title {
+                    g.window.set_title(&title);
+                    self.title = title;
+                }
+            }
             return Ok(());
         };
         while let Ok(done) = self.files.done.try_recv() {

@@ -154,6 +154,8 @@ pub struct Editor {
     gfx: Option<Gfx>,
     egui: egui::Context,
     doc: SharedDocument,
+    /// The document's long-edit progress (read without the document's lock).
+    progress: Arc<crate::editor::progress::Progress>,
     /// Bumped whenever the document is replaced (the GPU world is then rebuilt).
     generation: u64,
     gpu_generation: u64,
@@ -275,6 +277,7 @@ impl Editor {
             config,
             gfx: None,
             egui: egui::Context::default(),
+            progress: doc.progress.clone(),
             doc: Arc::new(RwLock::new(doc)),
             generation: 0,
             gpu_generation: 0,
@@ -697,8 +700,24 @@ impl ApplicationHandler<Wake> for Editor {
         }
         self.handle_window_event(event_loop, event);
     }
+    fn new_events(&mut self, _event_loop: &ActiveEventLoop, cause: winit::event::StartCause) {
+        if matches!(cause, winit::event::StartCause::ResumeTimeReached { .. })
+            && self.progress.fraction().is_some()
+            && let Some(g) = &self.gfx
+        {
+            g.window.request_redraw();
+        }
+    }
+
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
         event_loop.set_control_flow(ControlFlow::Wait);
+        if self.edits.busy() || self.progress.fraction().is_some() {
+            // An edit is running: look at a long one's progress ten times a second.
+            event_loop.set_control_flow(ControlFlow::WaitUntil(
+                Instant::now() + Duration::from_millis(100),
+            ));
+            return;
+        }
         if self.settings.autosave_secs > 0 && self.script.is_none() {
             event_loop.set_control_flow(ControlFlow::WaitUntil(
                 self.last_autosave + Duration::from_secs(self.settings.autosave_secs),

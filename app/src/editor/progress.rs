@@ -1,0 +1,64 @@
+//! How far a long edit (terrain generation) has got, for a progress bar: the edit's workers
+//! count what they finished with atomics; the UI reads the fraction without any lock (the
+//! document is locked by the edit meanwhile).
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Work done out of work to do; nothing running when `total` is 0.
+#[derive(Debug, Default)]
+pub struct Progress {
+    done: AtomicU64,
+    total: AtomicU64,
+}
+
+impl Progress {
+    /// A new piece of work of `total` steps starts.
+    pub fn start(&self, total: u64) {
+        self.done.store(0, Ordering::Relaxed);
+        self.total.store(total, Ordering::Relaxed);
+    }
+
+    /// One more step done.
+    pub fn step(&self) {
+        self.done.fetch_add(1, Ordering::Relaxed);
+    }
+
+    /// The work ended (done or failed).
+    pub fn finish(&self) {
+        self.total.store(0, Ordering::Relaxed);
+    }
+
+    /// The fraction done of the work running, if any.
+    pub fn fraction(&self) -> Option<f32> {
+        let total = self.total.load(Ordering::Relaxed);
+        (total > 0).then(|| (self.done.load(Ordering::Relaxed) as f64 / total as f64) as f32)
+    }
+
+    /// Steps done so far (of the latest work).
+    pub fn done(&self) -> u64 {
+        self.done.load(Ordering::Relaxed)
+    }
+}
+
+/// A column source that counts the columns it produced.
+pub(super) struct Counted {
+    /// What produces the columns.
+    pub inner: std::sync::Arc<dyn brickmap::edit::ColumnSource>,
+    /// Where the count goes.
+    pub progress: std::sync::Arc<Progress>,
+}
+
+impl brickmap::edit::ColumnSource for Counted {
+    fn column(
+        &self,
+        bx: u32,
+        bz: u32,
+        emit: &mut dyn FnMut(u32, brickmap::Mask, brickmap::PriorMaterials),
+    ) {
+        self.inner.column(bx, bz, emit);
+        self.progress.step();
+    }
+    fn materials(&self) -> Vec<u8> {
+        self.inner.materials()
+    }
+}
