@@ -206,6 +206,39 @@ pub fn preview(
     stroke: &Stroke,
     selection: Option<&Selection>,
 ) -> Result<Option<Vec<IVec3>>> {
+    let Some(bricks) = preview_bricks(view, stroke, selection)? else {
+        return Ok(None);
+    };
+    // In x, y, z order: for each x, the rows of each brick row.
+    let mut out = Vec::new();
+    for slab in bricks.chunk_by(|a, b| a.0.x == b.0.x) {
+        let bx = slab[0].0.x;
+        for x in 0..8 {
+            for column in slab.chunk_by(|a, b| a.0.y == b.0.y) {
+                let by = column[0].0.y;
+                for y in 0..8 {
+                    let base = (x + 8 * y) as usize;
+                    for (b, m) in column {
+                        for z in 0..8 {
+                            if m.get(base + 64 * z) {
+                                out.push(IVec3::new(bx * 8 + x, by * 8 + y, b.z * 8 + z as i32));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Ok(Some(out))
+}
+
+/// [`preview`] as brick coordinates and the masks of their changed voxels, sorted by brick
+/// (x, then y, then z).
+pub fn preview_bricks(
+    view: &brickmap::WorldView<'_>,
+    stroke: &Stroke,
+    selection: Option<&Selection>,
+) -> Result<Option<Vec<(IVec3, brickmap::Mask)>>> {
     use brickmap::shape::Coverage;
     let edits = stroke_edits(stroke, selection)?;
     let dims = view.dims().voxels();
@@ -263,28 +296,10 @@ pub fn preview(
             }
         }
     }
-    // In x, y, z order: bricks sorted, then for each x the rows of each brick row.
-    let mut bricks: Vec<((i32, i32, i32), brickmap::Mask)> = changed.into_iter().collect();
-    bricks.sort_unstable_by_key(|(b, _)| *b);
-    let mut out = Vec::new();
-    for slab in bricks.chunk_by(|a, b| a.0.0 == b.0.0) {
-        let bx = slab[0].0.0;
-        for x in 0..8 {
-            for column in slab.chunk_by(|a, b| a.0.1 == b.0.1) {
-                let by = column[0].0.1;
-                for y in 0..8 {
-                    let base = (x + 8 * y) as usize;
-                    for ((_, _, bz), m) in column {
-                        for z in 0..8 {
-                            if m.get(base + 64 * z) {
-                                let v = IVec3::new(bx * 8 + x, by * 8 + y, bz * 8 + z as i32);
-                                out.push(v);
-                            }
-                        }
-                    }
-                }
-            }
-        }
-    }
-    Ok(Some(out))
+    let mut bricks: Vec<(IVec3, brickmap::Mask)> = changed
+        .into_iter()
+        .map(|((x, y, z), m)| (IVec3::new(x, y, z), m))
+        .collect();
+    bricks.sort_unstable_by_key(|(b, _)| (b.x, b.y, b.z));
+    Ok(Some(bricks))
 }

@@ -3,7 +3,8 @@
 //! ([`Inverse`]). Strokes are in `brush`, flood fill in `fill`.
 
 pub use super::brush::{
-    Axis, BrushMode, BrushShape, Mirror, PREVIEW_LIMIT, Stroke, preview, stroke_edits,
+    Axis, BrushMode, BrushShape, Mirror, PREVIEW_LIMIT, Stroke, preview, preview_bricks,
+    stroke_edits,
 };
 pub use super::inverse::{Applied, Inverse};
 

@@ -7,12 +7,14 @@
 
 use super::camera::ViewCamera;
 use super::files::SharedDocument;
-use crate::editor::command::{BrushMode, Stroke, preview, stroke_edits};
+use crate::editor::command::{BrushMode, Stroke, preview_bricks, stroke_edits};
 use crate::selection::Selection;
 use brickmap::EditOp;
+use brickmap::Mask;
+use brickmap::brick::voxel_bit;
 use crossbeam_channel::{Receiver, Sender};
 use glam::{DVec3, IVec3};
-use std::collections::HashSet;
+use std::collections::HashMap;
 use std::sync::Arc;
 
 /// What is previewed: the stroke and the document revision it was computed for.
@@ -243,29 +245,44 @@ fn compute(
         mode: Some(stroke.mode),
         ..Default::default()
     };
-    match preview(view, stroke, selection) {
-        Ok(Some(voxels)) => shown.faces = outer_faces(&voxels),
+    match preview_bricks(view, stroke, selection) {
+        Ok(Some(bricks)) => shown.faces = outer_faces(&bricks),
         Ok(None) => shown.bounds = bounds(stroke, selection),
         Err(_) => shown.mode = None,
     }
     shown
 }
 
-/// The faces between the set and the rest, each with its outward normal.
-fn outer_faces(voxels: &[IVec3]) -> Vec<([DVec3; 4], IVec3)> {
-    let set: HashSet<IVec3> = voxels.iter().copied().collect();
+/// The faces between the set (brick coordinates and masks) and the rest, each with its
+/// outward normal: a neighbour inside the brick is a bit of its mask, one across a brick
+/// face a bit of that neighbour's (looked up once per brick and side).
+fn outer_faces(bricks: &[(IVec3, Mask)]) -> Vec<([DVec3; 4], IVec3)> {
+    let by: HashMap<IVec3, &Mask> = bricks.iter().map(|(b, m)| (*b, m)).collect();
     let mut faces = Vec::new();
-    for &v in voxels {
-        for axis in 0..3 {
-            for sign in [-1, 1] {
-                let mut n = IVec3::ZERO;
-                n[axis] = sign;
-                if set.contains(&(v + n)) {
+    for (b, mask) in bricks {
+        let mut sides = [IVec3::ZERO; 6];
+        let mut next: [Option<&Mask>; 6] = [None; 6];
+        for (k, side) in sides.iter_mut().enumerate() {
+            side[k / 2] = if k % 2 == 0 { -1 } else { 1 };
+            next[k] = by.get(&(*b + *side)).copied();
+        }
+        for bit in mask.ones() {
+            let l = IVec3::new(bit as i32 % 8, bit as i32 / 8 % 8, bit as i32 / 64);
+            for (k, n) in sides.iter().enumerate() {
+                let q = l + *n;
+                let inside = if q.cmpge(IVec3::ZERO).all() && q.cmplt(IVec3::splat(8)).all() {
+                    mask.get(voxel_bit(q.x, q.y, q.z))
+                } else {
+                    let w = q.rem_euclid(IVec3::splat(8));
+                    next[k].is_some_and(|m| m.get(voxel_bit(w.x, w.y, w.z)))
+                };
+                if inside {
                     continue;
                 }
                 // The face's four corners, in order around it.
+                let (axis, sign) = (k / 2, n[k / 2]);
                 let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
-                let mut base = v.as_dvec3();
+                let mut base = (*b * 8 + l).as_dvec3();
                 if sign > 0 {
                     base[axis] += 1.0;
                 }
@@ -273,7 +290,7 @@ fn outer_faces(voxels: &[IVec3]) -> Vec<([DVec3; 4], IVec3)> {
                 du[u] = 1.0;
                 let mut dw = DVec3::ZERO;
                 dw[w] = 1.0;
-                faces.push(([base, base + du, base + du + dw, base + dw], n));
+                faces.push(([base, base + du, base + du + dw, base + dw], *n));
             }
         }
     }
@@ -300,7 +317,20 @@ mod tests {
 
     #[test]
     fn one_voxel_has_six_outer_faces_and_two_touching_have_ten() {
-        let one = outer_faces(&[IVec3::ZERO]);
+        let set = |voxels: &[IVec3]| {
+            let mut by: std::collections::BTreeMap<(i32, i32, i32), Mask> = Default::default();
+            for v in voxels {
+                let b = v.div_euclid(IVec3::splat(8));
+                let l = v.rem_euclid(IVec3::splat(8));
+                by.entry((b.x, b.y, b.z))
+                    .or_default()
+                    .set(voxel_bit(l.x, l.y, l.z));
+            }
+            by.into_iter()
+                .map(|((x, y, z), m)| (IVec3::new(x, y, z), m))
+                .collect::<Vec<_>>()
+        };
+        let one = outer_faces(&set(&[IVec3::ZERO]));
         assert_eq!(one.len(), 6);
         // Each face lies on its side of the voxel, its corners one unit apart.
         for (c, n) in &one {
@@ -308,6 +338,16 @@ mod tests {
             assert_eq!(centre - DVec3::splat(0.5), n.as_dvec3() * 0.5);
             assert!(((c[1] - c[0]).length() - 1.0).abs() < 1e-12);
         }
-        assert_eq!(outer_faces(&[IVec3::ZERO, IVec3::X]).len(), 10);
+        assert_eq!(outer_faces(&set(&[IVec3::ZERO, IVec3::X])).len(), 10);
+        // Across a brick face: (7, 3, 3) and (8, 3, 3) touch, as do (5, -1, 2) and (5, 0, 2).
+        let pair = [IVec3::new(7, 3, 3), IVec3::new(8, 3, 3)];
+        assert_eq!(outer_faces(&set(&pair)).len(), 10);
+        let pair = [IVec3::new(5, -1, 2), IVec3::new(5, 0, 2)];
+        assert_eq!(outer_faces(&set(&pair)).len(), 10);
+        // A 3 × 3 × 3 block over a brick corner: 6 × 9 faces.
+        let block: Vec<IVec3> = (0..27)
+            .map(|i| IVec3::new(i % 3 + 7, i / 3 % 3 + 7, i / 9 + 7))
+            .collect();
+        assert_eq!(outer_faces(&set(&block)).len(), 54);
     }
 }
