@@ -41,21 +41,31 @@ fn frames(
     out
 }
 
+/// An interactive frame's request: `spp` per frame up to `target`, at `size` in and out.
+fn request(
+    params: &render::SceneParams,
+    size: (u32, u32),
+    spp: u32,
+    target: u32,
+) -> FrameRequest<'_> {
+    FrameRequest {
+        params,
+        internal: size,
+        output: size,
+        spp,
+        target_spp: target,
+        exposure: 0.0,
+        bgra: false,
+    }
+}
+
 #[test]
 fn interactive_frames_accumulate_the_one_shot_renders_samples() {
     let Some(ctx) = context() else { return };
     let (world, params) = common::showcase();
     let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
     let size = (40, 24);
-    let req = FrameRequest {
-        params: &params,
-        internal: size,
-        output: size,
-        spp: 3,
-        target_spp: 16,
-        exposure: 0.0,
-        bgra: false,
-    };
+    let req = request(&params, size, 3, 16);
     let statuses = frames(&mut vp, &world, &req, 64, |v| v.samples() >= 16);
     assert!(statuses[0].restarted && statuses[0].samples <= 3);
     assert_eq!(vp.samples(), 16, "stops exactly at the target");
@@ -160,16 +170,7 @@ fn an_edit_whose_upload_spans_frames_shows_only_once_it_is_all_there() {
     let (world, params) = common::showcase();
     // One 1 KiB staging slot: an edit of a few bricks takes several frames to upload.
     let mut vp = Viewport::with_staging(ctx.clone(), &world.read(), 1, 1024).unwrap();
-    let size = (32, 24);
-    let req = FrameRequest {
-        params: &params,
-        internal: size,
-        output: size,
-        spp: 2,
-        target_spp: 8,
-        exposure: 0.0,
-        bgra: false,
-    };
+    let req = request(&params, (32, 24), 2, 8);
     frames(&mut vp, &world, &req, 8, |v| v.samples() >= 8);
     let before = vp.live_hdr().unwrap().unwrap();
     world

@@ -158,6 +158,22 @@ fn failures_name_the_step_and_what_differed() {
     assert!(err.contains("--device cpu"), "{err}");
 }
 
+/// The session `doc` recorded (it started as an empty 64 × 32 × 64 grid), as script text and
+/// replayed headlessly.
+fn replay_recording(doc: &Document, name: &str) -> (String, Document) {
+    let text = doc.recorder.as_ref().unwrap().to_ron(
+        Start::New {
+            size: (64, 32, 64),
+            terrain: None,
+        },
+        Some(2),
+    );
+    let parsed = script::parse(&text).unwrap();
+    let out = scratch(name);
+    let replayed = script::replay(&parsed, &out, &options(1, &out), &mut |_| {}).unwrap();
+    (text, replayed.document)
+}
+
 #[test]
 fn a_recorded_session_replays_to_the_same_content() {
     let dims = brickmap::GridDims::new(8, 4, 8).unwrap();
@@ -191,22 +207,13 @@ fn a_recorded_session_replays_to_the_same_content() {
     doc.undo().unwrap();
     doc.redo().unwrap();
     let want = doc.scene.world.read().content_hash();
-    let text = doc.recorder.as_ref().unwrap().to_ron(
-        Start::New {
-            size: (64, 32, 64),
-            terrain: None,
-        },
-        Some(2),
-    );
+    let (text, replayed) = replay_recording(&doc, "recorded");
     assert_eq!(
         text.matches("\n        ").count(),
         7,
         "one line per step:\n{text}"
     );
-    let parsed = script::parse(&text).unwrap();
-    let out = scratch("recorded");
-    let replayed = script::replay(&parsed, &out, &options(1, &out), &mut |_| {}).unwrap();
-    assert_eq!(replayed.document.scene.world.read().content_hash(), want);
+    assert_eq!(replayed.scene.world.read().content_hash(), want);
 }
 
 #[test]
@@ -243,19 +250,10 @@ fn a_recorded_selection_session_replays_to_the_same_content() {
     })
     .unwrap();
     let want = doc.scene.world.read().content_hash();
-    let text = doc.recorder.as_ref().unwrap().to_ron(
-        Start::New {
-            size: (64, 32, 64),
-            terrain: None,
-        },
-        Some(2),
-    );
-    let parsed = script::parse(&text).unwrap();
-    let out = scratch("recorded-selection");
-    let replayed = script::replay(&parsed, &out, &options(1, &out), &mut |_| {}).unwrap();
-    assert_eq!(replayed.document.scene.world.read().content_hash(), want);
+    let (_, replayed) = replay_recording(&doc, "recorded-selection");
+    assert_eq!(replayed.scene.world.read().content_hash(), want);
     assert_eq!(
-        replayed.document.scene.selection.map(|s| s.region),
+        replayed.scene.selection.map(|s| s.region),
         doc.scene.selection.map(|s| s.region)
     );
 }
