@@ -213,3 +213,51 @@ fn an_edit_whose_upload_spans_frames_shows_only_once_it_is_all_there() {
     }
     assert_eq!(ctx.validation_errors(), 0, "validation errors");
 }
+
+#[test]
+fn switching_between_two_sizes_restarts_each_time_and_shows_the_current_world() {
+    let Some(ctx) = context() else { return };
+    let (world, params) = common::showcase();
+    let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
+    let (full, half) = (request(&params, (32, 24), 2, 8), request(&params, (16, 12), 2, 8));
+    frames(&mut vp, &world, &full, 8, |v| v.samples() >= 8);
+    frames(&mut vp, &world, &half, 8, |v| v.samples() >= 8);
+    // An edit while the full-size accumulation is the spare: back at that size the first
+    // frame starts over on the edited world (its old samples are neither kept nor shown).
+    world
+        .apply(EditOp::Shape {
+            shape: Shape::Sphere {
+                centre: DVec3::new(24.0, 12.0, 24.0),
+                radius: 6.0,
+            },
+            mode: Mode::Add(0),
+        })
+        .unwrap();
+    frames(&mut vp, &world, &half, 2, |_| false);
+    let back = frames(&mut vp, &world, &full, 1, |_| false);
+    assert!(back[0].restarted && back[0].samples == 2, "{back:?}");
+    let (edited, _) = vp
+        .render(
+            &world.read(),
+            &params,
+            &RenderJob {
+                width: 32,
+                height: 24,
+                spp: 2,
+                seed: 1,
+            },
+        )
+        .unwrap();
+    let live = vp.live_hdr().unwrap().unwrap();
+    let diff: f32 = live
+        .pixels
+        .iter()
+        .zip(&edited.pixels)
+        .map(|(a, b)| (a[0] - b[0]).abs())
+        .sum();
+    assert!(
+        diff < 1e-2 * live.pixels.len() as f32,
+        "the frame back at full size shows the edited world: {diff}"
+    );
+    assert_eq!(ctx.validation_errors(), 0, "validation errors");
+}

@@ -446,7 +446,79 @@ pub fn edits(
             );
         }
     }
+    text += &first_clicks(&mut vp, &mut doc, size, &params, radii)?;
     text += &selection_edits(&mut vp, &mut doc, size, &params)?;
+    Ok(text)
+}
+
+/// The editor's first click of a stroke: the frame in flight is at the full internal size,
+/// the edit's frame at the moving scale (0.5; the editor draws strokes at it). Each click
+/// is a one-point attach stroke, shown, undone (not timed) and followed by full-size frames.
+fn first_clicks(
+    vp: &mut Viewport,
+    doc: &mut app::editor::Document,
+    size: (u32, u32),
+    params: &render::SceneParams,
+    radii: &[f64],
+) -> Result<String> {
+    use app::editor::command::{BrushMode, BrushShape, Command, Mirror, Stroke};
+    const CLICKS: usize = 20;
+    let req = |scale| FrameRequest {
+        params,
+        internal: scaled(size, scale),
+        output: size,
+        spp: 1,
+        target_spp: u32::MAX,
+        exposure: 0.0,
+        bgra: true,
+    };
+    let (full, moving) = (req(1.0), req(0.5));
+    let dims = doc.scene.world.dims().voxels().as_dvec3();
+    let mut text = format!(
+        "\nfirst click of a stroke: frame in flight at scale 1.0, the edit's frame at 0.5; {CLICKS} clicks\nradius  edit → frame ms median (max)\n"
+    );
+    for &r in radii {
+        let mut ms = Vec::new();
+        for k in 0..CLICKS {
+            for _ in 0..4 {
+                if let Some(f) = vp.begin_frame()? {
+                    vp.trace_frame(&f, &doc.scene.world, &full)?;
+                    vp.submit_frame(f, &[], &[])?;
+                }
+            }
+            // A frame in flight, then the click.
+            let f = loop {
+                if let Some(f) = vp.begin_frame()? {
+                    break f;
+                }
+                std::thread::yield_now();
+            };
+            vp.trace_frame(&f, &doc.scene.world, &full)?;
+            vp.submit_frame(f, &[], &[])?;
+            let event = Instant::now();
+            let at = glam::DVec3::new(
+                dims.x * (0.2 + 0.03 * k as f64),
+                dims.y * 0.3,
+                dims.z * 0.5,
+            );
+            doc.execute(Command::Stroke(Stroke {
+                mode: BrushMode::Attach,
+                shape: BrushShape::Sphere,
+                size: r,
+                material: 1,
+                mirror: Mirror::default(),
+                points: vec![at],
+                axis: Default::default(),
+                in_selection: false,
+            }))?;
+            frames_until_shown(vp, &doc.scene.world, &moving)?;
+            ms.push(event.elapsed().as_secs_f64() * 1e3);
+            doc.undo()?;
+            frames_until_shown(vp, &doc.scene.world, &full)?;
+        }
+        let (_, m50, _, mmax) = stats(ms);
+        text += &format!("{r:<7} {m50:.3} ({mmax:.3})\n");
+    }
     Ok(text)
 }
 

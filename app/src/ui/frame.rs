@@ -219,7 +219,9 @@ impl Editor {
         // Texture changes wait here until a frame with the UI applies them.
         self.pending_textures.append(textures_delta);
         let primitives = egui_ctx.tessellate(shapes, pixels_per_point);
-        let moving = Instant::now() < self.moving_until;
+        // While the camera moves and while a stroke is drawn: the moving scale, so each
+        // change shows in the next, cheaper frame.
+        let moving = Instant::now() < self.moving_until || self.drawing.is_some();
         let internal = if moving {
             scaled(
                 (size.width, size.height),

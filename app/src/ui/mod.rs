@@ -829,6 +829,8 @@ impl Editor {
                     (ElementState::Released, MouseButton::Left) if self.drawing.is_some() => {
                         self.drawing = None;
                         self.edits.submit(&self.doc, Edit::StrokeEnd);
+                        // Back to the full internal size shortly after, as after a move.
+                        self.moving_until = Instant::now() + Duration::from_millis(150);
                     }
                     (ElementState::Released, MouseButton::Left) if self.selecting.is_some() => {
                         self.select_release()
