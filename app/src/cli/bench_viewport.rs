@@ -486,7 +486,8 @@ fn first_clicks(
                     vp.submit_frame(f, &[], &[])?;
                 }
             }
-            // A frame in flight, then the click.
+            // One frame in flight (as in the stroke cases), then the click.
+            vp.wait_idle()?;
             let f = loop {
                 if let Some(f) = vp.begin_frame()? {
                     break f;
