@@ -219,7 +219,10 @@ fn switching_between_two_sizes_restarts_each_time_and_shows_the_current_world() 
     let Some(ctx) = context() else { return };
     let (world, params) = common::showcase();
     let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
-    let (full, half) = (request(&params, (32, 24), 2, 8), request(&params, (16, 12), 2, 8));
+    let (full, half) = (
+        request(&params, (32, 24), 2, 8),
+        request(&params, (16, 12), 2, 8),
+    );
     frames(&mut vp, &world, &full, 8, |v| v.samples() >= 8);
     frames(&mut vp, &world, &half, 8, |v| v.samples() >= 8);
     // An edit while the full-size accumulation is the spare: back at that size the first

@@ -497,11 +497,7 @@ fn first_clicks(
             vp.trace_frame(&f, &doc.scene.world, &full)?;
             vp.submit_frame(f, &[], &[])?;
             let event = Instant::now();
-            let at = glam::DVec3::new(
-                dims.x * (0.2 + 0.03 * k as f64),
-                dims.y * 0.3,
-                dims.z * 0.5,
-            );
+            let at = glam::DVec3::new(dims.x * (0.2 + 0.03 * k as f64), dims.y * 0.3, dims.z * 0.5);
             doc.execute(Command::Stroke(Stroke {
                 mode: BrushMode::Attach,
                 shape: BrushShape::Sphere,

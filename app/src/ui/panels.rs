@@ -226,6 +226,30 @@ pub fn draw(
                 {
                     out.push(UiEvent::Action(Action::Redo));
                 }
+                ui.separator();
+                let selected = doc.scene.selection.is_some();
+                for (enabled, name, action) in [
+                    (selected, "Cut  Ctrl+X", Action::Cut),
+                    (selected, "Copy  Ctrl+C", Action::Copy),
+                    (
+                        doc.scene.clipboard.is_some(),
+                        "Paste  Ctrl+V",
+                        Action::Paste,
+                    ),
+                    (
+                        selected,
+                        "Delete selection  Delete",
+                        Action::DeleteSelection,
+                    ),
+                    (selected, "Fill selection  Ctrl+F", Action::FillSelection),
+                    (selected, "Paint selection  Ctrl+P", Action::PaintSelection),
+                    (true, "Select all  Ctrl+A", Action::SelectAll),
+                    (selected, "Select none  Ctrl+D", Action::SelectNone),
+                ] {
+                    if ui.add_enabled(enabled, egui::Button::new(name)).clicked() {
+                        out.push(UiEvent::Action(action));
+                    }
+                }
             });
             ui.menu_button("View", |ui| {
                 if ui.button("Frame the scene  F").clicked() {
