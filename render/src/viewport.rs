@@ -73,9 +73,6 @@ pub struct Viewport {
     tone: ManuallyDrop<ToneMapper>,
     /// Interactive accumulation (created at the requested internal size).
     live: Option<Progressive>,
-    /// The accumulation of the size used before (the editor switches between its full and
-    /// its moving internal size: swapping needs no wait and no allocation).
-    spare: Option<Progressive>,
     /// One-shot accumulation kept by benchmarks between calls.
     bench: Option<Progressive>,
     frames: Vec<FrameSlot>,
@@ -138,7 +135,6 @@ impl Viewport {
             tracer: ManuallyDrop::new(tracer),
             tone: ManuallyDrop::new(tone),
             live: None,
-            spare: None,
             bench: None,
             frames: Vec::new(),
             next: 0,
@@ -275,26 +271,20 @@ impl Viewport {
         }
         let internal = (req.internal.0.max(1), req.internal.1.max(1));
         let output = (req.output.0.max(1), req.output.1.max(1));
-        let fits = |l: &Progressive| l.internal() == internal && l.output() == output;
-        if !self.live.as_ref().is_some_and(fits) {
-            if self.spare.as_ref().is_some_and(fits) {
-                std::mem::swap(&mut self.live, &mut self.spare);
-                let live = self.live.as_mut().expect("the spare fitted");
-                // Its samples may be of an older world or view, and not for display.
-                live.restart();
-                live.forget_image();
-            } else {
-                if let Some(old) = self.spare.take() {
-                    // The other slot may still read it.
-                    self.wait_idle()?;
-                    old.destroy(&ctx);
-                    for s in &mut self.frames {
-                        s.sets.clear(&ctx);
-                    }
-                }
-                self.spare = self.live.take();
-                self.live = Some(Progressive::new(&ctx, internal, output, 1)?);
+        if self
+            .live
+            .as_ref()
+            .is_none_or(|l| l.internal() != internal || l.output() != output)
+        {
+            // The other slot may still read the old accumulation.
+            self.wait_idle()?;
+            if let Some(old) = self.live.take() {
+                old.destroy(&ctx);
             }
+            for s in &mut self.frames {
+                s.sets.clear(&ctx);
+            }
+            self.live = Some(Progressive::new(&ctx, internal, output, 1)?);
         }
         let live = self.live.as_mut().expect("made above");
         if upload.changed() {
@@ -408,7 +398,7 @@ impl Drop for Viewport {
             for s in self.frames.drain(..) {
                 s.destroy(&self.ctx);
             }
-            for l in [self.live.take(), self.spare.take()].into_iter().flatten() {
+            if let Some(l) = self.live.take() {
                 l.destroy(&self.ctx);
             }
             if let Some(b) = self.bench.take() {

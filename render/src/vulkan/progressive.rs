@@ -98,11 +98,6 @@ impl Progressive {
         self.traced
     }
 
-    /// The buffer's samples are not to be displayed (held) until the next batch.
-    pub fn forget_image(&mut self) {
-        self.traced = false;
-    }
-
     /// Drops the accumulated samples; the next frame starts over.
     pub fn restart(&mut self) {
         self.key = None;
