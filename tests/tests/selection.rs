@@ -354,9 +354,15 @@ fn a_cylinder_follows_its_axis() {
             ext[a] = p[a] - 32;
         }
         // Radius 4 across (centres within 4), half-length 4 along (caps at ±4 from 32).
-        assert_eq!(ext[long], 4, "{axis:?}: {ext:?}");
-        for a in (0..3).filter(|&a| a != long) {
-            assert_eq!(ext[a], 4, "{axis:?}: {ext:?}");
+        assert_eq!(ext, [4, 4, 4], "{axis:?}");
+        // Which axis: 3 voxels out on two axes, the centre is 3.5 · √2 ≈ 4.95 from the
+        // middle across (outside the radius) but 3.5 from the axis when one of the two is
+        // the axis (inside).
+        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
+            let mut v = IVec3::splat(32);
+            (v[p], v[q]) = (35, 35);
+            let along = p == long || q == long;
+            assert_eq!(view.voxel(v).unwrap().is_some(), along, "{axis:?} at {v}");
         }
         let count = view.solid_count();
         drop(view);

@@ -357,15 +357,7 @@ pub fn edits(
     let params = doc.scene.params.clone();
     for &r in radii {
         for &scale in scales {
-            let req = FrameRequest {
-                params: &params,
-                internal: scaled(size, scale),
-                output: size,
-                spp: 1,
-                target_spp: u32::MAX,
-                exposure: 0.0,
-                bgra: true,
-            };
+            let req = edit_request(&params, size, scale);
             // Warm-up frames (pipelines, clocks).
             for _ in 0..WARM_UP {
                 if let Some(f) = vp.begin_frame()? {
@@ -463,16 +455,10 @@ fn first_clicks(
 ) -> Result<String> {
     use app::editor::command::{BrushMode, BrushShape, Command, Mirror, Stroke};
     const CLICKS: usize = 20;
-    let req = |scale| FrameRequest {
-        params,
-        internal: scaled(size, scale),
-        output: size,
-        spp: 1,
-        target_spp: u32::MAX,
-        exposure: 0.0,
-        bgra: true,
-    };
-    let (full, moving) = (req(1.0), req(0.5));
+    let (full, moving) = (
+        edit_request(params, size, 1.0),
+        edit_request(params, size, 0.5),
+    );
     let dims = doc.scene.world.dims().voxels().as_dvec3();
     let mut text = format!(
         "\nfirst click of a stroke: frame in flight at scale 1.0, the edit's frame at 0.5; {CLICKS} clicks\nradius  edit → frame ms median (max)\n"
@@ -519,6 +505,19 @@ fn first_clicks(
     Ok(text)
 }
 
+/// The edit benchmarks' frames: 1 spp at `scale` of the output `size`, never converging.
+fn edit_request(params: &render::SceneParams, size: (u32, u32), scale: f32) -> FrameRequest<'_> {
+    FrameRequest {
+        params,
+        internal: scaled(size, scale),
+        output: size,
+        spp: 1,
+        target_spp: u32::MAX,
+        exposure: 0.0,
+        bgra: true,
+    }
+}
+
 /// Frames (submitted back to back, as the window does) until one shows the whole of the
 /// latest change: it restarted the accumulation and nothing is left for later uploads.
 /// Returns the frames and the bytes uploaded.
@@ -562,15 +561,7 @@ fn selection_edits(
     use app::selection::SelectOp;
     use glam::IVec3;
     const REPEATS: usize = 7;
-    let req = FrameRequest {
-        params,
-        internal: scaled(size, 0.5),
-        output: size,
-        spp: 1,
-        target_spp: u32::MAX,
-        exposure: 0.0,
-        bgra: true,
-    };
+    let req = edit_request(params, size, 0.5);
     let (min, max) = (IVec3::new(64, 48, 64), IVec3::new(319, 111, 319));
     // `undo`: the operation changes voxels, is shown, then undone for the next run.
     let select = Command::Select(SelectOp::Replace { min, max });
