@@ -19,6 +19,7 @@ pub mod dirty;
 pub mod edit;
 pub mod error;
 pub mod grid;
+pub mod lights;
 pub mod material;
 pub mod raycast;
 pub mod shape;
@@ -34,6 +35,7 @@ pub use edit::{
 };
 pub use error::{BrickmapError, Result};
 pub use grid::GridDims;
+pub use lights::{LightFace, Lights};
 pub use material::{Material, MaterialKind, MaterialTable};
 pub use raycast::{Occupancy, Ray, RayHit, cast, cast_from_cell};
 pub use shape::Shape;

@@ -10,6 +10,7 @@ use crate::dirty::DirtyRanges;
 use crate::edit::{EditInverse, EditOp, EditOutcome, Mode, PriorMaterials, VoxelEdit};
 use crate::error::{BrickmapError, Result};
 use crate::grid::{GridDims, SlabBounds};
+use crate::lights::{self, Lights};
 use crate::material::{Material, MaterialKind, MaterialTable, MaterialTablesGpu};
 use crate::shape::Shape;
 use crate::slab::{CellState, Slab, WorkItem};
@@ -67,16 +68,19 @@ pub enum GpuBuffer {
     MaterialBytes,
     /// [`MaterialTablesGpu`].
     MaterialTables,
+    /// The light faces' sum tree ([`crate::lights`]).
+    Lights,
 }
 
 impl GpuBuffer {
     /// Every buffer.
-    pub const ALL: [GpuBuffer; 5] = [
+    pub const ALL: [GpuBuffer; 6] = [
         GpuBuffer::BrickIndex,
         GpuBuffer::Bricks,
         GpuBuffer::Coarse,
         GpuBuffer::MaterialBytes,
         GpuBuffer::MaterialTables,
+        GpuBuffer::Lights,
     ];
 }
 
@@ -84,7 +88,7 @@ impl GpuBuffer {
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct DirtySet {
     /// Per buffer, in [`GpuBuffer::ALL`] order.
-    pub ranges: [Vec<Range<u64>>; 5],
+    pub ranges: [Vec<Range<u64>>; 6],
 }
 
 impl DirtySet {
@@ -165,6 +169,10 @@ pub struct World {
     submit_order: Mutex<()>,
     materials: RwLock<MaterialTable>,
     counters: Arc<ChunkCounters>,
+    lights: RwLock<Lights>,
+    /// Serialises light updates (each recomputes from the voxels as they are when it runs,
+    /// so the last update of a brick is never older than its last edit).
+    light_updates: Mutex<()>,
 }
 
 impl std::fmt::Debug for World {
@@ -225,6 +233,8 @@ impl World {
             submit_order: Mutex::new(()),
             materials: RwLock::new(MaterialTable::default()),
             counters,
+            lights: RwLock::new(Lights::default()),
+            light_updates: Mutex::new(()),
         })
     }
 
@@ -413,15 +423,21 @@ impl World {
     }
     /// Appends a material, returning its index.
     pub fn push_material(&self, m: Material) -> Result<u8> {
-        self.materials_mut().push(m)
+        let i = self.materials_mut().push(m)?;
+        self.refresh_light_weights();
+        Ok(i)
     }
     /// Replaces a material, returning the previous one.
     pub fn set_material(&self, index: u8, m: Material) -> Result<Material> {
-        self.materials_mut().set(index, m)
+        let old = self.materials_mut().set(index, m)?;
+        self.refresh_light_weights();
+        Ok(old)
     }
     /// Replaces a colour, returning the previous one.
     pub fn set_colour(&self, index: u8, rgb: [u8; 3]) -> [u8; 3] {
-        self.materials_mut().set_colour(index, rgb)
+        let old = self.materials_mut().set_colour(index, rgb);
+        self.refresh_light_weights();
+        old
     }
     /// Replaces the whole material table (loading a scene), returning the previous one.
     /// Refused when a voxel uses a material the new table lacks.
@@ -441,15 +457,60 @@ impl World {
         if let Some(m) = highest {
             table.check(m as u32)?;
         }
-        let mut current = self.materials_mut();
         let mut table = table;
         table.mark_all_dirty();
-        Ok(std::mem::replace(&mut *current, table))
+        let old = std::mem::replace(&mut *self.materials_mut(), table);
+        self.refresh_light_weights();
+        Ok(old)
     }
 
     /// Sets a material parameter, returning the previous value.
     pub fn set_param(&self, kind: MaterialKind, index: u8, value: f32) -> Result<f32> {
-        self.materials_mut().set_param(kind, index, value)
+        let old = self.materials_mut().set_param(kind, index, value)?;
+        self.refresh_light_weights();
+        Ok(old)
+    }
+
+    // ---- lights ----------------------------------------------------------------------
+
+    /// Brings the light weights up to a changed material table: leaves rewritten when only
+    /// weights changed (cost: the light faces), every brick rescanned when a material became
+    /// a light or stopped being one (cost: the bricks).
+    fn refresh_light_weights(&self) {
+        let _one = self.light_updates.lock().unwrap_or_else(|p| p.into_inner());
+        let weights = lights::material_weights(&self.materials());
+        let rescan = self.lights_mut().set_weights(weights);
+        if rescan {
+            let view = self.read();
+            let bricks = lights::rescan(&view, &weights);
+            drop(view);
+            let mut l = self.lights_mut();
+            l.clear();
+            l.apply(bricks);
+        }
+    }
+
+    /// Recomputes the lights of the bricks an edit changed and of their neighbours (nothing
+    /// when no material is a light).
+    fn refresh_lights(&self, changed: &[UVec3]) {
+        if changed.is_empty()
+            || !self
+                .lights
+                .read()
+                .unwrap_or_else(|p| p.into_inner())
+                .any_lit_material()
+        {
+            return;
+        }
+        let _one = self.light_updates.lock().unwrap_or_else(|p| p.into_inner());
+        let view = self.read();
+        let bricks = lights::recompute(&view, &view.lights, changed);
+        drop(view);
+        self.lights_mut().apply(bricks);
+    }
+
+    fn lights_mut(&self) -> std::sync::RwLockWriteGuard<'_, Lights> {
+        self.lights.write().unwrap_or_else(|p| p.into_inner())
     }
 
     // ---- reads -----------------------------------------------------------------------
@@ -467,6 +528,7 @@ impl World {
             world: self,
             slabs,
             materials: self.materials(),
+            lights: self.lights.read().unwrap_or_else(|p| p.into_inner()),
         }
     }
 
@@ -494,6 +556,7 @@ impl World {
                 coarse,
                 material,
                 self.materials_mut().take_dirty(),
+                self.lights_mut().take_dirty(),
             ],
         }
     }
@@ -512,6 +575,11 @@ impl World {
                 self.counters.material_chunks() as u64 * MATERIAL_CHUNK as u64
             }
             GpuBuffer::MaterialTables => std::mem::size_of::<MaterialTablesGpu>() as u64,
+            GpuBuffer::Lights => self
+                .lights
+                .read()
+                .unwrap_or_else(|p| p.into_inner())
+                .gpu_size(),
         }
     }
 }
@@ -584,6 +652,10 @@ impl Ticket<'_> {
             inverse.bricks.extend(undo);
             changed_voxels += changed;
         }
+        if first_error.is_none() {
+            let changed: Vec<UVec3> = inverse.bricks.iter().map(|u| u.brick).collect();
+            self.world.refresh_lights(&changed);
+        }
         if let Some(e) = first_error {
             if !inverse.is_empty()
                 && let Err(rollback) = self.world.apply(EditOp::Restore(inverse))
@@ -626,6 +698,7 @@ pub struct WorldView<'w> {
     world: &'w World,
     slabs: Vec<RwLockReadGuard<'w, Slab>>,
     materials: RwLockReadGuard<'w, MaterialTable>,
+    lights: RwLockReadGuard<'w, Lights>,
 }
 
 impl WorldView<'_> {
@@ -636,6 +709,10 @@ impl WorldView<'_> {
     /// The material table.
     pub fn materials(&self) -> &MaterialTable {
         &self.materials
+    }
+    /// The light faces ([`crate::lights`]).
+    pub fn lights(&self) -> &Lights {
+        &self.lights
     }
 
     #[inline]
@@ -786,7 +863,9 @@ impl WorldView<'_> {
         for (w, s) in self.slabs.iter().enumerate() {
             s.validate().map_err(|e| format!("worker {w}: {e}"))?;
         }
-        Ok(())
+        self.lights
+            .validate(self)
+            .map_err(|e| format!("lights: {e}"))
     }
 
     /// The bytes `range` of a GPU buffer, appended to `out`, built from only the cells,
@@ -839,17 +918,22 @@ impl WorldView<'_> {
             GpuBuffer::MaterialTables => {
                 copy_overlap(bytemuck::bytes_of(self.materials.gpu()), 0, &range, dst)
             }
+            GpuBuffer::Lights => self.lights.copy_range(&range, dst),
         }
     }
 
     /// Current size in bytes of a GPU buffer ([`World::gpu_buffer_size`]).
     pub fn gpu_buffer_size(&self, buffer: GpuBuffer) -> u64 {
-        self.world.gpu_buffer_size(buffer)
+        match buffer {
+            // The view holds the lights' read lock already.
+            GpuBuffer::Lights => self.lights.gpu_size(),
+            _ => self.world.gpu_buffer_size(buffer),
+        }
     }
 
     /// The whole of a GPU buffer, as the renderer's copy of it must be.
     pub fn gpu_image(&self, buffer: GpuBuffer) -> Vec<u8> {
-        let size = self.world.gpu_buffer_size(buffer) as usize;
+        let size = self.gpu_buffer_size(buffer) as usize;
         let mut out = vec![0u8; size];
         match buffer {
             GpuBuffer::BrickIndex => {
@@ -892,6 +976,7 @@ impl WorldView<'_> {
             GpuBuffer::MaterialTables => {
                 out.copy_from_slice(bytemuck::bytes_of(self.materials.gpu()))
             }
+            GpuBuffer::Lights => self.lights.copy_range(&(0..size as u64), &mut out),
         }
         out
     }
