@@ -36,7 +36,9 @@ void main() {
     ivec3 voxel;
     ivec3 normal;
     float t;
-    bool blocked = trace(r.origin_t.xyz, r.dir_key.xyz, false, cell, AIR, r.origin_t.w, voxel, normal, t);
+    // An emissive face's shadow ray may end in the light's voxel.
+    bool blocked = trace(r.origin_t.xyz, r.dir_key.xyz, false, cell, AIR, r.origin_t.w, voxel, normal, t)
+                   && voxel != r.target.xyz;
     if (COUNT_RAYS) {
         atomicAdd(counters[5], g_steps);
         atomicMax(counters[7], g_steps);

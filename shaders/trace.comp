@@ -35,6 +35,9 @@ layout(constant_id = 8) const uint EXPERIMENT = 0u;
 // them here costs the whole warp a traversal (measured on the H100: shadow rays cost 4× what
 // a camera ray costs when traced in place). When the queue is full they are traced here.
 layout(constant_id = 9) const bool SHADOW_QUEUE = false;
+// Next-event estimation of emissive voxels (shaders/lights.glsl): the scene has light faces
+// and light sampling is on. Without it emissive voxels are found by BSDF rays only.
+layout(constant_id = 10) const bool LIGHTS = false;
 
 // Without dielectrics every ray travels in air: the traversal drops its medium branch.
 #define MEDIUM_POSSIBLE HAS_DIELECTRIC
@@ -68,6 +71,7 @@ layout(std430, set = 0, binding = 6) buffer Accum { vec4 accum[]; };
 // shadow ray took.
 layout(std430, set = 0, binding = 7) buffer Counters { uint counters[8]; };
 #include "shadow_queue.glsl"
+#include "lights.glsl"
 uint g_rays[6];
 
 const float PI = 3.14159265358979;
@@ -233,12 +237,47 @@ int path_medium;    // material the path is inside (AIR outside dielectrics)
 float path_pdf;     // pdf the BSDF chose path_d with; < 0: delta or camera
 bool path_camera;   // the next ray is the camera ray
 uint path_vertex;   // index of the vertex the next ray finds (1: the camera ray's hit)
+bool path_lights;   // the vertex path_d left sampled the light faces (MIS on a hit)
 // A pending shadow ray from path_o, starting in path_start: when nothing blocks it before
-// shadow_t, shadow_l counts.
+// shadow_t (except its target voxel, an emissive face's; x = -1 for the sun), shadow_l
+// counts. A vertex may have two (the sun's and a light face's): the second waits in
+// shadow2_* and moves up when the first is traced or queued.
 bool shadow_pending;
 vec3 shadow_d;
 float shadow_t;
 vec3 shadow_l;
+ivec3 shadow_target;
+bool shadow2_pending;
+vec3 shadow2_d;
+float shadow2_t;
+vec3 shadow2_l;
+ivec3 shadow2_target;
+
+void next_shadow() {
+    shadow_pending = shadow2_pending;
+    shadow_d = shadow2_d;
+    shadow_t = shadow2_t;
+    shadow_l = shadow2_l;
+    shadow_target = shadow2_target;
+    shadow2_pending = false;
+}
+
+// Queues a shadow ray from the current vertex (the first free of the two).
+void add_shadow(vec3 d, float t, vec3 l, ivec3 target) {
+    if (!shadow_pending) {
+        shadow_pending = true;
+        shadow_d = d;
+        shadow_t = t;
+        shadow_l = l;
+        shadow_target = target;
+    } else {
+        shadow2_pending = true;
+        shadow2_d = d;
+        shadow2_t = t;
+        shadow2_l = l;
+        shadow2_target = target;
+    }
+}
 
 // The dielectric a camera ray starts in (AIR outside them): the same for every ray of a
 // perspective camera (found on the host), per ray for an orthographic one.
@@ -268,7 +307,9 @@ void begin_path(uvec2 px, uint index, uint s) {
     path_pdf = -1.0;
     path_camera = true;
     path_vertex = 1u;
+    path_lights = false;
     shadow_pending = false;
+    shadow2_pending = false;
 }
 
 // What the path's ray found (a voxel at t_voxel, or nothing): adds what it sees, prepares
@@ -300,7 +341,13 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
         return false;
     }
     if (HAS_EMISSIVE && here >= 0 && s.kind == EMISSIVE) {
-        pixel_sum += path_beta * s.albedo * s.param;
+        // It reflects nothing. Full weight unless the last vertex sampled the light faces.
+        float w = 1.0;
+        if (LIGHTS && path_lights && path_pdf >= 0.0) {
+            float pdf_light = light_weight(here) / light_total() * t_voxel * t_voxel / -dot(d, n);
+            w = power_heuristic(path_pdf, pdf_light);
+        }
+        pixel_sum += path_beta * s.albedo * s.param * w;
         return false;
     }
     if (path_vertex == bounces + 1u) return false;
@@ -332,6 +379,7 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
             path_medium = here;
         }
         path_pdf = -1.0;
+        path_lights = false;
     } else {
         vec3 ft;
         vec3 fb;
@@ -353,11 +401,37 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
                 vec3 fv = eval_bsdf(s, wo, wi, pdf_bsdf);
                 if (fv != vec3(0.0)) {
                     float pdf_light = dist * dist / (cl * sun_area());
-                    shadow_pending = (EXPERIMENT & 4u) == 0u;
-                    if ((EXPERIMENT & 4u) != 0u) pixel_sum += path_beta * fv * wi.z * p.sun_radiance.rgb * power_heuristic(pdf_light, pdf_bsdf) / pdf_light;
-                    shadow_d = w;
-                    shadow_t = dist;
-                    shadow_l = path_beta * fv * wi.z * p.sun_radiance.rgb * power_heuristic(pdf_light, pdf_bsdf) / pdf_light;
+                    vec3 l = path_beta * fv * wi.z * p.sun_radiance.rgb * power_heuristic(pdf_light, pdf_bsdf) / pdf_light;
+                    if ((EXPERIMENT & 4u) != 0u) pixel_sum += l;
+                    else add_shadow(w, dist, l, ivec3(-1));
+                }
+            }
+        }
+        // Light faces, from vertices in air (inside a medium every shadow ray is blocked at
+        // once: shadow rays stop at any voxel). A face by weight, a point uniform on it.
+        path_lights = false;
+        if (LIGHTS && !delta && path_medium == AIR && light_total() > 0.0) {
+            path_lights = true;
+            float leaf;
+            uint slot = sample_light(rand(), leaf);
+            ivec3 lv;
+            uint lf;
+            int lm;
+            light_face(slot, lv, lf, lm);
+            float u1 = rand();
+            float u2 = rand();
+            vec3 to = face_point(lv, lf, u1, u2) - pt;
+            float dist = length(to);
+            vec3 w = to / dist;
+            float cl = -dot(w, face_normal(lf));
+            vec3 wi = vec3(dot(w, ft), dot(w, fb), dot(w, n));
+            if (cl > 0.0 && wi.z > 0.0) {
+                float pdf_bsdf;
+                vec3 fv = eval_bsdf(s, wo, wi, pdf_bsdf);
+                if (fv != vec3(0.0)) {
+                    Shading e = material(lm);
+                    float pdf_light = leaf / light_total() * dist * dist / cl;
+                    add_shadow(w, dist, path_beta * fv * wi.z * e.albedo * e.param * power_heuristic(pdf_light, pdf_bsdf) / pdf_light, lv);
                 }
             }
         }
@@ -411,18 +485,20 @@ void main() {
                 atomicMax(counters[shadow ? 7 : 6], g_steps);
             }
             if (shadow) {
-                if (!hit) pixel_sum += shadow_l;
-                shadow_pending = false;
+                if (!hit || voxel == shadow_target) pixel_sum += shadow_l;
+                next_shadow();
             } else {
                 path_alive = scatter(hit, voxel, normal, t);
             }
             if (SHADOW_QUEUE) {
-                // A shadow ray made by this vertex goes to the queue; the subgroup reserves its
-                // slots with one atomic.
-                bool want = shadow_pending;
-                uvec4 ballot = subgroupBallot(want);
-                uint n = subgroupBallotBitCount(ballot);
-                if (n > 0u) {
+                // The shadow rays made by this vertex go to the queue (one, then the second);
+                // the subgroup reserves its slots with one atomic each time. A ray that does
+                // not fit stays pending and is traced here.
+                for (int k = 0; k < 2; k++) {
+                    bool want = shadow_pending;
+                    uvec4 ballot = subgroupBallot(want);
+                    uint n = subgroupBallotBitCount(ballot);
+                    if (n == 0u) break;
                     uint base = 0u;
                     if (subgroupElect()) {
                         base = atomicAdd(queue_count, n);
@@ -430,8 +506,8 @@ void main() {
                     }
                     base = subgroupBroadcastFirst(base);
                     uint slot = base + subgroupBallotExclusiveBitCount(ballot);
-                    if (want && push_shadow_ray(slot, path_o, path_start, shadow_d, shadow_t, shadow_l, index)) {
-                        shadow_pending = false;
+                    if (want && push_shadow_ray(slot, path_o, path_start, shadow_d, shadow_t, shadow_l, shadow_target, index)) {
+                        next_shadow();
                         if (COUNT_RAYS) g_rays[2]++;
                     }
                 }

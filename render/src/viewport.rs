@@ -173,7 +173,7 @@ impl Viewport {
         job: &RenderJob,
         variant: Option<Variant>,
     ) -> Result<(Image, Option<f64>, RayCounts), GpuError> {
-        let variant = variant.unwrap_or_else(|| Variant::for_scene(view.materials(), params));
+        let variant = variant.unwrap_or_else(|| Variant::for_scene(&view, params));
         self.tracer
             .render_counted_variant(&self.ctx, &self.world, view, params, job, variant)
     }
@@ -298,7 +298,7 @@ impl Viewport {
         let (base, variant) = {
             let view = world.read();
             let base = TraceParams::new(&view, req.params, &live.job_of(1));
-            (base, Variant::for_scene(view.materials(), req.params))
+            (base, Variant::for_scene(&view, req.params))
         };
         let slot = &mut self.frames[frame.slot];
         slot.ensure_ldr(&ctx, output.0 as u64 * output.1 as u64 * 4)?;

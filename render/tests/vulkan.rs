@@ -776,9 +776,18 @@ fn gpu_world_equals_the_cpu_world_byte_for_byte_after_random_edit_batches() {
         WorldConfig::with_workers(2),
     )
     .unwrap();
+    // Two of them emissive: the light faces (a sixth region) must stay byte-equal too.
     let mats: Vec<u8> = (0..6)
-        .map(|i| add_material(&w, MaterialKind::Lambertian, 0, [40 * i, 100, 200 - 30 * i]))
+        .map(|i| {
+            let kind = if i % 3 == 0 {
+                MaterialKind::Emissive
+            } else {
+                MaterialKind::Lambertian
+            };
+            add_material(&w, kind, i / 3, [40 * i, 100, 200 - 30 * i])
+        })
         .collect();
+    let mut most_light_faces = 0;
     let images = |w: &World| {
         let v = w.read();
         GpuBuffer::ALL.map(|b| v.gpu_image(b))
@@ -842,6 +851,9 @@ fn gpu_world_equals_the_cpu_world_byte_for_byte_after_random_edit_batches() {
                     ),
                     _ => {
                         w.set_colour(rand(256) as u8, [rand(256) as u8, 7, 9]);
+                        // A lamp's strength: the light weights change, no voxel does.
+                        w.set_param(MaterialKind::Emissive, rand(2) as u8, 0.5 + rand(8) as f32)
+                            .unwrap();
                         continue;
                     }
                 };
@@ -849,6 +861,7 @@ fn gpu_world_equals_the_cpu_world_byte_for_byte_after_random_edit_batches() {
             }
         }
         let now = images(&w);
+        most_light_faces = most_light_faces.max(w.read().lights().len());
         let changed: u64 = prev
             .iter()
             .zip(&now)
@@ -907,6 +920,10 @@ fn gpu_world_equals_the_cpu_world_byte_for_byte_after_random_edit_batches() {
         "no batch edited while uploads were deferred"
     );
     assert!(grew, "the world never outgrew its regions");
+    assert!(
+        most_light_faces > 100,
+        "too few light faces: {most_light_faces}"
+    );
     assert!(deferred, "the ring never deferred an upload");
     eprintln!("total: {total_changed} bytes changed, {total_up} uploaded");
     gpu.destroy(&ctx);
@@ -1057,7 +1074,7 @@ mod progressive {
             3,
         );
         let view = w.read();
-        let v = Variant::for_scene(view.materials(), &p);
+        let v = Variant::for_scene(&view, &p);
         assert!(v.lambertian && v.metal, "{v:?}");
         assert!(
             !v.dielectric && !v.emissive && !v.sun && !v.gradient_sky,
@@ -1105,7 +1122,7 @@ mod progressive {
         })
         .unwrap();
         let (_, sunny, _) = sun_floor();
-        let v2 = Variant::for_scene(w.read().materials(), &sunny);
+        let v2 = Variant::for_scene(&w.read(), &sunny);
         assert!(
             v2.dielectric && v2.sun && v2.gradient_sky == matches!(sunny.sky, Sky::Gradient { .. })
         );
@@ -1125,7 +1142,7 @@ mod progressive {
         let mut tracer = PathTracer::new(&ctx).unwrap();
         let size = (16, 12);
         let mut acc = Progressive::new(&ctx, size, size, 3).unwrap();
-        let variant = Variant::for_scene(w.read().materials(), &p);
+        let variant = Variant::for_scene(&w.read(), &p);
         let times = acc
             .time_repeated(&ctx, &mut tracer, &gpu, &w.read(), &p, variant, 2, 5)
             .unwrap();

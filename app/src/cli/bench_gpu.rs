@@ -77,7 +77,7 @@ pub(crate) fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize)
         // warm-up.
         let scene_variant = Variant {
             experiment,
-            ..Variant::for_scene(view.materials(), &params)
+            ..Variant::for_scene(&view, &params)
         };
         let variants = [scene_variant, Variant::everything(bounces)];
         let mut times = [Vec::with_capacity(frames), Vec::with_capacity(frames)];

@@ -16,7 +16,7 @@ pub mod sampling;
 
 use crate::image::Image;
 use crate::params::{SceneParams, Sky, SunDisc};
-use brickmap::{MaterialKind, Occupancy, Ray, RayHit, WorldView};
+use brickmap::{Lights, MaterialKind, Occupancy, Ray, RayHit, WorldView};
 use glam::{DVec3, IVec3, UVec3};
 use sampling::{
     Pcg32, cosine_hemisphere, fresnel_dielectric, ggx_d, ggx_lambda, ggx_sample_visible,
@@ -115,6 +115,8 @@ pub struct CpuScene<'a, 'w> {
     max_bounces: u32,
     camera: crate::params::Camera,
     rays: std::sync::atomic::AtomicU64,
+    /// The light faces of emissive voxels, when sampled (None: none, or BSDF rays only).
+    lights: Option<&'a Lights>,
 }
 
 impl<'a, 'w> CpuScene<'a, 'w> {
@@ -141,7 +143,19 @@ impl<'a, 'w> CpuScene<'a, 'w> {
             max_bounces: params.settings.max_bounces,
             camera: params.camera.clone(),
             rays: std::sync::atomic::AtomicU64::new(0),
+            lights: Some(view.lights()).filter(|l| l.total() > 0.0),
         }
+    }
+
+    /// Light sampling of emissive voxels on (the default when there are any) or off (they
+    /// are then found by BSDF rays only: the same converged image, noisier).
+    pub fn with_light_sampling(mut self, on: bool) -> Self {
+        self.lights = if on {
+            Some(self.view.lights()).filter(|l| l.total() > 0.0)
+        } else {
+            None
+        };
+        self
     }
 
     fn count_ray(&self) {
@@ -240,6 +254,9 @@ impl<'a, 'w> CpuScene<'a, 'w> {
         // Solid-angle pdf of the BSDF sample that made the current ray; None after a delta
         // scattering or at the camera (then a sun hit takes full weight).
         let mut bsdf_pdf: Option<f64> = None;
+        // Whether the vertex the current ray left sampled the emissive faces (then a hit on
+        // one is weighted against that by the power heuristic).
+        let mut lights_sampled = false;
         for vertex in 1..=self.max_bounces + 1 {
             let hit = self.trace(o, d, start, medium);
             let t_voxel = hit.map_or(f64::INFINITY, |h| h.t);
@@ -268,8 +285,18 @@ impl<'a, 'w> CpuScene<'a, 'w> {
             if let Some(s) = here
                 && s.kind == MaterialKind::Emissive
             {
-                // Emissive voxels are not light-sampled: full weight; they reflect nothing.
-                l += beta * s.albedo * s.param;
+                // They reflect nothing. Full weight unless the last vertex sampled them.
+                let w = match (bsdf_pdf, self.lights) {
+                    (Some(pdf), Some(lights)) if lights_sampled => {
+                        let m = self.view.voxel(hit.voxel).ok().flatten().unwrap_or(0);
+                        let cos_l = -d.dot(n);
+                        let pdf_light =
+                            lights.weight(m) as f64 / lights.total() as f64 * hit.t * hit.t / cos_l;
+                        power_heuristic(pdf, pdf_light)
+                    }
+                    _ => 1.0,
+                };
+                l += beta * s.albedo * s.param * w;
                 break;
             }
             if vertex == self.max_bounces + 1 {
@@ -298,6 +325,7 @@ impl<'a, 'w> CpuScene<'a, 'w> {
                     medium = here.and_then(|_| self.view.voxel(hit.voxel).ok().flatten());
                 }
                 bsdf_pdf = None;
+                lights_sampled = false;
             } else {
                 let s = here.expect("a surface interaction has a material");
                 let frame = Frame::new(n);
@@ -306,6 +334,16 @@ impl<'a, 'w> CpuScene<'a, 'w> {
                 let delta = s.kind == MaterialKind::Metal && s.param <= 0.0;
                 if !delta && let Some(sun) = &self.sun {
                     l += beta * self.sample_sun(sun, s, &frame, wo, p, front, rng);
+                }
+                // Emissive faces are sampled from vertices in air (from inside a medium every
+                // shadow ray is blocked at once: shadow rays stop at any voxel).
+                lights_sampled = false;
+                if !delta
+                    && medium.is_none()
+                    && let Some(lights) = self.lights
+                {
+                    l += beta * self.sample_lights(lights, s, &frame, wo, p, front, rng);
+                    lights_sampled = true;
                 }
                 let Some((wi, weight, pdf)) = sample_bsdf(s, wo, rng) else {
                     break;
@@ -360,6 +398,49 @@ impl<'a, 'w> CpuScene<'a, 'w> {
         f * wi.z * sun.radiance * power_heuristic(pdf_light, pdf_bsdf) / pdf_light
     }
 
+    /// Direct light from the emissive faces at a surface point: a face chosen by weight
+    /// (`Lights::sample`), a point uniform on it, weighted against BSDF sampling by the
+    /// power heuristic. The shadow ray may end in the light's voxel and nowhere before it.
+    #[allow(clippy::too_many_arguments)]
+    fn sample_lights(
+        &self,
+        lights: &Lights,
+        s: Shading,
+        frame: &Frame,
+        wo: DVec3,
+        p: DVec3,
+        front: IVec3,
+        rng: &mut Pcg32,
+    ) -> DVec3 {
+        let Some(slot) = lights.sample(rng.next_f64()) else {
+            return DVec3::ZERO;
+        };
+        let face = lights.face(slot);
+        let y = face_point(face.voxel, face.face, rng.next_f64(), rng.next_f64());
+        let to = y - p;
+        let dist = to.length();
+        let w = to / dist;
+        let cos_l = -w.dot(face.normal().as_dvec3());
+        let wi = frame.to_local(w);
+        if !(cos_l > 0.0 && wi.z > 0.0) {
+            return DVec3::ZERO;
+        }
+        let (f, pdf_bsdf) = eval_bsdf(s, wo, wi);
+        if f == DVec3::ZERO {
+            return DVec3::ZERO;
+        }
+        self.count_ray();
+        let blocker = brickmap::cast_from_cell(self.view, &Ray { origin: p, dir: w }, front, dist)
+            .ok()
+            .flatten();
+        if blocker.is_some_and(|h| h.voxel != face.voxel) {
+            return DVec3::ZERO;
+        }
+        let e = self.materials[face.material as usize];
+        let pdf_light = lights.leaf(slot) as f64 / lights.total() as f64 * dist * dist / cos_l;
+        f * wi.z * e.albedo * e.param * power_heuristic(pdf_light, pdf_bsdf) / pdf_light
+    }
+
     /// Renders an image: `spp` samples per pixel, box filter, on every core.
     pub fn render(&self, job: &RenderJob) -> Image {
         let (w, h) = (job.width as usize, job.height as usize);
@@ -396,6 +477,18 @@ impl<'a, 'w> CpuScene<'a, 'w> {
             height: job.height,
             pixels,
         }
+    }
+}
+
+/// The point (u1, u2) of a voxel's face (`brickmap::lights::FACE_NORMALS` order), uniform
+/// for uniform u.
+pub fn face_point(voxel: IVec3, face: u8, u1: f64, u2: f64) -> DVec3 {
+    let v = voxel.as_dvec3();
+    let high = (face & 1) as f64; // +x, +y, +z faces lie at the voxel's far side
+    v + match face / 2 {
+        0 => DVec3::new(high, u1, u2),
+        1 => DVec3::new(u1, high, u2),
+        _ => DVec3::new(u1, u2, high),
     }
 }
 

@@ -120,7 +120,7 @@ impl Progressive {
         if world_changed {
             self.restart();
         }
-        let variant = Variant::for_scene(view.materials(), params);
+        let variant = Variant::for_scene(view, params);
         let (gpu_seconds, restarted) =
             self.accumulate(ctx, tracer, world, view, params, variant, spp)?;
         Ok(FrameReport {
@@ -360,7 +360,7 @@ impl PathTracer {
         params: &SceneParams,
         job: &RenderJob,
     ) -> Result<(Image, Option<f64>), GpuError> {
-        let variant = Variant::for_scene(view.materials(), params);
+        let variant = Variant::for_scene(view, params);
         self.render_variant(ctx, world, view, params, job, variant)
     }
 
@@ -394,7 +394,7 @@ impl PathTracer {
         params: &SceneParams,
         job: &RenderJob,
     ) -> Result<(Image, Option<f64>, RayCounts), GpuError> {
-        let variant = Variant::for_scene(view.materials(), params);
+        let variant = Variant::for_scene(view, params);
         self.render_counted_variant(ctx, world, view, params, job, variant)
     }
 

@@ -25,10 +25,10 @@ const SLICED_SPIRV: &[u8] =
     include_bytes!(concat!(env!("OUT_DIR"), "/trace.comp.SAMPLE_SLICES.spv"));
 
 /// Storage bindings of both passes: the world (0..4), parameters, accumulation, counters,
-/// shadow rays, queue header.
-const BINDINGS: u32 = 10;
+/// shadow rays, queue header, light faces (10).
+const BINDINGS: u32 = 11;
 /// Bytes per queued shadow ray (`ShadowRay` in shaders/shadow_queue.glsl).
-const SHADOW_RAY_BYTES: u64 = 48;
+const SHADOW_RAY_BYTES: u64 = 64;
 /// Queue capacity bounds, in rays: enough for one shadow ray per sample of a dispatch,
 /// within these; rays that do not fit are traced in place (correct, slower).
 const QUEUE_MIN: u64 = 1 << 16;
@@ -161,7 +161,7 @@ impl TraceParams {
     }
 }
 
-/// What a pipeline variant contains (`constant_id` 0..8 of shaders/trace.comp; 9, the shadow
+/// What a pipeline variant contains (`constant_id` 0..8 and 10 of shaders/trace.comp; 9, the shadow
 /// queue, is the tracer's choice).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Variant {
@@ -173,6 +173,9 @@ pub struct Variant {
     pub dielectric: bool,
     /// Code for emissive voxels.
     pub emissive: bool,
+    /// Next-event estimation of emissive voxels (the scene has light faces; off: they are
+    /// found by BSDF rays only, the same converged image).
+    pub lights: bool,
     /// The sun disc (next-event estimation, MIS, hits).
     pub sun: bool,
     /// A gradient sky (else uniform).
@@ -187,13 +190,22 @@ pub struct Variant {
 
 impl Variant {
     /// The variant a scene needs: the kinds present in its material table (every entry, used
-    /// or not, so any voxel is shaded by its kind), its sun, sky and path length.
-    pub fn for_scene(materials: &MaterialTable, params: &SceneParams) -> Self {
+    /// or not, so any voxel is shaded by its kind), light sampling when it has light faces,
+    /// its sun, sky and path length.
+    pub fn for_scene(view: &WorldView<'_>, params: &SceneParams) -> Self {
+        let mut v = Self::for_table(view.materials(), params);
+        v.lights = v.emissive && view.lights().total() > 0.0;
+        v
+    }
+
+    /// [`Variant::for_scene`] without light sampling.
+    pub fn for_table(materials: &MaterialTable, params: &SceneParams) -> Self {
         let mut v = Self {
             lambertian: false,
             metal: false,
             dielectric: false,
             emissive: false,
+            lights: false,
             sun: params.sun.enabled,
             gradient_sky: matches!(params.sky, Sky::Gradient { .. }),
             max_bounces: params.settings.max_bounces.max(1),
@@ -220,6 +232,7 @@ impl Variant {
             metal: true,
             dielectric: true,
             emissive: true,
+            lights: true,
             sun: true,
             gradient_sky: true,
             max_bounces: max_bounces.max(1),
@@ -228,7 +241,7 @@ impl Variant {
         }
     }
 
-    fn constants(&self, shadow_queue: bool) -> [u32; 10] {
+    fn constants(&self, shadow_queue: bool) -> [u32; 11] {
         [
             self.lambertian as u32,
             self.metal as u32,
@@ -240,6 +253,7 @@ impl Variant {
             self.count_rays as u32,
             self.experiment,
             shadow_queue as u32,
+            self.lights as u32,
         ]
     }
 }
@@ -370,7 +384,7 @@ impl PathTracer {
     }
 
     fn queued(&self, variant: Variant) -> bool {
-        self.deferred_shadows && variant.sun
+        self.deferred_shadows && (variant.sun || variant.lights)
     }
 
     /// Builds a variant's pipelines now (they are cached), sliced or not.
@@ -585,6 +599,7 @@ impl PathTracer {
             // Unused without the queue (SHADOW_QUEUE is false): any valid buffer.
             None => bound.extend([self.counters.binding(), self.counters.binding()]),
         }
+        bound.push(world.light_binding());
         Ok(Plan {
             pass: (variant, queued, sliced),
             shadow: queued.then_some((variant.count_rays, variant.experiment)),

@@ -21,6 +21,9 @@ use gpu_allocator::MemoryLocation;
 use std::collections::VecDeque;
 use std::ops::Range;
 
+/// Regions: one per [`GpuBuffer`].
+const N: usize = GpuBuffer::ALL.len();
+
 /// Staging buffers in the ring.
 pub const RING_SLOTS: usize = 3;
 /// Bytes per staging buffer: what one frame uploads at most.
@@ -74,8 +77,8 @@ impl UploadReport {
 /// The world's buffers on the GPU.
 pub struct GpuWorld {
     buffer: HostBuffer,
-    regions: [Region; 5],
-    shadow: [Vec<u8>; 5],
+    regions: [Region; N],
+    shadow: [Vec<u8>; N],
     ring: StagingRing,
     queue: VecDeque<Upload>,
     dims: [u32; 3],
@@ -88,7 +91,7 @@ fn align(x: u64, a: u64) -> u64 {
 }
 
 /// Lays out regions of the given capacities; returns them and the total size.
-fn layout(capacities: [u64; 5], alignment: u64) -> ([Region; 5], u64) {
+fn layout(capacities: [u64; N], alignment: u64) -> ([Region; N], u64) {
     let mut at = 0;
     let regions = capacities.map(|c| {
         let r = Region {
@@ -104,7 +107,7 @@ fn layout(capacities: [u64; 5], alignment: u64) -> ([Region; 5], u64) {
 /// Initial capacity: buffers that grow with the content get 25% headroom.
 fn initial_capacity(b: GpuBuffer, size: u64) -> u64 {
     match b {
-        GpuBuffer::Bricks | GpuBuffer::MaterialBytes => size + size / 4,
+        GpuBuffer::Bricks | GpuBuffer::MaterialBytes | GpuBuffer::Lights => size + size / 4,
         _ => size,
     }
 }
@@ -256,7 +259,7 @@ impl GpuWorld {
         &mut self,
         ctx: &GpuContext,
         view: &WorldView<'_>,
-        ranges: &[Vec<Range<u64>>; 5],
+        ranges: &[Vec<Range<u64>>; N],
     ) -> Result<UploadReport, GpuError> {
         let mut report = UploadReport::default();
         let sizes = GpuBuffer::ALL.map(|b| view.gpu_buffer_size(b));
@@ -301,7 +304,7 @@ impl GpuWorld {
 
     /// Replaces the buffer by one whose regions fit `sizes` (growing ones get 50% headroom),
     /// copying the old contents on the GPU.
-    fn grow(&mut self, ctx: &GpuContext, sizes: [u64; 5]) -> Result<(), GpuError> {
+    fn grow(&mut self, ctx: &GpuContext, sizes: [u64; N]) -> Result<(), GpuError> {
         let capacities = std::array::from_fn(|i| {
             let cap = self.regions[i].capacity;
             if sizes[i] > cap {
@@ -313,7 +316,7 @@ impl GpuWorld {
         let (regions, total) = layout(capacities, self.alignment);
         self.ring.wait_idle(ctx)?;
         let buffer = zeroed_buffer(ctx, total)?;
-        let copies: Vec<(vk::BufferCopy, usize)> = (0..5)
+        let copies: Vec<(vk::BufferCopy, usize)> = (0..N)
             .filter(|&i| !self.shadow[i].is_empty())
             .map(|i| {
                 (
@@ -371,9 +374,9 @@ impl GpuWorld {
 }
 
 impl GpuWorld {
-    /// The five regions as bindings 0..4.
+    /// The voxel regions as bindings 0..4 (not the lights).
     pub fn bindings(&self) -> Vec<Binding> {
-        self.regions
+        self.regions[..GpuBuffer::Lights as usize]
             .iter()
             .map(|r| Binding {
                 buffer: self.buffer.raw,
@@ -381,6 +384,15 @@ impl GpuWorld {
                 range: r.capacity,
             })
             .collect()
+    }
+    /// The light faces' region ([`brickmap::lights`]; binding 10 of the tracer).
+    pub fn light_binding(&self) -> Binding {
+        let r = self.regions[GpuBuffer::Lights as usize];
+        Binding {
+            buffer: self.buffer.raw,
+            offset: r.offset,
+            range: r.capacity,
+        }
     }
     /// Grid size in bricks.
     pub fn dims(&self) -> [u32; 3] {
@@ -422,12 +434,12 @@ mod tests {
 
     #[test]
     fn regions_are_aligned_and_disjoint() {
-        let (r, total) = layout([10, 68 * 3, 4, 0, 2304], 256);
+        let (r, total) = layout([10, 68 * 3, 4, 0, 2304, 1056], 256);
         for w in r.windows(2) {
             assert!(w[0].offset + w[0].capacity <= w[1].offset);
             assert_eq!(w[1].offset % 256, 0);
         }
-        assert!(r[4].offset + r[4].capacity <= total);
+        assert!(r[5].offset + r[5].capacity <= total);
         assert_eq!(r[0].capacity, 12);
     }
 }
