@@ -9,6 +9,8 @@ layout(constant_id = 0) const bool COUNT_RAYS = false;
 // trace.comp's benchmark experiment bits; bit 4 skips this pass's work (to time the trace
 // pass alone).
 layout(constant_id = 1) const uint EXPERIMENT = 0u;
+// trace.comp's LIGHTS: rays towards emissive faces may end in their light's voxel.
+layout(constant_id = 2) const bool LIGHTS = false;
 
 // Shadow rays travel in air.
 #define MEDIUM_POSSIBLE false
@@ -20,6 +22,7 @@ layout(std430, set = 0, binding = 5) readonly buffer ParamBuffer { vec4 params[1
 layout(std430, set = 0, binding = 6) buffer Accum { vec4 accum[]; };
 layout(std430, set = 0, binding = 7) buffer Counters { uint counters[8]; };
 #include "shadow_queue.glsl"
+#include "lights.glsl"
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -36,9 +39,16 @@ void main() {
     ivec3 voxel;
     ivec3 normal;
     float t;
-    // An emissive face's shadow ray may end in the light's voxel.
-    bool blocked = trace(r.origin_t.xyz, r.dir_key.xyz, false, cell, AIR, r.origin_t.w, voxel, normal, t)
-                   && voxel != r.target.xyz;
+    bool blocked = trace(r.origin_t.xyz, r.dir_key.xyz, false, cell, AIR, r.origin_t.w, voxel, normal, t);
+    uint light_slot = floatBitsToUint(r.light.w);
+    if (LIGHTS && blocked && light_slot != NO_LIGHT) {
+        // An emissive face's shadow ray may end in the light's voxel.
+        ivec3 target;
+        uint face;
+        int material;
+        light_face(light_slot, target, face, material);
+        blocked = voxel != target;
+    }
     if (COUNT_RAYS) {
         atomicAdd(counters[5], g_steps);
         atomicMax(counters[7], g_steps);

@@ -239,43 +239,47 @@ bool path_camera;   // the next ray is the camera ray
 uint path_vertex;   // index of the vertex the next ray finds (1: the camera ray's hit)
 bool path_lights;   // the vertex path_d left sampled the light faces (MIS on a hit)
 // A pending shadow ray from path_o, starting in path_start: when nothing blocks it before
-// shadow_t (except its target voxel, an emissive face's; x = -1 for the sun), shadow_l
-// counts. A vertex may have two (the sun's and a light face's): the second waits in
-// shadow2_* and moves up when the first is traced or queued.
+// shadow_t (except in the voxel of the light face in slot shadow_slot; NO_LIGHT for the
+// sun), shadow_l counts. With LIGHTS a vertex may have two (the sun's and a light face's):
+// the second waits in shadow2_* and moves up when the first is traced or queued.
 bool shadow_pending;
 vec3 shadow_d;
 float shadow_t;
 vec3 shadow_l;
-ivec3 shadow_target;
+uint shadow_slot;
 bool shadow2_pending;
 vec3 shadow2_d;
 float shadow2_t;
 vec3 shadow2_l;
-ivec3 shadow2_target;
+uint shadow2_slot;
 
 void next_shadow() {
+    if (!LIGHTS) {
+        shadow_pending = false;
+        return;
+    }
     shadow_pending = shadow2_pending;
     shadow_d = shadow2_d;
     shadow_t = shadow2_t;
     shadow_l = shadow2_l;
-    shadow_target = shadow2_target;
+    shadow_slot = shadow2_slot;
     shadow2_pending = false;
 }
 
 // Queues a shadow ray from the current vertex (the first free of the two).
-void add_shadow(vec3 d, float t, vec3 l, ivec3 target) {
-    if (!shadow_pending) {
+void add_shadow(vec3 d, float t, vec3 l, uint light_slot) {
+    if (!LIGHTS || !shadow_pending) {
         shadow_pending = true;
         shadow_d = d;
         shadow_t = t;
         shadow_l = l;
-        shadow_target = target;
+        shadow_slot = light_slot;
     } else {
         shadow2_pending = true;
         shadow2_d = d;
         shadow2_t = t;
         shadow2_l = l;
-        shadow2_target = target;
+        shadow2_slot = light_slot;
     }
 }
 
@@ -403,7 +407,7 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
                     float pdf_light = dist * dist / (cl * sun_area());
                     vec3 l = path_beta * fv * wi.z * p.sun_radiance.rgb * power_heuristic(pdf_light, pdf_bsdf) / pdf_light;
                     if ((EXPERIMENT & 4u) != 0u) pixel_sum += l;
-                    else add_shadow(w, dist, l, ivec3(-1));
+                    else add_shadow(w, dist, l, NO_LIGHT);
                 }
             }
         }
@@ -431,7 +435,7 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
                 if (fv != vec3(0.0)) {
                     Shading e = material(lm);
                     float pdf_light = leaf / light_total() * dist * dist / cl;
-                    add_shadow(w, dist, path_beta * fv * wi.z * e.albedo * e.param * power_heuristic(pdf_light, pdf_bsdf) / pdf_light, lv);
+                    add_shadow(w, dist, path_beta * fv * wi.z * e.albedo * e.param * power_heuristic(pdf_light, pdf_bsdf) / pdf_light, slot);
                 }
             }
         }
@@ -485,7 +489,15 @@ void main() {
                 atomicMax(counters[shadow ? 7 : 6], g_steps);
             }
             if (shadow) {
-                if (!hit || voxel == shadow_target) pixel_sum += shadow_l;
+                if (LIGHTS && hit && shadow_slot != NO_LIGHT) {
+                    // A light face's shadow ray may end in its light's voxel.
+                    ivec3 target;
+                    uint face;
+                    int material;
+                    light_face(shadow_slot, target, face, material);
+                    hit = voxel != target;
+                }
+                if (!hit) pixel_sum += shadow_l;
                 next_shadow();
             } else {
                 path_alive = scatter(hit, voxel, normal, t);
@@ -494,7 +506,7 @@ void main() {
                 // The shadow rays made by this vertex go to the queue (one, then the second);
                 // the subgroup reserves its slots with one atomic each time. A ray that does
                 // not fit stays pending and is traced here.
-                for (int k = 0; k < 2; k++) {
+                for (int k = 0; k < (LIGHTS ? 2 : 1); k++) {
                     bool want = shadow_pending;
                     uvec4 ballot = subgroupBallot(want);
                     uint n = subgroupBallotBitCount(ballot);
@@ -506,7 +518,7 @@ void main() {
                     }
                     base = subgroupBroadcastFirst(base);
                     uint slot = base + subgroupBallotExclusiveBitCount(ballot);
-                    if (want && push_shadow_ray(slot, path_o, path_start, shadow_d, shadow_t, shadow_l, shadow_target, index)) {
+                    if (want && push_shadow_ray(slot, path_o, path_start, shadow_d, shadow_t, shadow_l, shadow_slot, index)) {
                         next_shadow();
                         if (COUNT_RAYS) g_rays[2]++;
                     }

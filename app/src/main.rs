@@ -214,6 +214,11 @@ enum Command {
         /// settings (1, 2, 4 … 256 spp against a reference render).
         #[arg(long)]
         convergence: bool,
+        /// Instead of the complexities: light sampling of emissive voxels against BSDF
+        /// sampling alone (efficiency at equal error; a lamp-lit room and the thesis scene with
+        /// lamps), and the cost of editing 10 k emissive voxels.
+        #[arg(long, conflicts_with = "convergence")]
+        lights: bool,
         /// Samples per pixel of the convergence reference.
         #[arg(long, default_value_t = 4096)]
         reference_spp: u32,
@@ -510,6 +515,7 @@ fn run(cli: Cli) -> Result<()> {
             experiment,
             inline_shadows,
             convergence,
+            lights,
             reference_spp,
             slices,
         } => bench_gpu(
@@ -521,6 +527,7 @@ fn run(cli: Cli) -> Result<()> {
                 inline_shadows,
                 convergence: convergence.then_some(reference_spp),
                 slices,
+                lights: lights.then_some(reference_spp),
             },
             device,
             workers,

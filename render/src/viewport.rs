@@ -165,6 +165,18 @@ impl Viewport {
             .render(&self.ctx, &self.world, view, params, job)
     }
 
+    /// [`Viewport::render`] with a chosen variant (benchmarks compare sampling choices).
+    pub fn render_variant(
+        &mut self,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        job: &RenderJob,
+        variant: Variant,
+    ) -> Result<(Image, Option<f64>), GpuError> {
+        self.tracer
+            .render_variant(&self.ctx, &self.world, view, params, job, variant)
+    }
+
     /// [`Viewport::render`] counting rays by kind.
     pub fn render_counted(
         &mut self,

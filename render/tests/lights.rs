@@ -62,9 +62,24 @@ mod gpu {
         spp: u32,
         seed: u64,
     ) -> Image {
+        render_with(ctx, w, p, variant, spp, seed, true)
+    }
+
+    /// `queued`: shadow rays go to the shadow pass (where the device can), else traced where
+    /// they start.
+    fn render_with(
+        ctx: &render::vulkan::GpuContext,
+        w: &brickmap::World,
+        p: &render::SceneParams,
+        variant: impl Fn(Variant) -> Variant,
+        spp: u32,
+        seed: u64,
+        queued: bool,
+    ) -> Image {
         let view = w.read();
         let world = GpuWorld::upload(ctx, &view).unwrap();
         let mut tracer = PathTracer::new(ctx).unwrap();
+        tracer.set_deferred_shadows(ctx, queued);
         let v = variant(Variant::for_scene(&view, p));
         let job = RenderJob {
             width: 24,
@@ -99,6 +114,18 @@ mod gpu {
             let c1 = cpu(&w, &p, true, 64, 5);
             let c2 = cpu(&w, &p, true, 64, 6);
             check(&format!("GPU against CPU, {what}"), &l1, &l2, &c1, &c2);
+            if what == "strengths 1 and 1000" {
+                // Shadow rays traced where they start (no shadow pass) render the same.
+                let i1 = render_with(&ctx, &w, &p, on, 64, 7, false);
+                let i2 = render_with(&ctx, &w, &p, on, 64, 8, false);
+                check(
+                    &format!("GPU in place against queued, {what}"),
+                    &i1,
+                    &i2,
+                    &l1,
+                    &l2,
+                );
+            }
         }
         assert_eq!(ctx.validation_errors(), 0);
     }

@@ -16,6 +16,9 @@ pub(crate) struct BenchGpu {
     pub(crate) convergence: Option<u32>,
     /// Invocations per pixel (None: the renderer's choice).
     pub(crate) slices: Option<u32>,
+    /// Light sampling of emissive voxels against BSDF sampling alone, with a reference of
+    /// this many samples (`bench_lights`), instead of the complexities.
+    pub(crate) lights: Option<u32>,
 }
 
 pub(crate) fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<()> {
@@ -27,8 +30,15 @@ pub(crate) fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize)
         inline_shadows,
         convergence,
         slices,
+        lights,
     } = bench;
     use render::vulkan::trace::Variant;
+    if let Some(reference_spp) = lights {
+        let device = device.as_deref().unwrap_or("gpu");
+        let text =
+            super::bench_lights::bench_lights(device, workers, (width, height), reference_spp)?;
+        return emit(&text);
+    }
     let scene = thesis_scene(workers)?;
     let view = scene.world.read();
     let mut session = app::gpu::session(device.as_deref().unwrap_or("gpu"), &view)?;

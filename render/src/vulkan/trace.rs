@@ -28,7 +28,7 @@ const SLICED_SPIRV: &[u8] =
 /// shadow rays, queue header, light faces (10).
 const BINDINGS: u32 = 11;
 /// Bytes per queued shadow ray (`ShadowRay` in shaders/shadow_queue.glsl).
-const SHADOW_RAY_BYTES: u64 = 64;
+const SHADOW_RAY_BYTES: u64 = 48;
 /// Queue capacity bounds, in rays: enough for one shadow ray per sample of a dispatch,
 /// within these; rays that do not fit are traced in place (correct, slower).
 const QUEUE_MIN: u64 = 1 << 16;
@@ -290,7 +290,7 @@ struct ShadowQueue {
 /// A dispatch ready to record: which pipelines, what they bind, how many groups.
 struct Plan {
     pass: (Variant, bool, bool),
-    shadow: Option<(bool, u32)>,
+    shadow: Option<(bool, u32, bool)>,
     bound: Vec<Binding>,
     groups: Dispatch,
     zero: Option<Binding>,
@@ -302,7 +302,7 @@ pub struct PathTracer {
     /// Trace pipelines by variant, shadow queue and sample slicing.
     passes: HashMap<(Variant, bool, bool), ComputePass>,
     /// The shadow pass, by ray counting and experiment.
-    shadow_passes: HashMap<(bool, u32), ComputePass>,
+    shadow_passes: HashMap<(bool, u32, bool), ComputePass>,
     queue: Option<ShadowQueue>,
     queue_limit: u64,
     deferred_shadows: bool,
@@ -406,14 +406,18 @@ impl PathTracer {
                 &variant.constants(queued),
             )?);
         }
-        let key = (variant.count_rays, variant.experiment);
+        let key = (variant.count_rays, variant.experiment, variant.lights);
         if queued && !self.shadow_passes.contains_key(&key) {
             let pass = ComputePass::specialized(
                 ctx,
                 SHADOW_SPIRV,
                 BINDINGS,
                 0,
-                &[variant.count_rays as u32, variant.experiment],
+                &[
+                    variant.count_rays as u32,
+                    variant.experiment,
+                    variant.lights as u32,
+                ],
             )?;
             self.shadow_passes.insert(key, pass);
         }
@@ -467,7 +471,7 @@ impl PathTracer {
         let mut stats = self.passes[&(variant, self.queued(variant), false)].statistics(ctx);
         if let Some(shadow) = self
             .shadow_passes
-            .get(&(variant.count_rays, variant.experiment))
+            .get(&(variant.count_rays, variant.experiment, variant.lights))
             .filter(|_| self.queued(variant))
         {
             stats.extend(
@@ -602,7 +606,7 @@ impl PathTracer {
         bound.push(world.light_binding());
         Ok(Plan {
             pass: (variant, queued, sliced),
-            shadow: queued.then_some((variant.count_rays, variant.experiment)),
+            shadow: queued.then_some((variant.count_rays, variant.experiment, variant.lights)),
             bound,
             groups: Dispatch::Groups(p.image[0].div_ceil(8), p.image[1].div_ceil(8), slices),
             // The sliced shader only adds: a new accumulation starts from zero.
