@@ -293,6 +293,19 @@ int camera_medium(vec3 o) {
     return (m >= 0 && material(m).kind == DIELECTRIC) ? m : AIR;
 }
 
+bool solid_or_outside(ivec3 c) {
+    if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(p.grid.xyz) * 8))) return true;
+    return material_at(c) >= 0;
+}
+
+// The probability that light sampling from a point in front of the light face (voxel,
+// outward normal) ends on it: its weight, plus its opposite's when that is a light face too
+// (a face chosen facing away is swapped for its opposite). CpuScene::face_probability.
+float face_probability(int material, ivec3 voxel, ivec3 normal) {
+    float k = solid_or_outside(voxel - normal) ? 1.0 : 2.0;
+    return light_weight(material) / light_total() * k;
+}
+
 void begin_path(uvec2 px, uint index, uint s) {
     rng = hash(p.seed.x ^ hash(index * 9781u + (p.seed.z + s) * 6271u + 1u));
     float u = (2.0 * (float(px.x) + rand()) / float(p.image.x) - 1.0);
@@ -348,7 +361,7 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
         // It reflects nothing. Full weight unless the last vertex sampled the light faces.
         float w = 1.0;
         if (LIGHTS && path_lights && path_pdf >= 0.0) {
-            float pdf_light = light_weight(here) / light_total() * t_voxel * t_voxel / -dot(d, n);
+            float pdf_light = face_probability(here, voxel, normal) * t_voxel * t_voxel / -dot(d, n);
             w = power_heuristic(path_pdf, pdf_light);
         }
         pixel_sum += path_beta * s.albedo * s.param * w;
@@ -424,17 +437,25 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
             light_face(slot, lv, lf, lm);
             float u1 = rand();
             float u2 = rand();
-            vec3 to = face_point(lv, lf, u1, u2) - pt;
+            vec3 y = face_point(lv, lf, u1, u2);
+            bool usable = true;
+            if (dot(pt - y, face_normal(lf)) <= 0.0) {
+                // It faces away: its opposite instead (a light face only if uncovered).
+                lf ^= 1u;
+                usable = !solid_or_outside(lv + ivec3(face_normal(lf)));
+                y = face_point(lv, lf, u1, u2);
+            }
+            vec3 to = y - pt;
             float dist = length(to);
             vec3 w = to / dist;
             float cl = -dot(w, face_normal(lf));
             vec3 wi = vec3(dot(w, ft), dot(w, fb), dot(w, n));
-            if (cl > 0.0 && wi.z > 0.0) {
+            if (usable && cl > 0.0 && wi.z > 0.0) {
                 float pdf_bsdf;
                 vec3 fv = eval_bsdf(s, wo, wi, pdf_bsdf);
                 if (fv != vec3(0.0)) {
                     Shading e = material(lm);
-                    float pdf_light = leaf / light_total() * dist * dist / cl;
+                    float pdf_light = face_probability(lm, lv, ivec3(face_normal(lf))) * dist * dist / cl;
                     add_shadow(w, dist, path_beta * fv * wi.z * e.albedo * e.param * power_heuristic(pdf_light, pdf_bsdf) / pdf_light, slot);
                 }
             }

@@ -185,7 +185,7 @@ impl Viewport {
         job: &RenderJob,
         variant: Option<Variant>,
     ) -> Result<(Image, Option<f64>, RayCounts), GpuError> {
-        let variant = variant.unwrap_or_else(|| Variant::for_scene(&view, params));
+        let variant = variant.unwrap_or_else(|| Variant::for_scene(view, params));
         self.tracer
             .render_counted_variant(&self.ctx, &self.world, view, params, job, variant)
     }

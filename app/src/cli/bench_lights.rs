@@ -51,13 +51,18 @@ fn fill(scene: &Scene, m: u8, min: IVec3, max: IVec3) -> Result<()> {
     Ok(())
 }
 
-/// A 128 × 64 × 128 room (walls, a table, a shelf) lit only by a few emissive voxels: a
+/// A 128 × 64 × 128 room (walls of albedo 0.46, a table, a shelf) lit only by a few emissive voxels: a
 /// 2 × 1 × 2 ceiling lamp and a 1 × 2 × 1 table lamp; no sun, black sky, 4 bounces.
 pub(crate) fn lamp_room(workers: usize) -> Result<Scene> {
     let dims = GridDims::new(16, 8, 16)?;
     let mut scene = Scene::empty(dims, workers)?;
     let v = dims.voxels() - 1;
-    fill(&scene, 0, IVec3::ZERO, v)?;
+    // Walls of a mid albedo (sRGB 180: 0.46 linear), as painted interiors have.
+    scene.world.set_colour(199, [180, 180, 180]);
+    let wall = scene
+        .world
+        .push_material(brickmap::Material::lambertian(199))?;
+    fill(&scene, wall, IVec3::ZERO, v)?;
     scene.world.apply(EditOp::Shape {
         shape: Shape::Box {
             min: IVec3::ONE,
@@ -65,8 +70,8 @@ pub(crate) fn lamp_room(workers: usize) -> Result<Scene> {
         },
         mode: Mode::Remove,
     })?;
-    fill(&scene, 0, IVec3::new(40, 1, 50), IVec3::new(80, 20, 80))?; // table
-    fill(&scene, 0, IVec3::new(1, 30, 20), IVec3::new(12, 32, 100))?; // shelf
+    fill(&scene, wall, IVec3::new(40, 1, 50), IVec3::new(80, 20, 80))?; // table
+    fill(&scene, wall, IVec3::new(1, 30, 20), IVec3::new(12, 32, 100))?; // shelf
     let ceiling = lamp(&scene, 300.0, [255, 236, 210])?;
     fill(
         &scene,
@@ -175,6 +180,7 @@ pub(crate) fn bench_lights(
             view.lights().len()
         );
         let mut ratios = Vec::new();
+        let mut last = [(0.0, 0.0); 2];
         for spp in (0..7).map(|k| 1u32 << k) {
             let mut row = [(0.0, 0.0); 2];
             for (i, v) in [on, off].into_iter().enumerate() {
@@ -188,6 +194,7 @@ pub(crate) fn bench_lights(
                 row[i] = (times[1], err);
             }
             let eff = row.map(|(t, e)| 1.0 / (e * t));
+            last = row.map(|(t, e)| (e, t));
             let ratio = eff[0] / eff[1];
             if spp >= 4 {
                 ratios.push(ratio);
@@ -206,6 +213,36 @@ pub(crate) fn bench_lights(
         text += &format!(
             "  efficiency with light sampling over BSDF only, median at 4..64 spp: {:.1}x\n",
             ratios[ratios.len() / 2]
+        );
+        // Steady state: GPU time per sample of back-to-back dispatches (the GPU never idles,
+        // so its clocks stay up), each of the samples per dispatch the renderer uses, and
+        // relMSE × spp at 64 spp.
+        let pixels = width as u64 * height as u64;
+        let mut per_sample = [0.0; 2];
+        for (i, v) in [on, off].into_iter().enumerate() {
+            let n = session.tracer().samples_per_dispatch_for(pixels, v);
+            let mut t = Vec::new();
+            for round in 0..6 {
+                let times = session.time_repeated(&view, params, v, (width, height), n, 10)?;
+                if round >= 2 {
+                    t.extend(times);
+                }
+            }
+            if t.is_empty() {
+                bail!("this queue cannot take timestamps");
+            }
+            t.sort_by(f64::total_cmp);
+            per_sample[i] = t[t.len() / 2] / n as f64;
+        }
+        let [(e_on, _), (e_off, _)] = last.map(|(e, _)| (e, ()));
+        text += &format!(
+            "  steady state: {:.3} / {:.3} ms per sample (light sampling / BSDF only, back-to-back dispatches); \
+             relMSE x spp at 64 spp {:.2} / {:.2}; efficiency ratio {:.1}x\n",
+            per_sample[0] * 1e3,
+            per_sample[1] * 1e3,
+            e_on * 64.0,
+            e_off * 64.0,
+            (e_off * per_sample[1]) / (e_on * per_sample[0])
         );
         drop(session);
         drop(view);

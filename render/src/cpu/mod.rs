@@ -290,9 +290,8 @@ impl<'a, 'w> CpuScene<'a, 'w> {
                     (Some(pdf), Some(lights)) if lights_sampled => {
                         let m = self.view.voxel(hit.voxel).ok().flatten().unwrap_or(0);
                         let cos_l = -d.dot(n);
-                        let pdf_light =
-                            lights.weight(m) as f64 / lights.total() as f64 * hit.t * hit.t / cos_l;
-                        power_heuristic(pdf, pdf_light)
+                        let area = self.face_probability(lights, m, hit.voxel, hit.normal);
+                        power_heuristic(pdf, area * hit.t * hit.t / cos_l)
                     }
                     _ => 1.0,
                 };
@@ -398,9 +397,19 @@ impl<'a, 'w> CpuScene<'a, 'w> {
         f * wi.z * sun.radiance * power_heuristic(pdf_light, pdf_bsdf) / pdf_light
     }
 
+    /// The probability that light sampling from a point in front of light face (`voxel`,
+    /// outward `normal`) ends on that face: its own weight, plus its opposite face's when
+    /// that is a light face too (a face chosen facing away is swapped for its opposite).
+    fn face_probability(&self, lights: &Lights, m: u8, voxel: IVec3, normal: IVec3) -> f64 {
+        let behind = voxel - normal;
+        let opposite_lit = self.view.voxel(behind).is_ok_and(|v| v.is_none());
+        lights.weight(m) as f64 / lights.total() as f64 * if opposite_lit { 2.0 } else { 1.0 }
+    }
+
     /// Direct light from the emissive faces at a surface point: a face chosen by weight
-    /// (`Lights::sample`), a point uniform on it, weighted against BSDF sampling by the
-    /// power heuristic. The shadow ray may end in the light's voxel and nowhere before it.
+    /// (`Lights::sample`), swapped for the opposite face of its voxel when it faces away
+    /// from the point, a point uniform on it, weighted against BSDF sampling by the power
+    /// heuristic. The shadow ray may end in the light's voxel and nowhere before it.
     #[allow(clippy::too_many_arguments)]
     fn sample_lights(
         &self,
@@ -415,8 +424,16 @@ impl<'a, 'w> CpuScene<'a, 'w> {
         let Some(slot) = lights.sample(rng.next_f64()) else {
             return DVec3::ZERO;
         };
-        let face = lights.face(slot);
-        let y = face_point(face.voxel, face.face, rng.next_f64(), rng.next_f64());
+        let mut face = lights.face(slot);
+        let (u1, u2) = (rng.next_f64(), rng.next_f64());
+        let mut y = face_point(face.voxel, face.face, u1, u2);
+        if (p - y).dot(face.normal().as_dvec3()) <= 0.0 {
+            face.face ^= 1; // faces away: its opposite (a light face only if uncovered)
+            if self.view.voxel(face.voxel + face.normal()) != Ok(None) {
+                return DVec3::ZERO;
+            }
+            y = face_point(face.voxel, face.face, u1, u2);
+        }
         let to = y - p;
         let dist = to.length();
         let w = to / dist;
@@ -437,7 +454,8 @@ impl<'a, 'w> CpuScene<'a, 'w> {
             return DVec3::ZERO;
         }
         let e = self.materials[face.material as usize];
-        let pdf_light = lights.leaf(slot) as f64 / lights.total() as f64 * dist * dist / cos_l;
+        let area = self.face_probability(lights, face.material, face.voxel, face.normal());
+        let pdf_light = area * dist * dist / cos_l;
         f * wi.z * e.albedo * e.param * power_heuristic(pdf_light, pdf_bsdf) / pdf_light
     }
 

@@ -160,7 +160,7 @@ impl Progressive {
         let mut done = 0;
         let pixels = self.internal.0 as u64 * self.internal.1 as u64;
         let (per_invocation, slices) = (
-            tracer.samples_per_dispatch(pixels),
+            tracer.samples_per_dispatch_for(pixels, variant),
             tracer.sample_slices(pixels),
         );
         while done < spp {
@@ -232,7 +232,7 @@ impl Progressive {
         let pixels = self.internal.0 as u64 * self.internal.1 as u64;
         let (per, split) = batch_shape(
             spp,
-            tracer.samples_per_dispatch(pixels),
+            tracer.samples_per_dispatch_for(pixels, variant),
             tracer.sample_slices(pixels),
         );
         let p = base.batch(per, self.samples, self.samples > 0);

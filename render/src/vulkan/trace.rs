@@ -33,6 +33,10 @@ const SHADOW_RAY_BYTES: u64 = 48;
 /// within these; rays that do not fit are traced in place (correct, slower).
 const QUEUE_MIN: u64 = 1 << 16;
 const QUEUE_MAX: u64 = 1 << 21;
+/// With light faces every vertex of a path may queue a shadow ray (two with the sun too), so
+/// those variants ask for one per vertex, up to 2²³ rays (384 MiB): a queue of one per
+/// sample overflowed at 1024 × 576, and rays traced in place cost several times a queued one.
+const QUEUE_MAX_LIGHTS: u64 = 1 << 23;
 /// The queue header before a trace dispatch: no groups, y = z = 1, no rays.
 const QUEUE_RESET: [u32; 4] = [0, 1, 1, 0];
 
@@ -321,7 +325,7 @@ impl PathTracer {
             passes: HashMap::new(),
             shadow_passes: HashMap::new(),
             queue: None,
-            queue_limit: QUEUE_MAX,
+            queue_limit: QUEUE_MAX_LIGHTS,
             deferred_shadows: ctx.shadow_queue,
             samples_per_dispatch: None,
             sample_slices: None,
@@ -341,10 +345,10 @@ impl PathTracer {
         self.deferred_shadows = on && ctx.shadow_queue;
     }
 
-    /// The most shadow rays one dispatch queues (at most the default, 2²¹ = 96 MiB of
-    /// queue); the rest are traced in place. Tests use small limits to exercise overflow.
+    /// The most shadow rays one dispatch queues (at most 2²¹ = 96 MiB of queue, 2²³ with
+    /// light faces); the rest are traced in place. Tests use small limits to exercise overflow.
     pub fn set_queue_limit(&mut self, rays: u64) {
-        self.queue_limit = rays.clamp(1, QUEUE_MAX);
+        self.queue_limit = rays.clamp(1, QUEUE_MAX_LIGHTS);
     }
 
     /// Samples per pixel in one dispatch: `Some(n)` fixes it (1..=16), `None` chooses from
@@ -362,6 +366,19 @@ impl PathTracer {
             } else {
                 SAMPLES_PER_DISPATCH[usize::from(pixels >= LARGE_IMAGE)]
             })
+    }
+
+    /// [`PathTracer::samples_per_dispatch`] for a variant: with light faces never more than
+    /// the smaller default (every vertex may queue a shadow ray; at 8 per dispatch the queue
+    /// of a 1024 × 576 image overflowed and the overflow, traced in place, cost 9 % of the
+    /// frame on the H200).
+    pub fn samples_per_dispatch_for(&self, pixels: u64, variant: Variant) -> u32 {
+        let n = self.samples_per_dispatch(pixels);
+        if variant.lights && self.samples_per_dispatch.is_none() {
+            n.min(SAMPLES_PER_DISPATCH[0])
+        } else {
+            n
+        }
     }
 
     /// Invocations a pixel's samples are split among: `Some(n)` fixes it (1..=[`MAX_SLICES`];
@@ -427,8 +444,8 @@ impl PathTracer {
     /// A queue of at least `rays` capacity (within the bounds and the limit): kept while it
     /// is large enough (a smaller batch does not reallocate it), replaced when too small or
     /// above a lowered limit.
-    fn ensure_queue(&mut self, ctx: &GpuContext, rays: u64) -> Result<(), GpuError> {
-        let capacity = rays.clamp(QUEUE_MIN, QUEUE_MAX).min(self.queue_limit);
+    fn ensure_queue(&mut self, ctx: &GpuContext, rays: u64, max: u64) -> Result<(), GpuError> {
+        let capacity = rays.clamp(QUEUE_MIN, max).min(self.queue_limit);
         if self
             .queue
             .as_ref()
@@ -589,10 +606,17 @@ impl PathTracer {
         self.prepare(ctx, variant, sliced)?;
         let queued = self.queued(variant);
         if queued {
-            self.ensure_queue(
-                ctx,
-                p.image[0] as u64 * p.image[1] as u64 * p.image[2] as u64 * slices as u64,
-            )?;
+            let samples = p.image[0] as u64 * p.image[1] as u64 * p.image[2] as u64 * slices as u64;
+            let (per_sample, max) = if variant.lights {
+                let per_vertex = 1 + variant.sun as u64;
+                (
+                    per_vertex * variant.max_bounces.min(4) as u64,
+                    QUEUE_MAX_LIGHTS,
+                )
+            } else {
+                (1, QUEUE_MAX)
+            };
+            self.ensure_queue(ctx, samples * per_sample, max)?;
         }
         uniforms.write(bytemuck::bytes_of(p));
         let mut bound = world.bindings();
