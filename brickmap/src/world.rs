@@ -134,6 +134,8 @@ pub struct MemoryStats {
     pub full_cells: u64,
     /// Material, colour and parameter tables.
     pub tables: u64,
+    /// The light faces' tree and records.
+    pub lights: u64,
     /// CPU-only bookkeeping (slot metadata, free-list links).
     pub cpu_only: u64,
 }
@@ -141,11 +143,21 @@ pub struct MemoryStats {
 impl MemoryStats {
     /// Everything the GPU must hold to render the world as it is.
     pub fn gpu_used(&self) -> u64 {
-        self.brick_index + self.bricks_used + self.coarse + self.material_used + self.tables
+        self.brick_index
+            + self.bricks_used
+            + self.coarse
+            + self.material_used
+            + self.tables
+            + self.lights
     }
     /// Everything the GPU buffers occupy with whole chunks.
     pub fn gpu_reserved(&self) -> u64 {
-        self.brick_index + self.bricks_reserved + self.coarse + self.material_reserved + self.tables
+        self.brick_index
+            + self.bricks_reserved
+            + self.coarse
+            + self.material_reserved
+            + self.tables
+            + self.lights
     }
 }
 
@@ -798,6 +810,7 @@ impl WorldView<'_> {
             brick_index: self.world.dims.brick_cells() as u64 * 4,
             coarse: self.world.dims.coarse_words() as u64 * 4,
             tables: std::mem::size_of::<MaterialTablesGpu>() as u64,
+            lights: self.lights.gpu_size(),
             ..Default::default()
         };
         for s in &self.slabs {

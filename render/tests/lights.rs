@@ -51,8 +51,7 @@ mod gpu {
     use brickmap::{EditOp, Mode, Shape};
     use glam::IVec3;
     use render::vulkan::DeviceChoice;
-    use render::vulkan::trace::{PathTracer, Variant};
-    use render::vulkan::world::GpuWorld;
+    use render::vulkan::trace::Variant;
 
     fn render(
         ctx: &render::vulkan::GpuContext,
@@ -62,38 +61,7 @@ mod gpu {
         spp: u32,
         seed: u64,
     ) -> Image {
-        render_with(ctx, w, p, variant, spp, seed, true)
-    }
-
-    /// `queued`: shadow rays go to the shadow pass (where the device can), else traced where
-    /// they start.
-    fn render_with(
-        ctx: &render::vulkan::GpuContext,
-        w: &brickmap::World,
-        p: &render::SceneParams,
-        variant: impl Fn(Variant) -> Variant,
-        spp: u32,
-        seed: u64,
-        queued: bool,
-    ) -> Image {
-        let view = w.read();
-        let world = GpuWorld::upload(ctx, &view).unwrap();
-        let mut tracer = PathTracer::new(ctx).unwrap();
-        tracer.set_deferred_shadows(ctx, queued);
-        let v = variant(Variant::for_scene(&view, p));
-        let job = RenderJob {
-            width: 24,
-            height: 24,
-            spp,
-            seed,
-        };
-        let image = tracer
-            .render_variant(ctx, &world, &view, p, &job, v)
-            .unwrap()
-            .0;
-        tracer.destroy(ctx);
-        world.destroy(ctx);
-        image
+        common::gpu_render_with(ctx, w, p, 24, spp, seed, variant, true)
     }
 
     #[test]
@@ -116,8 +84,8 @@ mod gpu {
             check(&format!("GPU against CPU, {what}"), &l1, &l2, &c1, &c2);
             if what == "strengths 1 and 1000" {
                 // Shadow rays traced where they start (no shadow pass) render the same.
-                let i1 = render_with(&ctx, &w, &p, on, 64, 7, false);
-                let i2 = render_with(&ctx, &w, &p, on, 64, 8, false);
+                let i1 = common::gpu_render_with(&ctx, &w, &p, 24, 64, 7, on, false);
+                let i2 = common::gpu_render_with(&ctx, &w, &p, 24, 64, 8, on, false);
                 check(
                     &format!("GPU in place against queued, {what}"),
                     &i1,

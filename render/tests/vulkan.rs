@@ -410,27 +410,7 @@ mod trace {
         spp: u32,
         seed: u64,
     ) -> Image {
-        let view = w.read();
-        let world = GpuWorld::upload(ctx, &view).unwrap();
-        let mut tracer = PathTracer::new(ctx).unwrap();
-        let image = tracer
-            .render(
-                ctx,
-                &world,
-                &view,
-                p,
-                &RenderJob {
-                    width: size,
-                    height: size,
-                    spp,
-                    seed,
-                },
-            )
-            .unwrap()
-            .0;
-        tracer.destroy(ctx);
-        world.destroy(ctx);
-        image
+        common::gpu_render_with(ctx, w, p, size, spp, seed, |v| v, true)
     }
 
     use super::common::cpu_render;

@@ -50,6 +50,10 @@ pub(crate) fn stats_text(world: &World, seconds: f64) -> String {
             kinds[3]
         ),
         format!(
+            "lights       {} emissive faces sampled as lights",
+            view.lights().len()
+        ),
+        format!(
             "gpu memory   {} bytes used, {} reserved",
             m.gpu_used(),
             m.gpu_reserved()
@@ -62,6 +66,7 @@ pub(crate) fn stats_text(world: &World, seconds: f64) -> String {
             m.material_used, m.material_payload
         ),
         format!("  tables       {}", m.tables),
+        format!("  lights       {}", m.lights),
     ];
     if solid > 0 {
         lines.push(format!(

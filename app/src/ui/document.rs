@@ -382,20 +382,22 @@ pub(super) fn scene_statistics(doc: &Document) -> String {
     let dims = doc.scene.world.dims().voxels();
     let solid = view.solid_count();
     let mut s = format!(
-        "size         {} x {} x {} voxels\nsolid        {solid} voxels\nbricks       {} stored, {} full cells\nmaterials    {}\n\
-         GPU memory   {:.1} MiB used\n  brick index {:.2} MiB\n  bricks      {:.2} MiB\n  coarse grid {:.2} MiB\n  materials   {:.2} MiB\n  tables      {} B\n",
+        "size         {} x {} x {} voxels\nsolid        {solid} voxels\nbricks       {} stored, {} full cells\nmaterials    {}\nlights       {} emissive faces\n\
+         GPU memory   {:.1} MiB used\n  brick index {:.2} MiB\n  bricks      {:.2} MiB\n  coarse grid {:.2} MiB\n  materials   {:.2} MiB\n  tables      {} B\n  lights      {} B\n",
         dims.x,
         dims.y,
         dims.z,
         view.brick_count(),
         m.full_cells,
         view.materials().len(),
+        view.lights().len(),
         m.gpu_used() as f64 / 1048576.0,
         m.brick_index as f64 / 1048576.0,
         m.bricks_used as f64 / 1048576.0,
         m.coarse as f64 / 1048576.0,
         m.material_used as f64 / 1048576.0,
-        m.tables
+        m.tables,
+        m.lights
     );
     if solid > 0 {
         s += &format!(

@@ -54,15 +54,8 @@ impl SunDisc {
     }
 }
 
-/// sRGB-encoded byte to linear.
-pub fn srgb_to_linear(c: u8) -> f64 {
-    let c = c as f64 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
+/// sRGB-encoded byte to linear (one definition, shared with the light weights).
+pub use brickmap::lights::srgb_to_linear;
 
 /// What to render.
 #[derive(Clone, Debug)]
@@ -381,20 +374,13 @@ impl<'a, 'w> CpuScene<'a, 'w> {
         let r = sun.radius * rng.next_f64().sqrt();
         let phi = 2.0 * PI * rng.next_f64();
         let y = sun.centre + (sun.e1 * phi.cos() + sun.e2 * phi.sin()) * r;
-        let to = y - p;
-        let dist = to.length();
-        let w = to / dist;
-        let cos_l = -w.dot(sun.normal);
-        let wi = frame.to_local(w);
-        if cos_l <= 0.0 || wi.z <= 0.0 {
+        let Some(c) = Connection::new(s, frame, wo, p, y, sun.normal) else {
+            return DVec3::ZERO;
+        };
+        if self.occluded(p, c.w, front, c.dist) {
             return DVec3::ZERO;
         }
-        let (f, pdf_bsdf) = eval_bsdf(s, wo, wi);
-        if f == DVec3::ZERO || self.occluded(p, w, front, dist) {
-            return DVec3::ZERO;
-        }
-        let pdf_light = dist * dist / (cos_l * sun.area());
-        f * wi.z * sun.radiance * power_heuristic(pdf_light, pdf_bsdf) / pdf_light
+        c.light(sun.radiance, c.dist * c.dist / (c.cos_l * sun.area()))
     }
 
     /// The probability that light sampling from a point in front of light face (`voxel`,
@@ -434,29 +420,25 @@ impl<'a, 'w> CpuScene<'a, 'w> {
             }
             y = face_point(face.voxel, face.face, u1, u2);
         }
-        let to = y - p;
-        let dist = to.length();
-        let w = to / dist;
-        let cos_l = -w.dot(face.normal().as_dvec3());
-        let wi = frame.to_local(w);
-        if !(cos_l > 0.0 && wi.z > 0.0) {
+        let Some(c) = Connection::new(s, frame, wo, p, y, face.normal().as_dvec3()) else {
             return DVec3::ZERO;
-        }
-        let (f, pdf_bsdf) = eval_bsdf(s, wo, wi);
-        if f == DVec3::ZERO {
-            return DVec3::ZERO;
-        }
+        };
         self.count_ray();
-        let blocker = brickmap::cast_from_cell(self.view, &Ray { origin: p, dir: w }, front, dist)
+        let ray = Ray {
+            origin: p,
+            dir: c.w,
+        };
+        let blocker = brickmap::cast_from_cell(self.view, &ray, front, c.dist);
+        if blocker
             .ok()
-            .flatten();
-        if blocker.is_some_and(|h| h.voxel != face.voxel) {
+            .flatten()
+            .is_some_and(|h| h.voxel != face.voxel)
+        {
             return DVec3::ZERO;
         }
         let e = self.materials[face.material as usize];
         let area = self.face_probability(lights, face.material, face.voxel, face.normal());
-        let pdf_light = area * dist * dist / cos_l;
-        f * wi.z * e.albedo * e.param * power_heuristic(pdf_light, pdf_bsdf) / pdf_light
+        c.light(e.albedo * e.param, area * c.dist * c.dist / c.cos_l)
     }
 
     /// Renders an image: `spp` samples per pixel, box filter, on every core.
@@ -495,6 +477,47 @@ impl<'a, 'w> CpuScene<'a, 'w> {
             height: job.height,
             pixels,
         }
+    }
+}
+
+/// A shading point joined to a point on a light (next-event estimation).
+struct Connection {
+    /// Unit direction to the light point, and its distance.
+    w: DVec3,
+    dist: f64,
+    /// Cosine at the light (its outward normal against −w).
+    cos_l: f64,
+    /// Cosine at the surface, BSDF value and the pdf BSDF sampling would choose w with.
+    cos_s: f64,
+    f: DVec3,
+    pdf_bsdf: f64,
+}
+
+impl Connection {
+    /// None when the light faces away, the point lies below the surface or the BSDF is 0.
+    fn new(s: Shading, frame: &Frame, wo: DVec3, p: DVec3, y: DVec3, n_l: DVec3) -> Option<Self> {
+        let to = y - p;
+        let dist = to.length();
+        let w = to / dist;
+        let cos_l = -w.dot(n_l);
+        let wi = frame.to_local(w);
+        if !(cos_l > 0.0 && wi.z > 0.0) {
+            return None;
+        }
+        let (f, pdf_bsdf) = eval_bsdf(s, wo, wi);
+        (f != DVec3::ZERO).then_some(Self {
+            w,
+            dist,
+            cos_l,
+            cos_s: wi.z,
+            f,
+            pdf_bsdf,
+        })
+    }
+    /// The light's contribution when unblocked: radiance `l` sampled with solid-angle pdf
+    /// `pdf_light`, weighted against BSDF sampling by the power heuristic.
+    fn light(&self, l: DVec3, pdf_light: f64) -> DVec3 {
+        self.f * self.cos_s * l * power_heuristic(pdf_light, self.pdf_bsdf) / pdf_light
     }
 }
 

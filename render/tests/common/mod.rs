@@ -664,3 +664,38 @@ pub fn same_image_within_noise(l1: &Image, l2: &Image, b1: &Image, b2: &Image) -
         (diff / count).abs() / (expected.sqrt() / count),
     )
 }
+
+/// A square GPU render of `size` pixels with the scene's variant changed by `variant`;
+/// `queued`: shadow rays go to the shadow pass (where the device can), else are traced where
+/// they start.
+#[allow(clippy::too_many_arguments)]
+pub fn gpu_render_with(
+    ctx: &render::vulkan::GpuContext,
+    w: &World,
+    p: &SceneParams,
+    size: u32,
+    spp: u32,
+    seed: u64,
+    variant: impl Fn(render::vulkan::trace::Variant) -> render::vulkan::trace::Variant,
+    queued: bool,
+) -> Image {
+    use render::vulkan::trace::{PathTracer, Variant};
+    let view = w.read();
+    let world = render::vulkan::world::GpuWorld::upload(ctx, &view).unwrap();
+    let mut tracer = PathTracer::new(ctx).unwrap();
+    tracer.set_deferred_shadows(ctx, queued);
+    let v = variant(Variant::for_scene(&view, p));
+    let job = render::cpu::RenderJob {
+        width: size,
+        height: size,
+        spp,
+        seed,
+    };
+    let image = tracer
+        .render_variant(ctx, &world, &view, p, &job, v)
+        .unwrap()
+        .0;
+    tracer.destroy(ctx);
+    world.destroy(ctx);
+    image
+}
