@@ -10,9 +10,9 @@ float light_node(uint i) { return uintBitsToFloat(light_words[LIGHT_NODES + i]);
 float light_total() { return light_node(1u); }
 float light_weight(int material) { return uintBitsToFloat(light_words[LIGHT_WEIGHTS + uint(material)]); }
 
-// The slot holding u ∈ [0, 1) of the total weight, and its leaf (its probability is
-// leaf / total). Call only when the total is positive.
-uint sample_light(float u, out float leaf) {
+// The slot holding u ∈ [0, 1) of the total weight (its probability is its leaf / total).
+// Call only when the total is positive.
+uint sample_light(float u) {
     uint c = light_words[0];
     float x = u * light_total();
     uint i = 1u;
@@ -26,7 +26,6 @@ uint sample_light(float u, out float leaf) {
             i = 2u * i + 1u;
         }
     }
-    leaf = light_node(i);
     return i - c;
 }
 

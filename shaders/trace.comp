@@ -429,8 +429,7 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
         path_lights = false;
         if (LIGHTS && !delta && path_medium == AIR && light_total() > 0.0) {
             path_lights = true;
-            float leaf;
-            uint slot = sample_light(rand(), leaf);
+            uint slot = sample_light(rand());
             ivec3 lv;
             uint lf;
             int lm;

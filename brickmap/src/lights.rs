@@ -424,10 +424,14 @@ impl Lights {
             }
         }
         let mut expected: HashMap<u32, Vec<[u32; 2]>> = HashMap::new();
+        let mut lit = HashSet::new();
         let dims = view.dims();
         view.for_each_brick(|b, _, _| {
             let cell = dims.cell_index(b) as u32;
             let lights = brick_lights(view, &self.weights, b);
+            if lights.lit {
+                lit.insert(cell);
+            }
             if !lights.faces.is_empty() {
                 expected.insert(cell, lights.faces);
             }
@@ -455,12 +459,6 @@ impl Lights {
             }
             count += faces.len() as u32;
         }
-        let mut lit = HashSet::new();
-        view.for_each_brick(|b, _, _| {
-            if brick_lights(view, &self.weights, b).lit {
-                lit.insert(dims.cell_index(b) as u32);
-            }
-        });
         if lit != self.lit_cells {
             return Err("the bricks marked as holding lit voxels are not those that do".into());
         }

@@ -203,7 +203,7 @@ impl Variant {
     }
 
     /// [`Variant::for_scene`] without light sampling.
-    pub fn for_table(materials: &MaterialTable, params: &SceneParams) -> Self {
+    fn for_table(materials: &MaterialTable, params: &SceneParams) -> Self {
         let mut v = Self {
             lambertian: false,
             metal: false,
