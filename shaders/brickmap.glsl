@@ -30,6 +30,9 @@ layout(std430, set = 0, binding = 4) readonly buffer MaterialTables {
 #define COUNT_STEPS false
 #endif
 uint g_steps;
+// COUNT_STEPS shaders only: iteration caps hit (a traversal that ran out of its step budget,
+// a cell_at that ran out of its corrections); every one is a bug (`voxbrick stress`).
+uint g_capped;
 
 const uint EMPTY = 0xFFFFFFFFu;
 const uint FULL_BASE = 0xFFFFFE00u;
@@ -113,7 +116,8 @@ int cell_at(int axis, float t, bool after) {
     if (sgn == 0) return int(floor(o));
     int n = comp(g_size, axis);
     int c = clamp(int(floor(o + t * comp(g_d, axis))), -1, n);
-    for (int k = 0; k < 8; k++) {
+    int k = 0;
+    for (; k < 8; k++) {
         if (sgn > 0) {
             if (c < n && plane_time(axis, float(c + 1)) <= t) { c++; continue; }
             if (c > -1 && plane_time(axis, float(c)) > t) { c--; continue; }
@@ -125,6 +129,7 @@ int cell_at(int axis, float t, bool after) {
         }
         break;
     }
+    if (COUNT_STEPS && k == 8) g_capped++;
     return c;
 }
 
@@ -194,6 +199,7 @@ bool dda(ivec3 cell, float t, int axis, int medium, float t_max, out ivec3 voxel
         }
         t = t_next;
     }
+    if (COUNT_STEPS) g_capped++;
     return false;
 }
 
@@ -214,24 +220,68 @@ int entry_axis(ivec3 cell) {
 // One entry for every ray, so a shader that calls only this has a single copy of the
 // traversal: from anywhere (the camera; finds its first cell in the grid) when `from_origin`,
 // else leaving a surface from the known `cell` at t = 0 (no epsilon offsets).
+// The time a ray from `o` enters the grid's box (0 inside it; infinite or NaN: never).
+float entry_time(vec3 o) {
+    float t = 0.0;
+    for (int a = 0; a < 3; a++) {
+        int s = comp(g_sgn, a);
+        float oa = comp(o, a);
+        float n = float(comp(g_size, a));
+        if (s == 0) {
+            if (!(oa >= 0.0 && oa < n)) return 1.0 / 0.0;
+        } else {
+            t = max(t, plane_time(a, s > 0 ? 0.0 : n));
+        }
+    }
+    return t;
+}
+
+// Beyond this many voxels outside the grid a ray from the origin first moves to just before
+// the grid (as brickmap::Ray::near_grid does): crossing times from a far origin carry its f32
+// rounding (half a voxel at 4·10⁶), and the walk's comparisons would order crossings wrongly.
+const float FAR_ORIGIN = 1024.0;
+
 bool trace(vec3 o, vec3 d, bool from_origin, ivec3 cell, int medium, float t_max, out ivec3 voxel, out ivec3 normal, out float t_hit) {
     set_ray(o, d);
     float t = 0.0;
+    float shift = 0.0;
     if (from_origin) {
-        for (int a = 0; a < 3; a++) {
-            int s = comp(g_sgn, a);
-            float oa = comp(o, a);
-            float n = float(comp(g_size, a));
-            if (s == 0) {
-                if (!(oa >= 0.0 && oa < n)) return false;
-            } else {
-                t = max(t, plane_time(a, s > 0 ? 0.0 : n));
-            }
-        }
+        t = entry_time(o);
         if (isinf(t) || isnan(t)) return false;
+        vec3 outside = max(-o, o - vec3(g_size));
+        if (max(outside.x, max(outside.y, outside.z)) > FAR_ORIGIN) {
+            vec3 ad = abs(d);
+            shift = max(t - 2.0 / max(ad.x, max(ad.y, ad.z)), 0.0);
+            // o + shift·d without the rounding of o's magnitude: the product's and the sum's
+            // errors recovered exactly (Dekker's product with Veltkamp's split, Knuth's
+            // two-sum; `precise` forbids contraction and reassociation; Vulkan does not
+            // promise a fused fma()) and added back near the grid.
+            // Scaled by a power of two first (exact), so the split cannot overflow.
+            int e;
+            frexp(max(ad.x, max(ad.y, ad.z)), e);
+            precise vec3 ds = ldexp(d, ivec3(-e));
+            precise float ss = ldexp(shift, e);
+            precise vec3 prod = ss * ds;
+            precise float cs = 4097.0 * ss;
+            precise float sh = cs - (cs - ss);
+            precise float sl = ss - sh;
+            precise vec3 cd = 4097.0 * ds;
+            precise vec3 dh = cd - (cd - ds);
+            precise vec3 dl = ds - dh;
+            precise vec3 prod_err = ((sh * dh - prod) + sh * dl + sl * dh) + sl * dl;
+            precise vec3 sum = o + prod;
+            precise vec3 bb = sum - o;
+            precise vec3 sum_err = (o - (sum - bb)) + (prod - bb);
+            precise vec3 near = sum + (prod_err + sum_err);
+            set_ray(near, d);
+            t = entry_time(g_o);
+            if (isinf(t) || isnan(t)) return false;
+        }
         cell = ivec3(cell_at(0, t, false), cell_at(1, t, false), cell_at(2, t, false));
     }
-    return dda(cell, t, entry_axis(cell), medium, t_max, voxel, normal, t_hit);
+    bool hit = dda(cell, t, entry_axis(cell), medium, t_max - shift, voxel, normal, t_hit);
+    t_hit += shift;
+    return hit;
 }
 
 bool trace_from_origin(vec3 o, vec3 d, int medium, float t_max, out ivec3 voxel, out ivec3 normal, out float t_hit) {

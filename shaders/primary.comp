@@ -4,10 +4,12 @@
 #version 450
 layout(local_size_x = 64) in;
 
+#define COUNT_STEPS true
 #include "brickmap.glsl"
 
 layout(std430, set = 0, binding = 5) readonly buffer Rays { vec4 rays[]; };   // origin, dir per ray
-layout(std430, set = 0, binding = 6) writeonly buffer Hits { vec4 hits[]; };  // voxel.xyz (or -1), t
+// Two per ray: voxel.xyz (or -1), t; the normal of the face entered, the iteration caps hit.
+layout(std430, set = 0, binding = 6) writeonly buffer Hits { vec4 hits[]; };
 
 layout(push_constant) uniform Push { uvec3 dims; uint count; uint words_per_column; uint medium; } pc;
 
@@ -19,9 +21,12 @@ void main() {
     ivec3 voxel;
     ivec3 normal;
     float t;
+    g_capped = 0u;
     if (trace_from_origin(rays[2 * i].xyz, rays[2 * i + 1].xyz, int(pc.medium) - 1, 1.0 / 0.0, voxel, normal, t)) {
-        hits[i] = vec4(vec3(voxel), t);
+        hits[2 * i] = vec4(vec3(voxel), t);
+        hits[2 * i + 1] = vec4(vec3(normal), float(g_capped));
     } else {
-        hits[i] = vec4(-1.0);
+        hits[2 * i] = vec4(-1.0);
+        hits[2 * i + 1] = vec4(0.0, 0.0, 0.0, float(g_capped));
     }
 }

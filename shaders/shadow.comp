@@ -20,7 +20,7 @@ layout(constant_id = 2) const bool LIGHTS = false;
 // The trace pass's bindings: only the grid size (Params.grid) is read here.
 layout(std430, set = 0, binding = 5) readonly buffer ParamBuffer { vec4 params[14]; };
 layout(std430, set = 0, binding = 6) buffer Accum { vec4 accum[]; };
-layout(std430, set = 0, binding = 7) buffer Counters { uint counters[8]; };
+layout(std430, set = 0, binding = 7) buffer Counters { uint counters[9]; };
 #include "shadow_queue.glsl"
 #include "lights.glsl"
 
@@ -36,6 +36,7 @@ void main() {
     uint off = key >> PIXEL_BITS;
     ivec3 cell = ivec3(floor(r.origin_t.xyz)) + ivec3(off % 3u, (off / 3u) % 3u, off / 9u) - 1;
     g_steps = 0u;
+    g_capped = 0u;
     ivec3 voxel;
     ivec3 normal;
     float t;
@@ -52,6 +53,7 @@ void main() {
     if (COUNT_RAYS) {
         atomicAdd(counters[5], g_steps);
         atomicMax(counters[7], g_steps);
+        if (g_capped != 0u) atomicAdd(counters[8], g_capped);
     }
     if (!blocked) {
         atomicAdd(accum[pixel].x, r.light.x);

@@ -68,8 +68,8 @@ layout(std430, set = 0, binding = 5) readonly buffer ParamBuffer { Params p; };
 layout(std430, set = 0, binding = 6) buffer Accum { vec4 accum[]; };
 // COUNT_RAYS variants only: camera rays, continuation rays, shadow rays, the traversal
 // steps each kind took, then the most steps one camera or continuation ray took and one
-// shadow ray took.
-layout(std430, set = 0, binding = 7) buffer Counters { uint counters[8]; };
+// shadow ray took, then the iteration caps hit (brickmap.glsl's g_capped).
+layout(std430, set = 0, binding = 7) buffer Counters { uint counters[9]; };
 #include "shadow_queue.glsl"
 #include "lights.glsl"
 uint g_rays[6];
@@ -484,6 +484,7 @@ void main() {
     g_words_per_column = p.grid.w;
     uint index = px.y * p.image.x + px.x;
     for (int k = 0; k < 6; k++) g_rays[k] = 0u;
+    g_capped = 0u;
     pixel_sum = vec3(0.0);
     uint next_sample = gl_WorkGroupID.z * p.image.z; // this slice's first sample
     uint end_sample = next_sample + p.image.z;
@@ -566,5 +567,6 @@ void main() {
 #endif
     if (COUNT_RAYS) {
         for (int k = 0; k < 6; k++) atomicAdd(counters[k], g_rays[k]);
+        if (g_capped != 0u) atomicAdd(counters[8], g_capped);
     }
 }

@@ -16,6 +16,18 @@ pub fn device_choice(device: &str) -> DeviceChoice {
     }
 }
 
+/// A headless context on `device` (several sessions may share it), with the validation layer
+/// when asked.
+pub fn context(device: &str, validation: bool) -> Result<Arc<GpuContext>> {
+    let ctx = GpuContext::new(&ContextOptions {
+        device: device_choice(device),
+        validation,
+        ..Default::default()
+    })
+    .context("no usable Vulkan device")?;
+    Ok(Arc::new(ctx))
+}
+
 /// A headless GPU session on `device` with the world of `view` uploaded.
 pub fn session(device: &str, view: &brickmap::WorldView<'_>) -> Result<Viewport> {
     session_with(device, view, false)

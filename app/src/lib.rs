@@ -2,6 +2,7 @@
 //! the `voxbrick` binary and the editor use.
 
 pub mod atomic;
+pub mod camera_path;
 pub mod editor;
 pub mod formats;
 pub mod gpu;

@@ -227,6 +227,78 @@ enum Command {
         #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8))]
         slices: Option<u32>,
     },
+    /// The thesis benchmark along a camera path: GPU frame times (Vulkan timestamps) per
+    /// preset (complexity 1, 2, 3, physical) and internal resolution, rays per second by
+    /// kind, the CPU reference at a small size, and sculpting while the path plays; writes
+    /// bench.json, bench.md and frame-time plots (PNG) into --out.
+    Bench {
+        /// Device name filter ("gpu": the best).
+        #[arg(long, default_value = "gpu")]
+        device: String,
+        /// A camera path file (RON; default: the built-in thesis path, assets/bench).
+        #[arg(long)]
+        path: Option<PathBuf>,
+        /// Frames along the path.
+        #[arg(long, default_value_t = 240)]
+        frames: usize,
+        /// Back-to-back dispatches per frame (their median is the frame's time).
+        #[arg(long, default_value_t = 5)]
+        repeat: u32,
+        /// Internal resolutions, WxH, comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "1024x576,1920x1080", value_parser = parse_resolution)]
+        sizes: Vec<(u32, u32)>,
+        /// Presets to run (complexity-1, complexity-2, complexity-3, physical; default all).
+        #[arg(long, value_delimiter = ',')]
+        presets: Vec<String>,
+        /// CPU reference resolution.
+        #[arg(long, default_value = "128x72", value_parser = parse_resolution)]
+        cpu_size: (u32, u32),
+        /// CPU reference frames along the path (0: none).
+        #[arg(long, default_value_t = 24)]
+        cpu_frames: usize,
+        /// Sculpting while rendering: sphere radii, comma-separated (empty: none).
+        #[arg(long, value_delimiter = ',', default_value = "16,64")]
+        edit_radii: Vec<f64>,
+        /// Edits (frames) per radius.
+        #[arg(long, default_value_t = 120)]
+        edit_frames: usize,
+        /// Folder for the report.
+        #[arg(long, default_value = "bench-report")]
+        out: PathBuf,
+    },
+    /// The numerical stress suite: random and adversarial rays through the GPU traversal
+    /// against the exact CPU ray cast, and adversarial scenes' images (NaN, infinite and
+    /// negative samples, white-furnace energy, iteration caps) on the GPU and the CPU
+    /// reference. Exits non-zero if any count is not zero.
+    Stress {
+        /// Rays per class and world (12 classes, 2 worlds).
+        #[arg(long, default_value_t = 250_000)]
+        rays: usize,
+        /// GPU images: width and height.
+        #[arg(long, default_value_t = 128)]
+        size: u32,
+        /// GPU images: one-sample renders per view.
+        #[arg(long, default_value_t = 64)]
+        renders: u32,
+        /// CPU reference images: width and height.
+        #[arg(long, default_value_t = 32)]
+        cpu_size: u32,
+        /// CPU reference images: one-sample renders per view.
+        #[arg(long, default_value_t = 8)]
+        cpu_renders: u32,
+        /// Seed of the rays and samples.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Device name filter ("gpu": the best), or "cpu": only the CPU reference's images.
+        #[arg(long, default_value = "gpu")]
+        device: String,
+        /// Also count validation-layer errors (each is a failure).
+        #[arg(long)]
+        validation: bool,
+        /// Folder to write stress.json and stress.md into.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Print a scene file's dimensions, voxel count, materials and memory.
     Info {
         /// A .ron or .vox file.
@@ -251,6 +323,16 @@ fn parse_ivec3(s: &str) -> Result<IVec3, String> {
     match v[..] {
         [x, y, z] => Ok(IVec3::new(x, y, z)),
         _ => Err(format!("{s:?}: expected three integers X,Y,Z")),
+    }
+}
+
+fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+    match s
+        .split_once('x')
+        .map(|(w, h)| (w.trim().parse::<u32>(), h.trim().parse::<u32>()))
+    {
+        Some((Ok(w), Ok(h))) if (1..=8192).contains(&w) && (1..=8192).contains(&h) => Ok((w, h)),
+        _ => Err(format!("{s:?}: expected WxH, each 1..=8192")),
     }
 }
 
@@ -532,6 +614,74 @@ fn run(cli: Cli) -> Result<()> {
             device,
             workers,
         ),
+        Command::Bench {
+            device,
+            path,
+            frames,
+            repeat,
+            sizes,
+            presets,
+            cpu_size,
+            cpu_frames,
+            edit_radii,
+            edit_frames,
+            out,
+        } => {
+            if edit_radii
+                .iter()
+                .any(|r| !(r.is_finite() && *r > 0.0 && *r <= 256.0))
+            {
+                anyhow::bail!("--edit-radii must be in (0, 256]");
+            }
+            let text = cli::bench::bench(
+                cli::bench::Bench {
+                    device,
+                    path,
+                    frames: frames.max(1),
+                    repeat: repeat.max(1),
+                    sizes,
+                    presets,
+                    cpu_size,
+                    cpu_frames,
+                    edit_radii,
+                    edit_frames: edit_frames.max(1),
+                    out,
+                },
+                workers,
+            )?;
+            emit(&text)
+        }
+        Command::Stress {
+            rays,
+            size,
+            renders,
+            cpu_size,
+            cpu_renders,
+            seed,
+            device,
+            validation,
+            out,
+        } => {
+            let config = render::stress::StressConfig {
+                rays_per_class: rays,
+                gpu_size: size.clamp(1, 4096),
+                gpu_renders: renders,
+                cpu_size: cpu_size.clamp(1, 4096),
+                cpu_renders,
+                seed,
+            };
+            let text = cli::stress::stress(
+                cli::stress::Stress {
+                    config,
+                    cpu_only: device == "cpu",
+                    device,
+                    out,
+                    validation,
+                },
+                workers,
+            )?;
+            emit(&text)
+        }
         Command::Info { file } => {
             let started = Instant::now();
             let scene = with_progress(format!("reading {}", file.display()), || {

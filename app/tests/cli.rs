@@ -221,3 +221,34 @@ fn render_on_the_cpu_writes_png_and_pfm() {
     assert!(err.contains("orthographic height"), "{err}");
     assert!(!d.join("y.png").exists());
 }
+
+#[test]
+fn stress_on_the_cpu_reference_writes_its_report() {
+    let dir = scratch("stress");
+    let out = ok(&[
+        "stress",
+        "--device",
+        "cpu",
+        "--cpu-size",
+        "4",
+        "--cpu-renders",
+        "1",
+        "--out",
+        s(&dir),
+    ]);
+    // Only the CPU reference's images: no ray table, one row per scene, all clean.
+    assert!(!out.contains("| world |"), "{out}");
+    let rows: Vec<&str> = out.lines().filter(|l| l.contains("| CPU |")).collect();
+    assert!(rows.len() >= 13, "{out}");
+    assert!(rows.iter().all(|l| l.ends_with("| ok |")), "{out}");
+    let json = std::fs::read_to_string(dir.join("stress.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v["images"].as_array().unwrap().len(), rows.len());
+    assert_eq!(
+        v["images"][0]["samples"],
+        2 * 16,
+        "two views of 4 × 4 pixels"
+    );
+    assert_eq!(std::fs::read_to_string(dir.join("stress.md")).unwrap(), out);
+    fails(&["stress", "--rays", "-3"]);
+}

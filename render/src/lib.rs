@@ -7,6 +7,7 @@ pub mod cpu;
 pub mod image;
 pub mod params;
 pub mod present;
+pub mod stress;
 pub mod viewport;
 pub mod vulkan;
 

@@ -14,6 +14,7 @@ use crate::image::Image;
 use crate::params::SceneParams;
 use crate::vulkan::barrier::{after_earlier_passes, barrier};
 use crate::vulkan::frame::{FRAMES_IN_FLIGHT, FrameSlot};
+use crate::vulkan::primary::{GpuHit, PrimaryTracer};
 use crate::vulkan::progressive::Progressive;
 use crate::vulkan::tonemap::ToneMapper;
 use crate::vulkan::trace::{PathTracer, RayCounts, TraceParams, Variant};
@@ -71,6 +72,8 @@ pub struct Viewport {
     world: ManuallyDrop<GpuWorld>,
     tracer: ManuallyDrop<PathTracer>,
     tone: ManuallyDrop<ToneMapper>,
+    /// First-hit traversal of given rays (made on first use: `voxbrick stress`).
+    primary: Option<PrimaryTracer>,
     /// Interactive accumulation (created at the requested internal size).
     live: Option<Progressive>,
     /// One-shot accumulation kept by benchmarks between calls.
@@ -134,6 +137,7 @@ impl Viewport {
             world: ManuallyDrop::new(world),
             tracer: ManuallyDrop::new(tracer),
             tone: ManuallyDrop::new(tone),
+            primary: None,
             live: None,
             bench: None,
             frames: Vec::new(),
@@ -218,6 +222,29 @@ impl Viewport {
             spp,
             count,
         )
+    }
+
+    /// The first solid voxel along each ray (origin, direction) in air, or with `medium` the
+    /// first voxel that is not that dielectric, by the tracer's own traversal
+    /// (`shaders/brickmap.glsl` through `shaders/primary.comp`), and the iteration caps the
+    /// traversals hit. The world is the one last uploaded (`trace_frame` or `sync_world`).
+    pub fn first_hits(
+        &mut self,
+        rays: &[(glam::Vec3, glam::Vec3)],
+        medium: Option<u8>,
+    ) -> Result<(Vec<Option<GpuHit>>, u64), GpuError> {
+        if self.primary.is_none() {
+            self.primary = Some(PrimaryTracer::new(&self.ctx)?);
+        }
+        let primary = self.primary.as_ref().expect("made above");
+        let (mut hits, mut capped) = (Vec::with_capacity(rays.len()), 0);
+        // One dispatch covers at most 65 535 workgroups of 64 rays.
+        for chunk in rays.chunks(1 << 20) {
+            let (h, c) = primary.trace_counted(&self.ctx, &self.world, chunk, medium)?;
+            hits.extend(h);
+            capped += c;
+        }
+        Ok((hits, capped))
     }
 
     /// The driver's statistics of a variant's pipelines.
@@ -415,6 +442,9 @@ impl Drop for Viewport {
             }
             if let Some(b) = self.bench.take() {
                 b.destroy(&self.ctx);
+            }
+            if let Some(p) = self.primary.take() {
+                p.destroy(&self.ctx);
             }
             ManuallyDrop::take(&mut self.tone).destroy(&self.ctx);
             ManuallyDrop::take(&mut self.tracer).destroy(&self.ctx);

@@ -506,7 +506,11 @@ fn first_clicks(
 }
 
 /// The edit benchmarks' frames: 1 spp at `scale` of the output `size`, never converging.
-fn edit_request(params: &render::SceneParams, size: (u32, u32), scale: f32) -> FrameRequest<'_> {
+pub(crate) fn edit_request(
+    params: &render::SceneParams,
+    size: (u32, u32),
+    scale: f32,
+) -> FrameRequest<'_> {
     FrameRequest {
         params,
         internal: scaled(size, scale),

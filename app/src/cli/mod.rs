@@ -1,10 +1,13 @@
 //! Subcommands of the `voxbrick` binary, one file each, and the helpers they share.
 
+pub mod bench;
 pub mod bench_gpu;
 pub mod bench_lights;
 pub mod bench_viewport;
+pub mod plot;
 pub mod render;
 pub mod stats;
+pub mod stress;
 
 use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};

@@ -32,6 +32,9 @@ pub struct GpuHit {
     pub voxel: IVec3,
     /// Ray parameter.
     pub t: f32,
+    /// The outward normal of the face the ray entered through (the face behind the origin
+    /// for a ray starting inside the voxel).
+    pub normal: IVec3,
 }
 
 /// The traversal pipeline.
@@ -57,6 +60,18 @@ impl PrimaryTracer {
         rays: &[(Vec3, Vec3)],
         medium: Option<u8>,
     ) -> Result<Vec<Option<GpuHit>>, GpuError> {
+        Ok(self.trace_counted(ctx, world, rays, medium)?.0)
+    }
+
+    /// [`PrimaryTracer::trace`], also returning the iteration caps the traversals hit (a
+    /// step budget or a cell correction loop run out; expected zero).
+    pub fn trace_counted(
+        &self,
+        ctx: &GpuContext,
+        world: &GpuWorld,
+        rays: &[(Vec3, Vec3)],
+        medium: Option<u8>,
+    ) -> Result<(Vec<Option<GpuHit>>, u64), GpuError> {
         let packed: Vec<[f32; 4]> = rays
             .iter()
             .flat_map(|(o, d)| [o.extend(0.0).to_array(), d.extend(0.0).to_array()])
@@ -70,7 +85,7 @@ impl PrimaryTracer {
         let output = match HostBuffer::new(
             ctx,
             "hits",
-            rays.len() as u64 * 16,
+            rays.len() as u64 * 32,
             MemoryLocation::GpuToCpu,
         ) {
             Ok(b) => b,
@@ -95,15 +110,19 @@ impl PrimaryTracer {
             [(rays.len() as u32).div_ceil(GROUP), 1],
         );
         let hits = result.map(|_| {
-            let raw: &[[f32; 4]] = bytemuck::cast_slice(&output.read()[..rays.len() * 16]);
-            raw.iter()
-                .map(|h| {
+            let raw: &[[[f32; 4]; 2]] = bytemuck::cast_slice(&output.read()[..rays.len() * 32]);
+            let capped = raw.iter().map(|[_, n]| n[3] as u64).sum();
+            let hits = raw
+                .iter()
+                .map(|[h, n]| {
                     (h[0] >= 0.0).then(|| GpuHit {
                         voxel: IVec3::new(h[0] as i32, h[1] as i32, h[2] as i32),
                         t: h[3],
+                        normal: IVec3::new(n[0] as i32, n[1] as i32, n[2] as i32),
                     })
                 })
-                .collect()
+                .collect();
+            (hits, capped)
         });
         input.destroy(ctx);
         output.destroy(ctx);

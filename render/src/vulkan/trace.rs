@@ -275,6 +275,9 @@ pub struct RayCounts {
     pub steps: [u64; 3],
     /// The most steps one camera or continuation ray took, and one shadow ray.
     pub max_steps: [u64; 2],
+    /// Iteration caps hit in the traversal (a step budget or `cell_at`'s corrections run
+    /// out); expected zero.
+    pub capped: u64,
 }
 
 impl RayCounts {
@@ -330,7 +333,7 @@ impl PathTracer {
             samples_per_dispatch: None,
             sample_slices: None,
             can_slice: ctx.shadow_queue,
-            counters: HostBuffer::new(ctx, "ray counters", 32, MemoryLocation::GpuToCpu)?,
+            counters: HostBuffer::new(ctx, "ray counters", 36, MemoryLocation::GpuToCpu)?,
         })
     }
 
@@ -703,18 +706,19 @@ impl PathTracer {
 
     /// Zeroes the ray counters (before a counted render).
     pub(crate) fn reset_counters(&mut self) {
-        self.counters.write(&[0; 32]);
+        self.counters.write(&[0; 36]);
     }
 
     /// The ray counters after a counted render.
     pub(crate) fn read_counters(&self) -> RayCounts {
-        let c: [u32; 8] = bytemuck::pod_read_unaligned(&self.counters.read()[..32]);
+        let c: [u32; 9] = bytemuck::pod_read_unaligned(&self.counters.read()[..36]);
         RayCounts {
             primary: c[0] as u64,
             secondary: c[1] as u64,
             shadow: c[2] as u64,
             steps: [c[3] as u64, c[4] as u64, c[5] as u64],
             max_steps: [c[6] as u64, c[7] as u64],
+            capped: c[8] as u64,
         }
     }
 

@@ -1,0 +1,692 @@
+//! `voxbrick bench`: the thesis benchmark along a camera path. For each preset (the thesis's
+//! complexities 1 / 2 / 3 and "physical": 8 bounces, sun, 4 spp) and internal resolution,
+//! every frame of the path is timed on the GPU (Vulkan timestamps: the median of a few
+//! back-to-back dispatches of that frame, after warm-up), rays are counted by kind on every
+//! tenth frame; the CPU reference renders the same path at a small size (wall clock); then a
+//! sculpting stroke edits the world every frame while the path plays (bytes uploaded, GPU
+//! frame time, edit → first frame showing it). Writes bench.json, bench.md and one PNG plot
+//! of frame time along the path per resolution.
+
+use super::bench_viewport::edit_request;
+use super::plot::{Series, line_plot};
+use anyhow::{Context, Result, bail};
+use app::camera_path::CameraPath;
+use app::scene::Scene;
+use brickmap::{EditOp, Mode, Shape};
+use glam::DVec3;
+use render::SceneParams;
+use render::cpu::{CpuScene, RenderJob};
+use render::viewport::{FrameRequest, Viewport};
+use render::vulkan::trace::Variant;
+use serde::Serialize;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// What `bench` runs.
+pub(crate) struct Bench {
+    pub(crate) device: String,
+    /// A camera path file (None: the built-in thesis path).
+    pub(crate) path: Option<PathBuf>,
+    /// Frames along the path, evenly spaced in path time.
+    pub(crate) frames: usize,
+    /// Dispatches per frame (their median is the frame's time).
+    pub(crate) repeat: u32,
+    /// Internal resolutions.
+    pub(crate) sizes: Vec<(u32, u32)>,
+    /// Preset names to run (empty: all).
+    pub(crate) presets: Vec<String>,
+    /// CPU reference: resolution and frames along the path (0: none).
+    pub(crate) cpu_size: (u32, u32),
+    pub(crate) cpu_frames: usize,
+    /// Sculpting while rendering: sphere radii (empty: none) and frames per radius.
+    pub(crate) edit_radii: Vec<f64>,
+    pub(crate) edit_frames: usize,
+    /// Where the report goes.
+    pub(crate) out: PathBuf,
+}
+
+/// A renderer setting of the benchmark.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub(crate) struct Preset {
+    pub(crate) name: &'static str,
+    pub(crate) bounces: u32,
+    pub(crate) spp: u32,
+    pub(crate) sun: bool,
+}
+
+/// The thesis's complexities and the physical preset.
+pub(crate) const PRESETS: [Preset; 4] = [
+    Preset {
+        name: "complexity 1",
+        bounces: 1,
+        spp: 1,
+        sun: false,
+    },
+    Preset {
+        name: "complexity 2",
+        bounces: 1,
+        spp: 1,
+        sun: true,
+    },
+    Preset {
+        name: "complexity 3",
+        bounces: 3,
+        spp: 2,
+        sun: true,
+    },
+    Preset {
+        name: "physical",
+        bounces: 8,
+        spp: 4,
+        sun: true,
+    },
+];
+
+/// Order statistics of a list of milliseconds.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub(crate) struct Summary {
+    pub(crate) min: f64,
+    pub(crate) median: f64,
+    pub(crate) p99: f64,
+    pub(crate) max: f64,
+    pub(crate) mean: f64,
+}
+
+impl Summary {
+    pub(crate) fn of(v: &[f64]) -> Summary {
+        let mut s = v.to_vec();
+        s.sort_by(f64::total_cmp);
+        if s.is_empty() {
+            return Summary {
+                min: f64::NAN,
+                median: f64::NAN,
+                p99: f64::NAN,
+                max: f64::NAN,
+                mean: f64::NAN,
+            };
+        }
+        let q = |p: f64| s[((s.len() - 1) as f64 * p).round() as usize];
+        Summary {
+            min: s[0],
+            median: q(0.5),
+            p99: q(0.99),
+            max: s[s.len() - 1],
+            mean: s.iter().sum::<f64>() / s.len() as f64,
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct Rates {
+    primary: f64,
+    secondary: f64,
+    shadow: f64,
+    all: f64,
+}
+
+#[derive(Serialize)]
+struct GpuRun {
+    preset: Preset,
+    width: u32,
+    height: u32,
+    path_time_s: Vec<f64>,
+    frame_ms: Vec<f64>,
+    summary: Summary,
+    /// Millions of rays per second by kind, over the counted frames.
+    mrays_per_s: Rates,
+    /// Rays per pixel per frame by kind, over the counted frames.
+    rays_per_pixel: Rates,
+    traversal_caps_hit: u64,
+}
+
+#[derive(Serialize)]
+struct CpuRun {
+    preset: Preset,
+    width: u32,
+    height: u32,
+    path_time_s: Vec<f64>,
+    frame_ms: Vec<f64>,
+    summary: Summary,
+    /// Millions of samples (paths) per second.
+    msamples_per_s: f64,
+}
+
+#[derive(Serialize)]
+struct EditRun {
+    radius: f64,
+    width: u32,
+    height: u32,
+    edits: usize,
+    /// Host time to apply one stroke sphere (workers, undo records, dirty ranges).
+    apply_ms: Summary,
+    /// Bytes uploaded per frame while editing.
+    uploaded_bytes_per_frame: Summary,
+    /// Bytes uploaded per edit (every frame until it shows).
+    uploaded_bytes_per_edit: Summary,
+    /// GPU time of the frames while editing.
+    frame_ms: Summary,
+    /// Frames from the edit's first frame to the first showing all of it.
+    latency_frames: Summary,
+    /// Wall time from applying the edit to that frame finishing on the GPU.
+    latency_ms: Summary,
+}
+
+/// Scene statistics for the report.
+fn scene_stats(scene: &Scene) -> serde_json::Value {
+    let view = scene.world.read();
+    let m = view.memory();
+    let v = scene.world.dims().voxels();
+    serde_json::json!({
+        "name": "thesis",
+        "voxels": [v.x, v.y, v.z],
+        "solid_voxels": view.solid_count(),
+        "stored_bricks": view.brick_count(),
+        "full_cells": m.full_cells,
+        "materials": view.materials().len(),
+        "light_faces": view.lights().len(),
+        "gpu_bytes": m.gpu_used(),
+    })
+}
+
+/// The GPU's clocks from nvidia-smi, where there is one.
+fn clocks() -> Option<String> {
+    let out = std::process::Command::new("nvidia-smi")
+        .args([
+            "--query-gpu=clocks.sm,clocks.max.sm,clocks.mem,power.draw,temperature.gpu",
+            "--format=csv,noheader",
+        ])
+        .output()
+        .ok()?;
+    out.status
+        .success()
+        .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
+}
+
+/// The scene's parameters for `preset` at path time `t`.
+fn params_at(
+    base: &SceneParams,
+    path: &CameraPath,
+    preset: &Preset,
+    t: f64,
+    centre: DVec3,
+) -> SceneParams {
+    let mut p = base.clone();
+    p.settings.max_bounces = preset.bounces;
+    p.camera = path.camera_at(t, base.camera.fov_y_deg);
+    p.sun = path.sun_at(&base.sun, t, centre);
+    p.sun.enabled = preset.sun;
+    p
+}
+
+fn times(frames: usize, duration: f64) -> Vec<f64> {
+    (0..frames)
+        .map(|i| {
+            if frames > 1 {
+                duration * i as f64 / (frames - 1) as f64
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// One preset at one size along the path on the GPU.
+fn gpu_run(
+    session: &mut Viewport,
+    scene: &Scene,
+    path: &CameraPath,
+    preset: &Preset,
+    size: (u32, u32),
+    frames: usize,
+    repeat: u32,
+) -> Result<GpuRun> {
+    let view = scene.world.read();
+    let centre = view.dims().voxels().as_dvec3() * 0.5;
+    let ts = times(frames, path.duration());
+    // Warm-up: pipelines built, clocks up.
+    let p0 = params_at(&scene.params, path, preset, 0.0, centre);
+    for _ in 0..3 {
+        session.time_repeated(
+            &view,
+            &p0,
+            Variant::for_scene(&view, &p0),
+            size,
+            preset.spp,
+            10,
+        )?;
+    }
+    let (mut frame_ms, mut counted_ms) = (Vec::new(), 0.0);
+    let mut rays = render::vulkan::trace::RayCounts::default();
+    let mut counted_frames = 0u64;
+    for (i, &t) in ts.iter().enumerate() {
+        let p = params_at(&scene.params, path, preset, t, centre);
+        let variant = Variant::for_scene(&view, &p);
+        let mut v = session.time_repeated(&view, &p, variant, size, preset.spp, repeat)?;
+        if v.is_empty() {
+            bail!("this queue cannot take timestamps");
+        }
+        v.sort_by(f64::total_cmp);
+        let ms = v[v.len() / 2] * 1e3;
+        frame_ms.push(ms);
+        if i % 10 == 0 {
+            let job = RenderJob {
+                width: size.0,
+                height: size.1,
+                spp: preset.spp,
+                seed: i as u64,
+            };
+            let (_, _, c) = session.render_counted(&view, &p, &job, Some(variant))?;
+            rays.primary += c.primary;
+            rays.secondary += c.secondary;
+            rays.shadow += c.shadow;
+            rays.capped += c.capped;
+            counted_ms += ms;
+            counted_frames += 1;
+        }
+    }
+    let s = counted_ms / 1e3;
+    let px = (size.0 as u64 * size.1 as u64 * counted_frames).max(1) as f64;
+    Ok(GpuRun {
+        preset: *preset,
+        width: size.0,
+        height: size.1,
+        path_time_s: ts,
+        summary: Summary::of(&frame_ms),
+        frame_ms,
+        mrays_per_s: Rates {
+            primary: rays.primary as f64 / s / 1e6,
+            secondary: rays.secondary as f64 / s / 1e6,
+            shadow: rays.shadow as f64 / s / 1e6,
+            all: rays.total() as f64 / s / 1e6,
+        },
+        rays_per_pixel: Rates {
+            primary: rays.primary as f64 / px,
+            secondary: rays.secondary as f64 / px,
+            shadow: rays.shadow as f64 / px,
+            all: rays.total() as f64 / px,
+        },
+        traversal_caps_hit: rays.capped,
+    })
+}
+
+/// One preset along the path on the CPU reference (wall clock, all cores).
+fn cpu_run(
+    scene: &Scene,
+    path: &CameraPath,
+    preset: &Preset,
+    size: (u32, u32),
+    frames: usize,
+) -> CpuRun {
+    let view = scene.world.read();
+    let centre = view.dims().voxels().as_dvec3() * 0.5;
+    let ts = times(frames, path.duration());
+    let frame_ms: Vec<f64> = ts
+        .iter()
+        .enumerate()
+        .map(|(i, &t)| {
+            let p = params_at(&scene.params, path, preset, t, centre);
+            let started = Instant::now();
+            let cpu = CpuScene::new(&view, &p);
+            std::hint::black_box(cpu.render(&RenderJob {
+                width: size.0,
+                height: size.1,
+                spp: preset.spp,
+                seed: i as u64,
+            }));
+            started.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    let total_s = frame_ms.iter().sum::<f64>() / 1e3;
+    CpuRun {
+        preset: *preset,
+        width: size.0,
+        height: size.1,
+        path_time_s: ts,
+        summary: Summary::of(&frame_ms),
+        msamples_per_s: (size.0 as u64 * size.1 as u64 * preset.spp as u64 * frames as u64) as f64
+            / total_s
+            / 1e6,
+        frame_ms,
+    }
+}
+
+/// A sculpting stroke while the path plays: one sphere of `radius` added per frame at the
+/// next point of a circle of stroke points on the terrain's surface, each shown before the
+/// next (frames in flight as in the editor), at complexity 3's settings, 1 spp per frame.
+fn edit_run(
+    session: &mut Viewport,
+    scene: &Scene,
+    path: &CameraPath,
+    radius: f64,
+    size: (u32, u32),
+    frames: usize,
+) -> Result<EditRun> {
+    let preset = PRESETS[2];
+    let dims = scene.world.dims().voxels().as_dvec3();
+    let centre = dims * 0.5;
+    // The stroke's points on the surface, found by the exact CPU cast (before any edit).
+    let points: Vec<DVec3> = {
+        let view = scene.world.read();
+        (0..frames)
+            .map(|i| {
+                let a = i as f64 * (radius * 0.5 / 150.0);
+                let (x, z) = (centre.x + 150.0 * a.cos(), centre.z + 150.0 * a.sin());
+                let ray = brickmap::Ray {
+                    origin: DVec3::new(x, dims.y - 0.5, z),
+                    dir: DVec3::NEG_Y,
+                };
+                let y = view
+                    .ray_cast(&ray, f64::INFINITY)
+                    .ok()
+                    .flatten()
+                    .map_or(dims.y * 0.4, |(h, _)| h.voxel.y as f64 + 1.0);
+                DVec3::new(x, y, z)
+            })
+            .collect()
+    };
+    let material = 0u8;
+    let (mut apply, mut per_frame, mut per_edit, mut gpu, mut lat_frames, mut lat_ms) = (
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+    );
+    let ts = times(frames, path.duration());
+    for (i, &t) in ts.iter().enumerate() {
+        let p = params_at(&scene.params, path, &preset, t, centre);
+        let req: FrameRequest<'_> = edit_request(&p, size, 1.0);
+        let started = Instant::now();
+        scene
+            .world
+            .apply(EditOp::Shape {
+                shape: Shape::Sphere {
+                    centre: points[i],
+                    radius,
+                },
+                mode: Mode::Add(material),
+            })
+            .context("the stroke's sphere")?;
+        apply.push(started.elapsed().as_secs_f64() * 1e3);
+        let (mut n, mut bytes, mut restarted) = (0u32, 0u64, false);
+        loop {
+            let Some(f) = session.begin_frame()? else {
+                std::thread::yield_now();
+                continue;
+            };
+            n += 1;
+            let status = session.trace_frame(&f, &scene.world, &req)?;
+            session.submit_frame(f, &[], &[])?;
+            if let Some(g) = session.last_gpu_seconds() {
+                gpu.push(g * 1e3);
+            }
+            per_frame.push(status.upload.uploaded_bytes as f64);
+            bytes += status.upload.uploaded_bytes;
+            restarted |= status.restarted;
+            if restarted && status.upload.deferred_bytes == 0 {
+                break;
+            }
+            anyhow::ensure!(n < 10_000, "the edit never showed");
+        }
+        session.wait_idle()?;
+        lat_ms.push(started.elapsed().as_secs_f64() * 1e3);
+        lat_frames.push(n as f64);
+        per_edit.push(bytes as f64);
+    }
+    Ok(EditRun {
+        radius,
+        width: size.0,
+        height: size.1,
+        edits: frames,
+        apply_ms: Summary::of(&apply),
+        uploaded_bytes_per_frame: Summary::of(&per_frame),
+        uploaded_bytes_per_edit: Summary::of(&per_edit),
+        frame_ms: Summary::of(&gpu),
+        latency_frames: Summary::of(&lat_frames),
+        latency_ms: Summary::of(&lat_ms),
+    })
+}
+
+fn row(s: &Summary) -> String {
+    format!(
+        "{:.3} | {:.3} | {:.3} | {:.3} | {:.3}",
+        s.min, s.median, s.p99, s.max, s.mean
+    )
+}
+
+/// Runs the benchmark; writes the report files and returns the Markdown.
+pub(crate) fn bench(b: Bench, workers: usize) -> Result<String> {
+    let path = match &b.path {
+        Some(p) => CameraPath::load(p)?,
+        None => CameraPath::thesis(),
+    };
+    let presets: Vec<Preset> = PRESETS
+        .iter()
+        .filter(|p| {
+            b.presets.is_empty()
+                || b.presets
+                    .iter()
+                    .any(|n| n == p.name || n.replace('-', " ") == p.name)
+        })
+        .copied()
+        .collect();
+    if presets.is_empty() {
+        bail!(
+            "no preset named {:?} (complexity-1, complexity-2, complexity-3, physical)",
+            b.presets
+        );
+    }
+    let mut scene = app::scene::thesis_scene(workers)?;
+    // The path's sun circles the scene; the scene's own sun gives its height and distance.
+    scene.params.sun.animate = true;
+    scene.params.sun.speed_deg_per_s = path.sun_deg_per_s;
+    let stats = scene_stats(&scene);
+    let mut session = {
+        let view = scene.world.read();
+        app::gpu::session(&b.device, &view)?
+    };
+    let ctx = session.ctx().clone();
+    let clocks_before = clocks();
+    let mut gpu = Vec::new();
+    for &size in &b.sizes {
+        for preset in &presets {
+            eprintln!("GPU {} at {}x{}", preset.name, size.0, size.1);
+            gpu.push(gpu_run(
+                &mut session,
+                &scene,
+                &path,
+                preset,
+                size,
+                b.frames,
+                b.repeat,
+            )?);
+        }
+    }
+    let clocks_after = clocks();
+    // What the path shows: each keyframe's view at complexity 3 (16 spp, 320 × 180).
+    std::fs::create_dir_all(b.out.join("views"))
+        .with_context(|| format!("creating {}", b.out.display()))?;
+    {
+        let view = scene.world.read();
+        let centre = view.dims().voxels().as_dvec3() * 0.5;
+        for k in &path.keyframes {
+            let p = params_at(&scene.params, &path, &PRESETS[2], k.time_s, centre);
+            let job = RenderJob {
+                width: 320,
+                height: 180,
+                spp: 16,
+                seed: 1,
+            };
+            let (img, _) = session.render(&view, &p, &job)?;
+            let file = b.out.join("views").join(format!("t{:04.1}s.png", k.time_s));
+            app::atomic::write_atomic(&file, |w| img.write_png(w, p.settings.exposure))?;
+        }
+    }
+    let mut cpu = Vec::new();
+    if b.cpu_frames > 0 {
+        for preset in &presets {
+            eprintln!("CPU {} at {}x{}", preset.name, b.cpu_size.0, b.cpu_size.1);
+            cpu.push(cpu_run(&scene, &path, preset, b.cpu_size, b.cpu_frames));
+        }
+    }
+    let mut edits = Vec::new();
+    for &r in &b.edit_radii {
+        eprintln!("editing: spheres of radius {r}");
+        edits.push(edit_run(
+            &mut session,
+            &scene,
+            &path,
+            r,
+            b.sizes[0],
+            b.edit_frames,
+        )?);
+    }
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let json = serde_json::json!({
+        "device": ctx.name,
+        "driver": ctx.driver,
+        "clocks_before": clocks_before,
+        "clocks_after": clocks_after,
+        "clocks_fields": "sm MHz, max sm MHz, memory MHz, power, temperature (nvidia-smi)",
+        "cpu_threads": threads,
+        "scene": stats,
+        "path": { "duration_s": path.duration(), "keyframes": path.keyframes.len(), "sun_deg_per_s": path.sun_deg_per_s, "frames": b.frames, "dispatches_per_frame": b.repeat },
+        "gpu": gpu,
+        "cpu": cpu,
+        "editing": edits,
+    });
+    std::fs::create_dir_all(&b.out).with_context(|| format!("creating {}", b.out.display()))?;
+    let json_text = serde_json::to_string_pretty(&json)?;
+    app::atomic::write_atomic(&b.out.join("bench.json"), |w| {
+        w.write_all(json_text.as_bytes())
+    })?;
+
+    // Markdown.
+    let scene_line = format!(
+        "{} solid voxels, {} stored bricks, {} full cells, {} materials, {} GPU bytes",
+        stats["solid_voxels"],
+        stats["stored_bricks"],
+        stats["full_cells"],
+        stats["materials"],
+        stats["gpu_bytes"]
+    );
+    let mut md = format!(
+        "device: {} ({}); clocks before / after (sm, max sm, memory, power, temperature): {} / {}\n\
+         scene: thesis, {}; path: {} keyframes over {:.1} s, {} frames, each the median of {} back-to-back dispatches (GPU timestamps); the sun circles at {}°/s\n\n",
+        ctx.name,
+        ctx.driver,
+        json["clocks_before"].as_str().unwrap_or("n/a"),
+        json["clocks_after"].as_str().unwrap_or("n/a"),
+        scene_line,
+        path.keyframes.len(),
+        path.duration(),
+        b.frames,
+        b.repeat,
+        path.sun_deg_per_s
+    );
+    md += "| preset | internal | min ms | median ms | p99 ms | max ms | mean ms | Mrays/s primary | secondary | shadow | all | rays/pixel | caps hit |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    for g in &gpu {
+        md += &format!(
+            "| {} | {}x{} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.2} | {} |\n",
+            g.preset.name,
+            g.width,
+            g.height,
+            row(&g.summary),
+            g.mrays_per_s.primary,
+            g.mrays_per_s.secondary,
+            g.mrays_per_s.shadow,
+            g.mrays_per_s.all,
+            g.rays_per_pixel.all,
+            g.traversal_caps_hit
+        );
+    }
+    if !cpu.is_empty() {
+        md += &format!(
+            "\nCPU reference ({threads} threads, wall clock):\n\n| preset | size | min ms | median ms | p99 ms | max ms | mean ms | Msamples/s |\n| --- | --- | --- | --- | --- | --- | --- | --- |\n"
+        );
+        for c in &cpu {
+            md += &format!(
+                "| {} | {}x{} | {} | {:.3} |\n",
+                c.preset.name,
+                c.width,
+                c.height,
+                row(&c.summary),
+                c.msamples_per_s
+            );
+        }
+    }
+    if !edits.is_empty() {
+        md += "\nSculpting while the path plays (complexity 3, 1 spp per frame; one sphere per edit; median / p99 / max):\n\n| radius | internal | edits | apply ms | uploaded bytes per frame | per edit | GPU frame ms | latency frames | latency ms |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+        for e in &edits {
+            let m =
+                |s: &Summary, d: usize| format!("{:.d$} / {:.d$} / {:.d$}", s.median, s.p99, s.max);
+            md += &format!(
+                "| {} | {}x{} | {} | {} | {} | {} | {} | {} | {} |\n",
+                e.radius,
+                e.width,
+                e.height,
+                e.edits,
+                m(&e.apply_ms, 2),
+                m(&e.uploaded_bytes_per_frame, 0),
+                m(&e.uploaded_bytes_per_edit, 0),
+                m(&e.frame_ms, 3),
+                m(&e.latency_frames, 0),
+                m(&e.latency_ms, 2)
+            );
+        }
+    }
+    app::atomic::write_atomic(&b.out.join("bench.md"), |w| w.write_all(md.as_bytes()))?;
+
+    // Plots: frame time along the path, one per resolution (and the CPU's).
+    for &size in &b.sizes {
+        let series: Vec<Series> = gpu
+            .iter()
+            .filter(|g| (g.width, g.height) == size)
+            .map(|g| Series {
+                name: g.preset.name.to_string(),
+                points: g
+                    .path_time_s
+                    .iter()
+                    .copied()
+                    .zip(g.frame_ms.iter().copied())
+                    .collect(),
+            })
+            .collect();
+        line_plot(
+            &b.out.join(format!("frame_time_{}x{}.png", size.0, size.1)),
+            (1000, 560),
+            &format!("{} — thesis path at {}x{}", ctx.name, size.0, size.1),
+            ("path time (s)", "GPU frame time (ms)"),
+            &series,
+        )?;
+    }
+    if !cpu.is_empty() {
+        let series: Vec<Series> = cpu
+            .iter()
+            .map(|c| Series {
+                name: c.preset.name.to_string(),
+                points: c
+                    .path_time_s
+                    .iter()
+                    .copied()
+                    .zip(c.frame_ms.iter().copied())
+                    .collect(),
+            })
+            .collect();
+        line_plot(
+            &b.out.join("frame_time_cpu.png"),
+            (1000, 560),
+            &format!(
+                "CPU reference ({threads} threads) — thesis path at {}x{}",
+                b.cpu_size.0, b.cpu_size.1
+            ),
+            ("path time (s)", "frame time (ms, wall clock)"),
+            &series,
+        )?;
+    }
+    if ctx.validation_errors() > 0 {
+        bail!("{} validation errors", ctx.validation_errors());
+    }
+    Ok(md)
+}
