@@ -217,9 +217,6 @@ int entry_axis(ivec3 cell) {
     return axis;
 }
 
-// One entry for every ray, so a shader that calls only this has a single copy of the
-// traversal: from anywhere (the camera; finds its first cell in the grid) when `from_origin`,
-// else leaving a surface from the known `cell` at t = 0 (no epsilon offsets).
 // The time a ray from `o` enters the grid's box (0 inside it; infinite or NaN: never).
 float entry_time(vec3 o) {
     float t = 0.0;
@@ -236,51 +233,74 @@ float entry_time(vec3 o) {
     return t;
 }
 
-// Beyond this many voxels outside the grid a ray from the origin first moves to just before
+// Beyond this many voxels outside the grid trace_any first moves a ray's origin to just before
 // the grid (as brickmap::Ray::near_grid does): crossing times from a far origin carry its f32
 // rounding (half a voxel at 4·10⁶), and the walk's comparisons would order crossings wrongly.
 const float FAR_ORIGIN = 1024.0;
 
+// One entry for every ray, so a shader that calls only this has a single copy of the
+// traversal: from anywhere (the camera; finds its first cell in the grid) when `from_origin`,
+// else leaving a surface from the known `cell` at t = 0 (no epsilon offsets).
 bool trace(vec3 o, vec3 d, bool from_origin, ivec3 cell, int medium, float t_max, out ivec3 voxel, out ivec3 normal, out float t_hit) {
     set_ray(o, d);
     float t = 0.0;
-    float shift = 0.0;
     if (from_origin) {
         t = entry_time(o);
         if (isinf(t) || isnan(t)) return false;
-        vec3 outside = max(-o, o - vec3(g_size));
-        if (max(outside.x, max(outside.y, outside.z)) > FAR_ORIGIN) {
-            vec3 ad = abs(d);
-            shift = max(t - 2.0 / max(ad.x, max(ad.y, ad.z)), 0.0);
-            // o + shift·d without the rounding of o's magnitude: the product's and the sum's
-            // errors recovered exactly (Dekker's product with Veltkamp's split, Knuth's
-            // two-sum; `precise` forbids contraction and reassociation; Vulkan does not
-            // promise a fused fma()) and added back near the grid.
-            // Scaled by a power of two first (exact), so the split cannot overflow.
-            int e;
-            frexp(max(ad.x, max(ad.y, ad.z)), e);
-            precise vec3 ds = ldexp(d, ivec3(-e));
-            precise float ss = ldexp(shift, e);
-            precise vec3 prod = ss * ds;
-            precise float cs = 4097.0 * ss;
-            precise float sh = cs - (cs - ss);
-            precise float sl = ss - sh;
-            precise vec3 cd = 4097.0 * ds;
-            precise vec3 dh = cd - (cd - ds);
-            precise vec3 dl = ds - dh;
-            precise vec3 prod_err = ((sh * dh - prod) + sh * dl + sl * dh) + sl * dl;
-            precise vec3 sum = o + prod;
-            precise vec3 bb = sum - o;
-            precise vec3 sum_err = (o - (sum - bb)) + (prod - bb);
-            precise vec3 near = sum + (prod_err + sum_err);
-            set_ray(near, d);
-            t = entry_time(g_o);
-            if (isinf(t) || isnan(t)) return false;
-        }
         cell = ivec3(cell_at(0, t, false), cell_at(1, t, false), cell_at(2, t, false));
     }
-    bool hit = dda(cell, t, entry_axis(cell), medium, t_max - shift, voxel, normal, t_hit);
-    t_hit += shift;
+    return dda(cell, t, entry_axis(cell), medium, t_max, voxel, normal, t_hit);
+}
+
+// Direction components below f32's least normal count as zero (Vulkan lets a device flush
+// denormals; trace_any flushes them itself, so all devices agree).
+const float LEAST_NORMAL = 1.17549435e-38;
+
+// `trace` from the origin for any finite ray (shaders/primary.comp, `voxbrick stress`):
+// denormal direction components flushed; the direction scaled by a power of two (exact) so
+// its largest component is in [0.5, 1) (crossing times of huge directions would underflow,
+// of tiny ones overflow); an origin farther than FAR_ORIGIN outside the grid moved exactly
+// to just before it. The path tracer's rays are unit vectors from nearby origins and skip
+// this conditioning (measured: +7% GPU time on the thesis complexities 2 and 3 if every
+// ray paid for it).
+bool trace_any(vec3 o, vec3 d, int medium, out ivec3 voxel, out ivec3 normal, out float t_hit) {
+    d = mix(d, vec3(0.0), lessThan(abs(d), vec3(LEAST_NORMAL)));
+    vec3 ad = abs(d);
+    float dmax = max(ad.x, max(ad.y, ad.z));
+    int e = 0;
+    frexp(dmax, e);
+    d = ldexp(d, ivec3(-e));
+    ad = abs(d);
+    set_ray(o, d);
+    float t = entry_time(o);
+    if (isinf(t) || isnan(t)) return false;
+    float shift = 0.0;
+    vec3 outside = max(-o, o - vec3(g_size));
+    if (max(outside.x, max(outside.y, outside.z)) > FAR_ORIGIN) {
+        shift = max(t - 2.0 / max(ad.x, max(ad.y, ad.z)), 0.0);
+        // o + shift·d without the rounding of o's magnitude: the product's and the sum's
+        // errors recovered exactly (Dekker's product with Veltkamp's split, Knuth's two-sum;
+        // `precise` forbids contraction and reassociation; Vulkan does not promise a fused
+        // fma()) and added back near the grid. |d| < 1 here, so the split cannot overflow.
+        precise vec3 prod = shift * d;
+        precise float cs = 4097.0 * shift;
+        precise float sh = cs - (cs - shift);
+        precise float sl = shift - sh;
+        precise vec3 cd = 4097.0 * d;
+        precise vec3 dh = cd - (cd - d);
+        precise vec3 dl = d - dh;
+        precise vec3 prod_err = ((sh * dh - prod) + sh * dl + sl * dh) + sl * dl;
+        precise vec3 sum = o + prod;
+        precise vec3 bb = sum - o;
+        precise vec3 sum_err = (o - (sum - bb)) + (prod - bb);
+        precise vec3 near = sum + (prod_err + sum_err);
+        set_ray(near, d);
+        t = entry_time(g_o);
+        if (isinf(t) || isnan(t)) return false;
+    }
+    ivec3 cell = ivec3(cell_at(0, t, false), cell_at(1, t, false), cell_at(2, t, false));
+    bool hit = dda(cell, t, entry_axis(cell), medium, 1.0 / 0.0, voxel, normal, t_hit);
+    t_hit = ldexp(t_hit + shift, -e);
     return hit;
 }
 

@@ -22,7 +22,7 @@ void main() {
     ivec3 normal;
     float t;
     g_capped = 0u;
-    if (trace_from_origin(rays[2 * i].xyz, rays[2 * i + 1].xyz, int(pc.medium) - 1, 1.0 / 0.0, voxel, normal, t)) {
+    if (trace_any(rays[2 * i].xyz, rays[2 * i + 1].xyz, int(pc.medium) - 1, voxel, normal, t)) {
         hits[2 * i] = vec4(vec3(voxel), t);
         hits[2 * i + 1] = vec4(vec3(normal), float(g_capped));
     } else {

@@ -9,7 +9,8 @@
 //! [`tolerance`] = 4 ulps of f32 at the largest coordinate involved (the ray's origin unless
 //! it is farther than [`FAR_ORIGIN`] outside, the hit points, the grid's far corner), compared
 //! with distances to voxel boxes in the max norm; hit parameters are compared as |Δt| ·
-//! max|dᵢ| with 4 ulps of t added.
+//! max|dᵢ| with 4 ulps of t (and f32's least normal, a t that small may be flushed) added.
+//! Direction components below f32's least normal are zero for both ([`flush_denormals`]).
 
 use super::Rng;
 use brickmap::{Ray, RayHit, WorldView};
@@ -403,7 +404,8 @@ pub fn judge(
     let t_scale = cpu
         .map_or(0.0, |c| c.t)
         .max(gpu.map_or(0.0, |g| g.t as f64));
-    let eps_t = eps + tolerance(&[t_scale]) * dmax;
+    // A t below f32's least normal may come back as 0 (flushed).
+    let eps_t = eps + (tolerance(&[t_scale]) + f32::MIN_POSITIVE as f64) * dmax;
     match (cpu, gpu) {
         (None, None) => return Verdict::Exact,
         (Some(c), Some(g))
@@ -456,6 +458,16 @@ pub fn judge(
     if ok { Verdict::Tie } else { Verdict::Mismatch }
 }
 
+/// The direction the GPU traverses: components below f32's least normal are zero
+/// (`LEAST_NORMAL` in shaders/brickmap.glsl; Vulkan lets devices flush denormals, so the
+/// traversal does it on every device).
+pub fn flush_denormals(d: Vec3) -> Vec3 {
+    Vec3::from_array(
+        d.to_array()
+            .map(|c| if c.abs() < f32::MIN_POSITIVE { 0.0 } else { c }),
+    )
+}
+
 /// One ray and both answers, with the exact bits of the ray.
 fn describe(o: Vec3, d: Vec3, cpu: Option<RayHit>, gpu: Option<GpuHit>) -> String {
     format!(
@@ -490,7 +502,7 @@ pub fn tally(
                         t.tried += 1;
                         let ray = Ray {
                             origin: o.as_dvec3(),
-                            dir: d.as_dvec3(),
+                            dir: flush_denormals(d).as_dvec3(),
                         };
                         let cpu = match brickmap::cast(view, &ray, f64::INFINITY) {
                             Ok(c) => c,
