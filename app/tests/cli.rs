@@ -252,3 +252,83 @@ fn stress_on_the_cpu_reference_writes_its_report() {
     assert_eq!(std::fs::read_to_string(dir.join("stress.md")).unwrap(), out);
     fails(&["stress", "--rays", "-3"]);
 }
+
+#[test]
+fn bench_plays_the_path_and_writes_its_report() {
+    let dir = scratch("bench");
+    let out = voxbrick(&[
+        "bench",
+        "--sizes",
+        "32x18",
+        "--frames",
+        "3",
+        "--repeat",
+        "1",
+        "--presets",
+        "complexity-1,physical",
+        "--cpu-size",
+        "8x4",
+        "--cpu-frames",
+        "2",
+        "--edit-radii",
+        "16",
+        "--edit-frames",
+        "2",
+        "--out",
+        s(&dir),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success()
+        && err.contains("no usable Vulkan device")
+        && std::env::var("VOXBRICK_REQUIRE_GPU").as_deref() != Ok("1")
+    {
+        eprintln!(
+            "SKIPPED: no Vulkan driver on this machine; VOXBRICK_REQUIRE_GPU=1 makes this a failure"
+        );
+        return;
+    }
+    assert!(out.status.success(), "{err}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("bench.json")).unwrap()).unwrap();
+    let gpu = v["gpu"].as_array().unwrap();
+    assert_eq!(gpu.len(), 2, "two presets at one size");
+    for g in gpu {
+        let ms = g["frame_ms"].as_array().unwrap();
+        assert_eq!(ms.len(), 3);
+        assert!(ms.iter().all(|m| m.as_f64().unwrap() > 0.0));
+        assert_eq!(
+            g["path_time_s"][2], 20.0,
+            "the last frame is the path's end"
+        );
+        assert!(g["rays_per_pixel"]["primary"].as_f64().unwrap() >= 1.0);
+    }
+    // Physical traces more rays per pixel than complexity 1.
+    assert!(
+        gpu[1]["rays_per_pixel"]["all"].as_f64().unwrap()
+            > gpu[0]["rays_per_pixel"]["all"].as_f64().unwrap()
+    );
+    assert_eq!(v["cpu"].as_array().unwrap().len(), 2);
+    let edit = &v["editing"][0];
+    assert_eq!(edit["edits"], 2);
+    assert!(
+        edit["uploaded_bytes_per_edit"]["min"].as_f64().unwrap() > 0.0,
+        "each edit uploads"
+    );
+    for f in [
+        "bench.md",
+        "frame_time_32x18.png",
+        "frame_time_cpu.png",
+        "views/t00.0s.png",
+        "views/t20.0s.png",
+    ] {
+        assert!(dir.join(f).is_file(), "{f}");
+    }
+    let png = std::fs::read(dir.join("frame_time_32x18.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    // Bad arguments: one line, nothing written.
+    let bad = scratch("bench-bad");
+    fails(&["bench", "--sizes", "0x5", "--out", s(&bad)]);
+    fails(&["bench", "--presets", "complexity-9", "--out", s(&bad)]);
+    fails(&["bench", "--path", "/no/such/path.ron", "--out", s(&bad)]);
+    assert_eq!(std::fs::read_dir(&bad).unwrap().count(), 0);
+}
