@@ -303,7 +303,3 @@ bool trace_any(vec3 o, vec3 d, int medium, out ivec3 voxel, out ivec3 normal, ou
     t_hit = ldexp(t_hit + shift, -e);
     return hit;
 }
-
-bool trace_from_origin(vec3 o, vec3 d, int medium, float t_max, out ivec3 voxel, out ivec3 normal, out float t_hit) {
-    return trace(o, d, true, ivec3(0), medium, t_max, voxel, normal, t_hit);
-}

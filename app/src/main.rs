@@ -670,16 +670,13 @@ fn run(cli: Cli) -> Result<()> {
                 cpu_renders,
                 seed,
             };
-            let text = cli::stress::stress(
-                cli::stress::Stress {
-                    config,
-                    cpu_only: device == "cpu",
-                    device,
-                    out,
-                    validation,
-                },
-                workers,
-            )?;
+            let text = cli::stress::stress(cli::stress::Stress {
+                config,
+                cpu_only: device == "cpu",
+                device,
+                out,
+                validation,
+            })?;
             emit(&text)
         }
         Command::Info { file } => {

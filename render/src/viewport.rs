@@ -227,7 +227,8 @@ impl Viewport {
     /// The first solid voxel along each ray (origin, direction) in air, or with `medium` the
     /// first voxel that is not that dielectric, by the tracer's own traversal
     /// (`shaders/brickmap.glsl` through `shaders/primary.comp`), and the iteration caps the
-    /// traversals hit. The world is the one last uploaded (`trace_frame` or `sync_world`).
+    /// traversals hit. The world is the GPU's copy: as uploaded when the session was made and by
+    /// each `trace_frame` since.
     pub fn first_hits(
         &mut self,
         rays: &[(glam::Vec3, glam::Vec3)],

@@ -93,25 +93,19 @@ pub(crate) struct Summary {
 }
 
 impl Summary {
+    /// Min, median, p99 and max by `bench_viewport::stats`' order statistics, and the mean.
     pub(crate) fn of(v: &[f64]) -> Summary {
-        let mut s = v.to_vec();
-        s.sort_by(f64::total_cmp);
-        if s.is_empty() {
-            return Summary {
-                min: f64::NAN,
-                median: f64::NAN,
-                p99: f64::NAN,
-                max: f64::NAN,
-                mean: f64::NAN,
-            };
-        }
-        let q = |p: f64| s[((s.len() - 1) as f64 * p).round() as usize];
+        let (min, median, p99, max) = super::bench_viewport::stats(v.to_vec());
         Summary {
-            min: s[0],
-            median: q(0.5),
-            p99: q(0.99),
-            max: s[s.len() - 1],
-            mean: s.iter().sum::<f64>() / s.len() as f64,
+            min,
+            median,
+            p99,
+            max,
+            mean: if v.is_empty() {
+                f64::NAN
+            } else {
+                v.iter().sum::<f64>() / v.len() as f64
+            },
         }
     }
 }

@@ -33,7 +33,7 @@ fn scaled((w, h): (u32, u32), f: f32) -> (u32, u32) {
     )
 }
 
-fn stats(mut v: Vec<f64>) -> (f64, f64, f64, f64) {
+pub(crate) fn stats(mut v: Vec<f64>) -> (f64, f64, f64, f64) {
     v.sort_by(f64::total_cmp);
     if v.is_empty() {
         return (f64::NAN, f64::NAN, f64::NAN, f64::NAN);

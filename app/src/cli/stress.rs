@@ -86,8 +86,7 @@ fn markdown(device: &str, cfg: &StressConfig, rays: &[RayRow], images: &[ImageRo
     t
 }
 
-pub(crate) fn stress(s: Stress, workers: usize) -> Result<String> {
-    let _ = workers; // the suite's worlds use the default worker count
+pub(crate) fn stress(s: Stress) -> Result<String> {
     let cfg = s.config;
     let ctx = if s.cpu_only {
         None
