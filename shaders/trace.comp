@@ -38,6 +38,9 @@ layout(constant_id = 9) const bool SHADOW_QUEUE = false;
 // Next-event estimation of emissive voxels (shaders/lights.glsl): the scene has light faces
 // and light sampling is on. Without it emissive voxels are found by BSDF rays only.
 layout(constant_id = 10) const bool LIGHTS = false;
+// The numbers paths are made from: independent (a hash chain) or Owen-scrambled Sobol
+// points, padded in pairs of dimensions (Sequence::Sobol).
+layout(constant_id = 11) const bool SOBOL = false;
 
 // Without dielectrics every ray travels in air: the traversal drops its medium branch.
 #define MEDIUM_POSSIBLE HAS_DIELECTRIC
@@ -86,9 +89,70 @@ uint hash(uint x) {
     x = ((x >> ((x >> 28u) + 4u)) ^ x) * 277803737u;
     return (x >> 22u) ^ x;
 }
+// Sobol: the sample's index in the pixel's sequence, the pixel's (and render's) scrambling
+// seed, the next dimension, and the last pair of dimensions made.
+uint sob_index;
+uint sob_seed;
+uint sob_dim;
+uint sob_pair;
+vec2 sob_xy;
+
+// Burley 2020, "Practical Hash-based Owen Scrambling": a hash whose output bit j depends only
+// on input bits ≤ j (Laine and Karras), applied to the bit-reversed value, is a nested
+// uniform (Owen) scramble. Of an index below 2^k it stays in one aligned block of 2^k.
+uint owen_scramble(uint x, uint seed) {
+    x = bitfieldReverse(x);
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return bitfieldReverse(x);
+}
+
+// The second Sobol dimension (primitive polynomial x + 1: direction numbers v_1 = 1/2,
+// v_k = v_{k-1} ^ (v_{k-1} >> 1)); the first is the bit-reversed index. Its generator matrix
+// is Pascal's triangle mod 2: bit j (from the top) of the point is the coefficient of x^j in
+// i(x + 1), where i(x) has the index's bits as coefficients. The Taylor shift by 1 over GF(2)
+// takes five steps: within blocks of 2, 4 … 32 coefficients, the low half ^= the high half
+// (the 32-step loop over direction numbers cost 5–14 % of a frame on the H200).
+uint sobol_1(uint i) {
+    i ^= (i >> 1) & 0x55555555u;
+    i ^= (i >> 2) & 0x33333333u;
+    i ^= (i >> 4) & 0x0f0f0f0fu;
+    i ^= (i >> 8) & 0x00ff00ffu;
+    i ^= (i >> 16) & 0x0000ffffu;
+    return bitfieldReverse(i);
+}
+
+// Where the next numbers come from: dimension d of the sample's point (no-op for
+// independent numbers). Each vertex has its own dimensions (vertex_dims), so a pair of them
+// samples the same decision in every sample of the pixel.
+void dims(uint d) {
+    sob_dim = d;
+}
+uint vertex_dims(uint vertex) {
+    return 2u + 8u * (vertex - 1u);
+}
+
 float rand() {
-    rng = hash(rng);
-    return float(rng >> 8) * (1.0 / 16777216.0);
+    if (!SOBOL) {
+        rng = hash(rng);
+        return float(rng >> 8) * (1.0 / 16777216.0);
+    }
+    uint d = sob_dim++;
+    uint pair = d >> 1;
+    if (pair != sob_pair) {
+        // The pair's own shuffle of the pixel's samples and its own scrambles: pairs are
+        // independent of each other, each pair's points a scrambled (0, 2)-sequence.
+        sob_pair = pair;
+        uint s = hash(sob_seed ^ hash(pair * 0x9e3779b9u + 0x7f4a7c15u));
+        uint i = owen_scramble(sob_index, s);
+        uint x = owen_scramble(bitfieldReverse(i), hash(s ^ 0xa511e9b3u));
+        uint y = owen_scramble(sobol_1(i), hash(s ^ 0x63d83595u));
+        sob_xy = vec2(float(x >> 8), float(y >> 8)) * (1.0 / 16777216.0);
+    }
+    return (d & 1u) == 0u ? sob_xy.x : sob_xy.y;
 }
 
 struct Shading { int kind; vec3 albedo; float param; };
@@ -308,6 +372,10 @@ float face_probability(int material, ivec3 voxel, ivec3 normal) {
 
 void begin_path(uvec2 px, uint index, uint s) {
     rng = hash(p.seed.x ^ hash(index * 9781u + (p.seed.z + s) * 6271u + 1u));
+    sob_index = p.seed.z + s;
+    sob_seed = hash(p.seed.x ^ hash(index * 9781u + 0x2545f491u));
+    sob_pair = 0xffffffffu;
+    dims(0u);
     float u = (2.0 * (float(px.x) + rand()) / float(p.image.x) - 1.0);
     float v = (1.0 - 2.0 * (float(px.y) + rand()) / float(p.image.y));
     if (p.cam_pos.w > 0.5) {
@@ -386,6 +454,7 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
             float rp = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
             f = 0.5 * (rs * rs + rp * rp);
         }
+        dims(vertex_dims(path_vertex) + 6u);
         if (rand() < f) {
             path_d = normalize(d + n * (2.0 * cos_i));
             path_start = front;
@@ -404,7 +473,9 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
         vec3 wo = vec3(dot(-d, ft), dot(-d, fb), dot(-d, n));
         path_start = front; // the shadow ray's first cell too
         bool delta = HAS_METAL && s.kind == METAL && s.param <= 0.0;
+        uint base = vertex_dims(path_vertex);
         if (SUN && !delta && p.sun_normal.w != 0.0 && (EXPERIMENT & 8u) == 0u) {
+            dims(base);
             float r = p.sun_centre.w * sqrt(rand());
             float phi = 2.0 * PI * rand();
             vec3 y = p.sun_centre.xyz + (p.sun_e1.xyz * cos(phi) + p.sun_e2.xyz * sin(phi)) * r;
@@ -429,11 +500,13 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
         path_lights = false;
         if (LIGHTS && !delta && path_medium == AIR && light_total() > 0.0) {
             path_lights = true;
+            dims(base + 2u);
             uint slot = sample_light(rand());
             ivec3 lv;
             uint lf;
             int lm;
             light_face(slot, lv, lf, lm);
+            dims(base + 4u);
             float u1 = rand();
             float u2 = rand();
             vec3 y = face_point(lv, lf, u1, u2);
@@ -462,6 +535,7 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
         vec3 wi;
         vec3 weight;
         float pdf;
+        dims(base + 6u);
         if (!sample_bsdf(s, wo, wi, weight, pdf)) return false;
         path_beta *= weight;
         path_pdf = pdf;
@@ -470,6 +544,7 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
     path_camera = false;
     if (path_vertex >= 4u) {
         float q = clamp(max(path_beta.r, max(path_beta.g, path_beta.b)), 0.05, 1.0);
+        dims(vertex_dims(path_vertex) + 3u);
         if (rand() >= q) return false;
         path_beta /= q;
     }

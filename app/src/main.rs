@@ -266,6 +266,39 @@ enum Command {
         #[arg(long, default_value = "bench-report")]
         out: PathBuf,
     },
+    /// Image error against samples and GPU time at views along the benchmark path: every
+    /// preset and sampling choice, relMSE and FLIP against a converged reference whose own
+    /// noise is measured, slope and bias checks, efficiency at equal error. Writes
+    /// error.csv, error.md, error.json and log-log plots; exits non-zero if a check fails.
+    BenchError {
+        /// Device name filter ("gpu": the best).
+        #[arg(long, default_value = "gpu")]
+        device: String,
+        /// A camera path file (RON; default: the built-in thesis path).
+        #[arg(long)]
+        path: Option<PathBuf>,
+        /// Path times of the views in seconds, comma-separated (default 0,9,15).
+        #[arg(long, value_delimiter = ',')]
+        views: Vec<f64>,
+        /// Image size, WxH.
+        #[arg(long, default_value = "512x288", value_parser = parse_resolution)]
+        size: (u32, u32),
+        /// Samples of each reference (at least 8 × --max-spp).
+        #[arg(long, default_value_t = 8192)]
+        reference_spp: u32,
+        /// The most samples per pixel measured (a power of two, 4 or more).
+        #[arg(long, default_value_t = 256)]
+        max_spp: u32,
+        /// The references' numbers: sobol (the renderer's default) or independent.
+        #[arg(long, default_value = "sobol", value_parser = parse_sequence)]
+        reference_sequence: render::Sequence,
+        /// Presets (complexity-1, complexity-2, complexity-3, physical, lamps; default all).
+        #[arg(long, value_delimiter = ',')]
+        presets: Vec<String>,
+        /// Folder for the report.
+        #[arg(long, default_value = "error-report")]
+        out: PathBuf,
+    },
     /// The numerical stress suite: random and adversarial rays through the GPU traversal
     /// against the exact CPU ray cast, and adversarial scenes' images (NaN, infinite and
     /// negative samples, white-furnace energy, iteration caps) on the GPU and the CPU
@@ -323,6 +356,14 @@ fn parse_ivec3(s: &str) -> Result<IVec3, String> {
     match v[..] {
         [x, y, z] => Ok(IVec3::new(x, y, z)),
         _ => Err(format!("{s:?}: expected three integers X,Y,Z")),
+    }
+}
+
+fn parse_sequence(s: &str) -> Result<render::Sequence, String> {
+    match s {
+        "sobol" => Ok(render::Sequence::Sobol),
+        "independent" => Ok(render::Sequence::Independent),
+        _ => Err(format!("{s:?} is not a sequence (sobol or independent)")),
     }
 }
 
@@ -645,6 +686,33 @@ fn run(cli: Cli) -> Result<()> {
                     cpu_frames,
                     edit_radii,
                     edit_frames: edit_frames.max(1),
+                    out,
+                },
+                workers,
+            )?;
+            emit(&text)
+        }
+        Command::BenchError {
+            device,
+            path,
+            views,
+            size,
+            reference_spp,
+            max_spp,
+            reference_sequence,
+            presets,
+            out,
+        } => {
+            let text = cli::bench_error::bench_error(
+                cli::bench_error::BenchError {
+                    device,
+                    path,
+                    views,
+                    size,
+                    reference_spp,
+                    max_spp,
+                    reference_sequence,
+                    presets,
                     out,
                 },
                 workers,

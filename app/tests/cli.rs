@@ -332,3 +332,108 @@ fn bench_plays_the_path_and_writes_its_report() {
     fails(&["bench", "--path", "/no/such/path.ron", "--out", s(&bad)]);
     assert_eq!(std::fs::read_dir(&bad).unwrap().count(), 0);
 }
+
+#[test]
+fn bench_error_measures_every_choice_against_a_checked_reference() {
+    let dir = scratch("bench-error");
+    let out = voxbrick(&[
+        "bench-error",
+        "--size",
+        "32x18",
+        "--reference-spp",
+        "128",
+        "--max-spp",
+        "8",
+        "--views",
+        "0",
+        "--presets",
+        "lamps",
+        "--out",
+        s(&dir),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success()
+        && err.contains("no usable Vulkan device")
+        && std::env::var("VOXBRICK_REQUIRE_GPU").as_deref() != Ok("1")
+    {
+        eprintln!(
+            "SKIPPED: no Vulkan driver on this machine; VOXBRICK_REQUIRE_GPU=1 makes this a failure"
+        );
+        return;
+    }
+    assert!(out.status.success(), "{err}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("error.json")).unwrap()).unwrap();
+    let cases = v["cases"].as_array().unwrap();
+    assert_eq!(cases.len(), 1);
+    assert_eq!(cases[0]["name"], "physical + lamps");
+    let view = &cases[0]["views"][0];
+    assert!(view["reference_noise"].as_f64().unwrap() > 0.0);
+    let curves = view["curves"].as_array().unwrap();
+    let named = |n: &str| {
+        curves
+            .iter()
+            .find(|c| c["name"] == n)
+            .unwrap_or_else(|| panic!("no curve {n}"))
+    };
+    for c in curves {
+        let spp: Vec<u64> = c["levels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|l| l["spp"].as_u64().unwrap())
+            .collect();
+        assert_eq!(spp, [1, 2, 4, 8], "{}", c["name"]);
+        assert!(c["ms_per_sample"].as_f64().unwrap() > 0.0);
+        assert_eq!(c["passed"], true, "{}", c["name"]);
+        // Choices that only schedule samples otherwise render the defaults' image.
+        if let Some(same) = c["same_image_rel_mse"].as_f64() {
+            assert!(same < 1e-10, "{}: {same}", c["name"]);
+        }
+    }
+    let rel = |c: &serde_json::Value, i: usize| c["levels"][i]["rel_mse"].as_f64().unwrap();
+    for n in ["defaults", "independent numbers", "no light sampling"] {
+        let c = named(n);
+        assert!(c["same_image_rel_mse"].is_null(), "{n} has its own curve");
+        assert!(
+            rel(c, 3) < rel(c, 0) / 4.0,
+            "{n}: the error falls with samples"
+        );
+    }
+    // Light sampling and Sobol numbers beat BSDF sampling and independent numbers at 8 spp.
+    assert!(rel(named("defaults"), 3) < rel(named("independent numbers"), 3));
+    assert!(rel(named("defaults"), 3) < rel(named("no light sampling"), 3));
+    let csv = std::fs::read_to_string(dir.join("error.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 4 * curves.len());
+    for f in [
+        "error.md",
+        "relmse_spp_physical___lamps.png",
+        "relmse_time_physical___lamps.png",
+        "flip_spp_physical___lamps.png",
+        "reference_physical___lamps_t00.0s.png",
+    ] {
+        assert!(dir.join(f).is_file(), "{f}");
+    }
+    // Bad arguments: one line, nothing written.
+    let bad = scratch("bench-error-bad");
+    fails(&["bench-error", "--max-spp", "6", "--out", s(&bad)]);
+    fails(&[
+        "bench-error",
+        "--max-spp",
+        "8",
+        "--reference-spp",
+        "32",
+        "--out",
+        s(&bad),
+    ]);
+    fails(&["bench-error", "--views", "99", "--out", s(&bad)]);
+    fails(&["bench-error", "--presets", "nope", "--out", s(&bad)]);
+    fails(&[
+        "bench-error",
+        "--reference-sequence",
+        "halton",
+        "--out",
+        s(&bad),
+    ]);
+    assert_eq!(std::fs::read_dir(&bad).unwrap().count(), 0);
+}

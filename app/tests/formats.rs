@@ -104,6 +104,22 @@ fn project_round_trips_everything() {
 }
 
 #[test]
+fn the_sample_sequence_is_saved_and_older_projects_load_with_the_default() {
+    let mut scene = default_scene(SceneSize::Small, 2).unwrap();
+    scene.params.settings.sequence = render::Sequence::Independent;
+    let text = project::to_string(&scene);
+    assert!(text.contains("sequence: Independent"), "{}", &text[..800]);
+    let p = Path::new("test.ron");
+    let back = project::from_bytes(text.as_bytes(), p, 2).unwrap();
+    assert_eq!(back.params.settings.sequence, render::Sequence::Independent);
+    // A project written before the setting existed: the default, scrambled Sobol.
+    let old = text.replacen(", sequence: Independent", "", 1);
+    assert!(!old.contains("sequence:"));
+    let back = project::from_bytes(old.as_bytes(), p, 2).unwrap();
+    assert_eq!(back.params.settings.sequence, render::Sequence::Sobol);
+}
+
+#[test]
 fn versions_and_hostile_files_are_clear_errors() {
     let scene = default_scene(SceneSize::Small, 2).unwrap();
     let text = project::to_string(&scene);

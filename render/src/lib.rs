@@ -12,4 +12,6 @@ pub mod viewport;
 pub mod vulkan;
 
 pub use image::Image;
-pub use params::{Camera, ParamError, Projection, RenderSettings, SceneParams, Sky, Sun, SunDisc};
+pub use params::{
+    Camera, ParamError, Projection, RenderSettings, SceneParams, Sequence, Sky, Sun, SunDisc,
+};

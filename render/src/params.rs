@@ -343,6 +343,23 @@ pub struct RenderSettings {
     pub internal_resolution: (u32, u32),
     /// Exposure in stops.
     pub exposure: f32,
+    /// The numbers the samples are made from (projects from before it: independent).
+    #[serde(default)]
+    pub sequence: Sequence,
+}
+
+/// The numbers a path's random decisions are made from (`voxbrick bench-error` measures
+/// both; Sobol reaches equal error in 1.3–3× less GPU time on the H200, so it is the default,
+/// also for projects saved before the choice existed).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Sequence {
+    /// Independent uniform numbers (a hash chain per pixel and sample).
+    Independent,
+    /// Owen-scrambled Sobol points, padded in pairs of dimensions (Burley 2020): stratified
+    /// over a pixel's samples, still unbiased (each render's scrambling is random). The CPU
+    /// reference always uses independent numbers.
+    #[default]
+    Sobol,
 }
 
 impl RenderSettings {
@@ -415,6 +432,7 @@ impl SceneParams {
                 max_bounces: 3,
                 internal_resolution: (1024, 576),
                 exposure: 0.0,
+                sequence: Sequence::default(),
             },
         }
     }

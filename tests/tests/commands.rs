@@ -151,6 +151,7 @@ fn every_command() -> Vec<Command> {
             max_bounces: 5,
             internal_resolution: (640, 360),
             exposure: 1.5,
+            sequence: render::Sequence::Sobol,
         }),
         Command::SetPalette((0..256).map(|i| [i as u8, 7, 255 - i as u8]).collect()),
         Command::GenerateTerrain(TerrainSpec {

@@ -183,7 +183,7 @@ fn scene_stats(scene: &Scene) -> serde_json::Value {
 }
 
 /// The GPU's clocks from nvidia-smi, where there is one.
-fn clocks() -> Option<String> {
+pub(crate) fn clocks() -> Option<String> {
     let out = std::process::Command::new("nvidia-smi")
         .args([
             "--query-gpu=clocks.sm,clocks.max.sm,clocks.mem,power.draw,temperature.gpu",
@@ -196,8 +196,26 @@ fn clocks() -> Option<String> {
         .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
 }
 
+/// The presets named in `names` (all when empty; "complexity-1" or "complexity 1").
+pub(crate) fn select_presets(names: &[String]) -> Result<Vec<Preset>> {
+    let presets: Vec<Preset> = PRESETS
+        .iter()
+        .filter(|p| {
+            names.is_empty()
+                || names
+                    .iter()
+                    .any(|n| n == p.name || n.replace('-', " ") == p.name)
+        })
+        .copied()
+        .collect();
+    if presets.is_empty() {
+        bail!("no preset named {names:?} (complexity-1, complexity-2, complexity-3, physical)");
+    }
+    Ok(presets)
+}
+
 /// The scene's parameters for `preset` at path time `t`.
-fn params_at(
+pub(crate) fn params_at(
     base: &SceneParams,
     path: &CameraPath,
     preset: &Preset,
@@ -455,22 +473,7 @@ pub(crate) fn bench(b: Bench, workers: usize) -> Result<String> {
         Some(p) => CameraPath::load(p)?,
         None => CameraPath::thesis(),
     };
-    let presets: Vec<Preset> = PRESETS
-        .iter()
-        .filter(|p| {
-            b.presets.is_empty()
-                || b.presets
-                    .iter()
-                    .any(|n| n == p.name || n.replace('-', " ") == p.name)
-        })
-        .copied()
-        .collect();
-    if presets.is_empty() {
-        bail!(
-            "no preset named {:?} (complexity-1, complexity-2, complexity-3, physical)",
-            b.presets
-        );
-    }
+    let presets = select_presets(&b.presets)?;
     let mut scene = app::scene::thesis_scene(workers)?;
     // The path's sun circles the scene; the scene's own sun gives its height and distance.
     scene.params.sun.animate = true;

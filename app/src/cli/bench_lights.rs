@@ -16,18 +16,8 @@ use render::vulkan::trace::Variant;
 use render::{Camera, Image, Sky};
 use std::time::Instant;
 
-/// relMSE's ε: mean over pixel channels of (x − r)² / (r² + ε).
-const EPSILON: f64 = 1e-2;
-
 fn rel_mse(image: &Image, reference: &Image) -> f64 {
-    let mut sum = 0.0;
-    for (a, r) in image.pixels.iter().zip(&reference.pixels) {
-        for k in 0..3 {
-            let (a, r) = (a[k] as f64, r[k] as f64);
-            sum += (a - r).powi(2) / (r * r + EPSILON);
-        }
-    }
-    sum / (3 * image.pixels.len()) as f64
+    render::convergence::rel_mse(image, reference).unwrap_or(f64::NAN)
 }
 
 fn lamp(scene: &Scene, strength: f32, rgb: [u8; 3]) -> Result<u8> {

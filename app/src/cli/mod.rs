@@ -1,6 +1,7 @@
 //! Subcommands of the `voxbrick` binary, one file each, and the helpers they share.
 
 pub mod bench;
+pub mod bench_error;
 pub mod bench_gpu;
 pub mod bench_lights;
 pub mod bench_viewport;

@@ -323,6 +323,17 @@ pub fn draw(
                     )
                     .changed()
                 {
+                    out.push(UiEvent::SetSettings(settings.clone()));
+                }
+                let before = settings.sequence;
+                egui::ComboBox::from_label("sample numbers (scene)")
+                    .selected_text(sequence_name(before))
+                    .show_ui(ui, |ui| {
+                        for q in [render::Sequence::Sobol, render::Sequence::Independent] {
+                            ui.selectable_value(&mut settings.sequence, q, sequence_name(q));
+                        }
+                    });
+                if settings.sequence != before {
                     out.push(UiEvent::SetSettings(settings));
                 }
                 ui.add(
@@ -544,4 +555,12 @@ pub(super) fn window(area: egui::Rect, title: &str) -> egui::Window<'_> {
         .constrain_to(area)
         .max_height(area.height() - 40.0)
         .vscroll(true)
+}
+
+/// What the render settings call a sample sequence.
+fn sequence_name(q: render::Sequence) -> &'static str {
+    match q {
+        render::Sequence::Sobol => "scrambled Sobol",
+        render::Sequence::Independent => "independent random",
+    }
 }

@@ -2,7 +2,7 @@
 //! and the adversarial image scenes, white furnaces among them.
 
 use super::Rng;
-use crate::{Camera, RenderSettings, SceneParams, Sky, Sun};
+use crate::{Camera, RenderSettings, SceneParams, Sequence, Sky, Sun};
 use brickmap::{
     EditOp, GridDims, Material, MaterialKind, Mode, Shape, VoxelEdit, VoxelOp, World, WorldConfig,
 };
@@ -219,6 +219,7 @@ fn params(camera: Camera, sky: Sky, sun: Sun, bounces: u32) -> SceneParams {
             max_bounces: bounces,
             internal_resolution: (32, 32),
             exposure: 0.0,
+            sequence: Sequence::Independent,
         },
     }
 }

@@ -10,7 +10,7 @@ use super::pass::{ComputePass, Dispatch, SetCache, run_batch};
 use super::world::GpuWorld;
 use super::{GpuContext, GpuError};
 use crate::cpu::RenderJob;
-use crate::params::{SceneParams, Sky};
+use crate::params::{SceneParams, Sequence, Sky};
 use ash::vk;
 use brickmap::{MaterialKind, MaterialTable, WorldView};
 use glam::DVec3;
@@ -165,7 +165,7 @@ impl TraceParams {
     }
 }
 
-/// What a pipeline variant contains (`constant_id` 0..8 and 10 of shaders/trace.comp; 9, the shadow
+/// What a pipeline variant contains (`constant_id` 0..8, 10 and 11 of shaders/trace.comp; 9, the shadow
 /// queue, is the tracer's choice).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Variant {
@@ -190,6 +190,8 @@ pub struct Variant {
     pub count_rays: bool,
     /// Benchmark experiments (`EXPERIMENT` in trace.comp); 0 for real renders.
     pub experiment: u32,
+    /// The numbers samples are made from (`SEQUENCE` in trace.comp).
+    pub sequence: Sequence,
 }
 
 impl Variant {
@@ -215,6 +217,7 @@ impl Variant {
             max_bounces: params.settings.max_bounces.max(1),
             count_rays: false,
             experiment: 0,
+            sequence: params.settings.sequence,
         };
         for i in 0..materials.len() {
             if let Ok(m) = materials.get(i as u8) {
@@ -242,10 +245,11 @@ impl Variant {
             max_bounces: max_bounces.max(1),
             count_rays: false,
             experiment: 0,
+            sequence: Sequence::Independent,
         }
     }
 
-    fn constants(&self, shadow_queue: bool) -> [u32; 11] {
+    fn constants(&self, shadow_queue: bool) -> [u32; 12] {
         [
             self.lambertian as u32,
             self.metal as u32,
@@ -258,6 +262,7 @@ impl Variant {
             self.experiment,
             shadow_queue as u32,
             self.lights as u32,
+            (self.sequence == Sequence::Sobol) as u32,
         ]
     }
 }

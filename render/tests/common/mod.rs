@@ -6,7 +6,7 @@ use brickmap::{
     EditOp, GridDims, Material, MaterialKind, Mode, Shape, VoxelEdit, VoxelOp, World, WorldConfig,
 };
 use glam::{DVec3, IVec3};
-use render::{Camera, Image, RenderSettings, SceneParams, Sky, Sun};
+use render::{Camera, Image, RenderSettings, SceneParams, Sequence, Sky, Sun};
 
 pub fn params(camera: Camera, sky: Sky, sun: Option<Sun>, bounces: u32) -> SceneParams {
     SceneParams {
@@ -26,6 +26,7 @@ pub fn params(camera: Camera, sky: Sky, sun: Option<Sun>, bounces: u32) -> Scene
             max_bounces: bounces,
             internal_resolution: (32, 32),
             exposure: 0.0,
+            sequence: Sequence::Independent,
         },
     }
 }
