@@ -290,7 +290,7 @@ enum Command {
         #[arg(long, default_value_t = 256)]
         max_spp: u32,
         /// The references' numbers: sobol (the renderer's default) or independent.
-        #[arg(long, default_value = "sobol", value_parser = parse_sequence)]
+        #[arg(long, default_value = "sobol", value_parser = cli::parse_sequence)]
         reference_sequence: render::Sequence,
         /// Presets (complexity-1, complexity-2, complexity-3, physical, lamps; default all).
         #[arg(long, value_delimiter = ',')]
@@ -356,14 +356,6 @@ fn parse_ivec3(s: &str) -> Result<IVec3, String> {
     match v[..] {
         [x, y, z] => Ok(IVec3::new(x, y, z)),
         _ => Err(format!("{s:?}: expected three integers X,Y,Z")),
-    }
-}
-
-fn parse_sequence(s: &str) -> Result<render::Sequence, String> {
-    match s {
-        "sobol" => Ok(render::Sequence::Sobol),
-        "independent" => Ok(render::Sequence::Independent),
-        _ => Err(format!("{s:?} is not a sequence (sobol or independent)")),
     }
 }
 

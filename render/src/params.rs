@@ -349,7 +349,7 @@ pub struct RenderSettings {
 }
 
 /// The numbers a path's random decisions are made from (`voxbrick bench-error` measures
-/// both; Sobol reaches equal error in 1.3–3× less GPU time on the H200, so it is the default,
+/// both; Sobol reaches equal error in 1.6–3.2× less GPU time on the H200, so it is the default,
 /// also for projects saved before the choice existed).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum Sequence {

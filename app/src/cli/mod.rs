@@ -35,3 +35,12 @@ pub(crate) fn emit(text: &str) -> Result<()> {
         _ => Ok(()),
     }
 }
+
+/// A sample sequence's name on the command line: sobol or independent.
+pub(crate) fn parse_sequence(s: &str) -> Result<::render::Sequence, String> {
+    match s {
+        "sobol" => Ok(::render::Sequence::Sobol),
+        "independent" => Ok(::render::Sequence::Independent),
+        _ => Err(format!("{s:?} is not a sequence (sobol or independent)")),
+    }
+}

@@ -56,6 +56,10 @@ pub(crate) struct RenderArgs {
     /// (default: enough for 0.6 M invocations, where the device has float atomics).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8))]
     pub(crate) slices: Option<u32>,
+    /// GPU: the numbers samples are made from, sobol or independent (default: the scene's
+    /// setting; the CPU reference always uses independent numbers).
+    #[arg(long, value_parser = super::parse_sequence)]
+    pub(crate) sequence: Option<render::Sequence>,
 }
 
 pub(crate) fn render_command(a: RenderArgs, workers: usize) -> Result<()> {
@@ -92,6 +96,9 @@ pub(crate) fn render_command(a: RenderArgs, workers: usize) -> Result<()> {
             bail!("--bounces {b} is outside 1..=64");
         }
         params.settings.max_bounces = b;
+    }
+    if let Some(q) = a.sequence {
+        params.settings.sequence = q;
     }
     let view = scene.world.read();
     let internal = (
