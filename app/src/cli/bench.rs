@@ -196,6 +196,14 @@ pub(crate) fn clocks() -> Option<String> {
         .then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
 }
 
+/// A preset's frame times along the path, as a plot series.
+fn path_series(preset: &Preset, times: &[f64], ms: &[f64]) -> Series {
+    Series {
+        name: preset.name.to_string(),
+        points: times.iter().copied().zip(ms.iter().copied()).collect(),
+    }
+}
+
 /// The presets named in `names` (all when empty; "complexity-1" or "complexity 1").
 pub(crate) fn select_presets(names: &[String]) -> Result<Vec<Preset>> {
     let presets: Vec<Preset> = PRESETS
@@ -640,15 +648,7 @@ pub(crate) fn bench(b: Bench, workers: usize) -> Result<String> {
         let series: Vec<Series> = gpu
             .iter()
             .filter(|g| (g.width, g.height) == size)
-            .map(|g| Series {
-                name: g.preset.name.to_string(),
-                points: g
-                    .path_time_s
-                    .iter()
-                    .copied()
-                    .zip(g.frame_ms.iter().copied())
-                    .collect(),
-            })
+            .map(|g| path_series(&g.preset, &g.path_time_s, &g.frame_ms))
             .collect();
         line_plot(
             &b.out.join(format!("frame_time_{}x{}.png", size.0, size.1)),
@@ -661,15 +661,7 @@ pub(crate) fn bench(b: Bench, workers: usize) -> Result<String> {
     if !cpu.is_empty() {
         let series: Vec<Series> = cpu
             .iter()
-            .map(|c| Series {
-                name: c.preset.name.to_string(),
-                points: c
-                    .path_time_s
-                    .iter()
-                    .copied()
-                    .zip(c.frame_ms.iter().copied())
-                    .collect(),
-            })
+            .map(|c| path_series(&c.preset, &c.path_time_s, &c.frame_ms))
             .collect();
         line_plot(
             &b.out.join("frame_time_cpu.png"),
