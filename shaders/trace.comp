@@ -46,27 +46,7 @@ layout(constant_id = 11) const bool SOBOL = false;
 #define MEDIUM_POSSIBLE HAS_DIELECTRIC
 #define COUNT_STEPS COUNT_RAYS
 #include "brickmap.glsl"
-
-struct Params {
-    vec4 cam_pos;       // xyz
-    vec4 cam_forward;   // xyz
-    vec4 cam_right;     // xyz, scaled by tan(fov/2)·aspect
-    vec4 cam_up;        // xyz, scaled by tan(fov/2)
-    vec4 sun_centre;    // xyz, w: radius
-    vec4 sun_normal;    // xyz, w: 1 when the sun is on
-    vec4 sun_e1;
-    vec4 sun_e2;
-    vec4 sun_radiance;  // rgb
-    vec4 sky_horizon;   // rgb
-    vec4 sky_zenith;    // rgb, w: 1 for a gradient, 0 for uniform (horizon colour)
-    uvec4 grid;         // bricks xyz, coarse words per column
-    uvec4 image;        // width, height, samples per pixel and slice in this dispatch, B (the shader
-                        // uses the variant's MAX_BOUNCES; B is kept for the image key)
-    uvec4 seed;         // seed, camera medium (material + 1, 0 for air), first sample index,
-                        // 1 to add to the accumulation (0 to start it)
-};
-
-layout(std430, set = 0, binding = 5) readonly buffer ParamBuffer { Params p; };
+#include "scene.glsl"
 // Per pixel: the sum of its samples' radiance (rgb) and their count (a).
 layout(std430, set = 0, binding = 6) buffer Accum { vec4 accum[]; };
 // COUNT_RAYS variants only: camera rays, continuation rays, shadow rays, the traversal
@@ -76,12 +56,6 @@ layout(std430, set = 0, binding = 7) buffer Counters { uint counters[9]; };
 #include "shadow_queue.glsl"
 #include "lights.glsl"
 uint g_rays[6];
-
-const float PI = 3.14159265358979;
-const int LAMBERTIAN = 0;
-const int METAL = 1;
-const int DIELECTRIC = 2;
-const int EMISSIVE = 3;
 
 uint rng;
 uint hash(uint x) {
@@ -153,27 +127,6 @@ float rand() {
         sob_xy = vec2(float(x >> 8), float(y >> 8)) * (1.0 / 16777216.0);
     }
     return (d & 1u) == 0u ? sob_xy.x : sob_xy.y;
-}
-
-struct Shading { int kind; vec3 albedo; float param; };
-
-float srgb_to_linear(uint c) {
-    float x = float(c) / 255.0;
-    if ((EXPERIMENT & 2u) != 0u) return x * x;
-    return x <= 0.04045 ? x / 12.92 : pow((x + 0.055) / 1.055, 2.4);
-}
-
-Shading material(int index) {
-    uint v = (tables.packed_materials[index / 2] >> (16 * (index % 2))) & 0xFFFFu;
-    Shading s;
-    s.kind = int(v & 3u);
-    uint param = (v >> 2) & 63u;
-    uint colour = tables.colours[v >> 8];
-    s.albedo = vec3(srgb_to_linear(colour & 0xFFu), srgb_to_linear((colour >> 8) & 0xFFu), srgb_to_linear((colour >> 16) & 0xFFu));
-    s.param = HAS_METAL && s.kind == METAL ? tables.roughness[param]
-            : (HAS_DIELECTRIC && s.kind == DIELECTRIC ? tables.ior[param]
-            : (HAS_EMISSIVE && s.kind == EMISSIVE ? tables.strength[param] : 0.0));
-    return s;
 }
 
 vec3 sky(vec3 d) {
@@ -347,16 +300,6 @@ void add_shadow(vec3 d, float t, vec3 l, uint light_slot) {
     }
 }
 
-// The dielectric a camera ray starts in (AIR outside them): the same for every ray of a
-// perspective camera (found on the host), per ray for an orthographic one.
-int camera_medium(vec3 o) {
-    if (p.cam_pos.w < 0.5) return int(p.seed.y) - 1;
-    ivec3 c = ivec3(floor(o));
-    if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(p.grid.xyz) * 8))) return AIR;
-    int m = material_at(c);
-    return (m >= 0 && material(m).kind == DIELECTRIC) ? m : AIR;
-}
-
 bool solid_or_outside(ivec3 c) {
     if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(p.grid.xyz) * 8))) return true;
     return material_at(c) >= 0;
@@ -376,16 +319,8 @@ void begin_path(uvec2 px, uint index, uint s) {
     sob_seed = hash(p.seed.x ^ hash(index * 9781u + 0x2545f491u));
     sob_pair = 0xffffffffu;
     dims(0u);
-    float u = (2.0 * (float(px.x) + rand()) / float(p.image.x) - 1.0);
-    float v = (1.0 - 2.0 * (float(px.y) + rand()) / float(p.image.y));
-    if (p.cam_pos.w > 0.5) {
-        // Orthographic: parallel rays from the image plane through the camera's position.
-        path_o = p.cam_pos.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v;
-        path_d = p.cam_forward.xyz;
-    } else {
-        path_o = p.cam_pos.xyz;
-        path_d = normalize(p.cam_forward.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v);
-    }
+    float jx = rand();
+    camera_ray(vec2(px) + vec2(jx, rand()), path_o, path_d);
     path_beta = vec3(1.0);
     path_start = ivec3(0);
     path_medium = HAS_DIELECTRIC ? camera_medium(path_o) : AIR;

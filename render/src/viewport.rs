@@ -13,7 +13,10 @@ use crate::cpu::RenderJob;
 use crate::image::Image;
 use crate::params::SceneParams;
 use crate::vulkan::barrier::{after_earlier_passes, barrier};
+use crate::vulkan::buffer::{Binding, HostBuffer, read_device};
+use crate::vulkan::denoise::Denoiser;
 use crate::vulkan::frame::{FRAMES_IN_FLIGHT, FrameSlot};
+use crate::vulkan::pass::{SetCache, run_batch};
 use crate::vulkan::primary::{GpuHit, PrimaryTracer};
 use crate::vulkan::progressive::Progressive;
 use crate::vulkan::tonemap::ToneMapper;
@@ -42,6 +45,9 @@ pub struct FrameRequest<'a> {
     pub exposure: f32,
     /// Write the output in B, G, R, A byte order (for a B8G8R8A8 target).
     pub bgra: bool,
+    /// Display the denoised accumulation ([`crate::vulkan::denoise`]; a view setting, never
+    /// in reference renders).
+    pub denoise: bool,
 }
 
 /// What one interactive frame did.
@@ -83,6 +89,10 @@ pub struct Viewport {
     last_gpu_seconds: Option<f64>,
     /// Frames in a row that showed the previous image while an upload was incomplete.
     held: u32,
+    /// The edge-aware denoiser (made when first asked for).
+    denoiser: Option<Denoiser>,
+    /// The denoiser's output holds the live accumulation's filtered image.
+    denoised: bool,
     ctx: Arc<GpuContext>,
 }
 
@@ -144,6 +154,8 @@ impl Viewport {
             next: 0,
             last_gpu_seconds: None,
             held: 0,
+            denoiser: None,
+            denoised: false,
             ctx,
         })
     }
@@ -192,6 +204,96 @@ impl Viewport {
         let variant = variant.unwrap_or_else(|| Variant::for_scene(view, params));
         self.tracer
             .render_counted_variant(&self.ctx, &self.world, view, params, job, variant)
+    }
+
+    /// Renders `job` with `variant` as the viewport does with its denoiser on, one batch per
+    /// dispatch (the tracer's batch shape), and waits: the linear image, the denoised one,
+    /// and the filter's GPU time (the median of `timed` repetitions; None when the queue
+    /// cannot time or `timed` is 0).
+    pub fn render_denoised(
+        &mut self,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        job: &RenderJob,
+        variant: Variant,
+        timed: u32,
+    ) -> Result<(Image, Image, Option<f64>), GpuError> {
+        let ctx = self.ctx.clone();
+        // The denoiser's buffers may be the live accumulation's.
+        self.wait_idle()?;
+        if self.denoiser.is_none() {
+            self.denoiser = Some(Denoiser::new(&ctx)?);
+        }
+        self.denoised = false;
+        let size = (job.width, job.height);
+        let mut acc = Progressive::new(&ctx, size, size, job.seed)?;
+        let mut guide_params = match HostBuffer::new(
+            &ctx,
+            "guide params",
+            std::mem::size_of::<TraceParams>() as u64,
+            gpu_allocator::MemoryLocation::CpuToGpu,
+        ) {
+            Ok(b) => b,
+            Err(e) => {
+                acc.destroy(&ctx);
+                return Err(e);
+            }
+        };
+        guide_params.write(bytemuck::bytes_of(&TraceParams::new(view, params, job)));
+        let mut sets = match SetCache::new(&ctx) {
+            Ok(s) => s,
+            Err(e) => {
+                acc.destroy(&ctx);
+                guide_params.destroy(&ctx);
+                return Err(e);
+            }
+        };
+        let denoiser = self.denoiser.as_mut().expect("made above");
+        denoiser.invalidate();
+        let world = &*self.world;
+        let result = acc
+            .accumulate_with(
+                &ctx,
+                &mut self.tracer,
+                world,
+                view,
+                params,
+                variant,
+                job.spp,
+                |accum, first| {
+                    let mut recorded = Ok(());
+                    ctx.submit_and_wait(|cmd| {
+                        recorded = denoiser.record_batch(
+                            &ctx,
+                            cmd,
+                            &mut sets,
+                            world,
+                            guide_params.binding(),
+                            accum,
+                            size,
+                            first,
+                        );
+                    })?;
+                    recorded
+                },
+            )
+            .and_then(|_| {
+                let filter_sets = denoiser.filter_sets(&ctx, &mut sets, acc.accumulation())?;
+                let record = |cmd| {
+                    denoiser.record_filter_sets(&ctx, cmd, filter_sets);
+                };
+                let times = run_batch(&ctx, timed.max(1), timed > 0, record)?;
+                let raw = acc.hdr(&ctx)?;
+                let denoised = read_image(&ctx, denoiser.output().expect("filtered"), size)?;
+                let mut times: Vec<f64> = times;
+                times.sort_by(f64::total_cmp);
+                Ok((raw, denoised, times.get(times.len() / 2).copied()))
+            });
+        acc.destroy(&ctx);
+        guide_params.destroy(&ctx);
+        sets.destroy(&ctx);
+        denoiser.invalidate();
+        result
     }
 
     /// Benchmarks: GPU times of `count` back-to-back dispatches of `spp` samples per pixel
@@ -271,6 +373,21 @@ impl Viewport {
         self.live.as_ref().map(|l| l.hdr(&self.ctx)).transpose()
     }
 
+    /// The denoised image the last frame displayed (linear, internal size), or None when it
+    /// displayed the raw accumulation (waits for the GPU; tests).
+    pub fn live_denoised(&mut self) -> Result<Option<Image>, GpuError> {
+        self.wait_idle()?;
+        let (Some(live), Some(d)) = (&self.live, &self.denoiser) else {
+            return Ok(None);
+        };
+        match d.output() {
+            Some(out) if self.denoised && d.is_current() => {
+                read_image(&self.ctx, out, live.internal()).map(Some)
+            }
+            _ => Ok(None),
+        }
+    }
+
     /// The next frame slot, if its previous submission finished; never blocks.
     pub fn begin_frame(&mut self) -> Result<Option<Frame>, GpuError> {
         while self.frames.len() < FRAMES_IN_FLIGHT {
@@ -325,6 +442,10 @@ impl Viewport {
                 s.sets.clear(&ctx);
             }
             self.live = Some(Progressive::new(&ctx, internal, output, 1)?);
+            self.denoised = false;
+            if let Some(d) = &mut self.denoiser {
+                d.invalidate();
+            }
         }
         let live = self.live.as_mut().expect("made above");
         if upload.changed() {
@@ -371,12 +492,54 @@ impl Viewport {
                 vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
             );
         }
+        let mut shown = live.accumulation();
+        if req.denoise && live.has_image() {
+            if self.denoiser.is_none() {
+                self.denoiser = Some(Denoiser::new(&ctx)?);
+            }
+            let d = self.denoiser.as_mut().expect("made above");
+            if !d.has_size(internal) {
+                // The other slot may still read the old size's buffers.
+                for s in &self.frames {
+                    s.wait(&ctx)?;
+                }
+            }
+            let slot = &mut self.frames[frame.slot];
+            let fresh = !d.is_current() || !d.has_size(internal);
+            if added > 0 || (fresh && !hold) {
+                if added == 0 {
+                    // No batch this frame wrote the slot's parameters (the denoiser was
+                    // switched on over a finished image): the guides need the camera.
+                    slot.uniforms
+                        .write(bytemuck::bytes_of(&base.batch(0, live.samples(), true)));
+                }
+                d.record_batch(
+                    &ctx,
+                    frame.cmd,
+                    &mut slot.sets,
+                    &self.world,
+                    slot.uniforms.binding(),
+                    live.accumulation(),
+                    internal,
+                    restarted,
+                )?;
+                shown = d.record_filter(&ctx, frame.cmd, &mut slot.sets, live.accumulation())?;
+                self.denoised = true;
+            } else if self.denoised && d.is_current() {
+                shown = d.output().expect("filtered before");
+            }
+        } else if let Some(d) = &mut self.denoiser {
+            // Batches added meanwhile are not in its moments.
+            d.invalidate();
+            self.denoised = false;
+        }
+        let slot = &mut self.frames[frame.slot];
         let ldr = slot.ldr.as_ref().expect("ensured above").binding();
         self.tone.record(
             &ctx,
             frame.cmd,
             &mut slot.sets,
-            live.accumulation(),
+            shown,
             ldr,
             (internal, output),
             req.exposure,
@@ -430,6 +593,21 @@ impl Viewport {
     }
 }
 
+/// A device buffer of vec4 per pixel (radiance, count 1) as a linear image.
+fn read_image(ctx: &GpuContext, buffer: Binding, size: (u32, u32)) -> Result<Image, GpuError> {
+    let raw = read_device(ctx, buffer)?;
+    let px: &[[f32; 4]] = bytemuck::cast_slice(&raw);
+    Ok(Image {
+        width: size.0,
+        height: size.1,
+        pixels: px
+            .iter()
+            .take(size.0 as usize * size.1 as usize)
+            .map(|p| [p[0], p[1], p[2]])
+            .collect(),
+    })
+}
+
 impl Drop for Viewport {
     fn drop(&mut self) {
         // SAFETY: the device is idle after the wait; each field is taken once, here.
@@ -446,6 +624,9 @@ impl Drop for Viewport {
             }
             if let Some(p) = self.primary.take() {
                 p.destroy(&self.ctx);
+            }
+            if let Some(d) = self.denoiser.take() {
+                d.destroy(&self.ctx);
             }
             ManuallyDrop::take(&mut self.tone).destroy(&self.ctx);
             ManuallyDrop::take(&mut self.tracer).destroy(&self.ctx);

@@ -56,6 +56,7 @@ fn request(
         target_spp: target,
         exposure: 0.0,
         bgra: false,
+        denoise: false,
     }
 }
 
@@ -116,6 +117,7 @@ fn an_edit_or_a_camera_move_restarts_and_the_edit_is_visible_the_next_frame() {
             target_spp: 8,
             exposure: 0.0,
             bgra: false,
+            denoise: false,
         };
         frames(vp, &world, &req, n, |_| false)
     };

@@ -272,6 +272,7 @@ pub fn run(
             target_spp: u32::MAX,
             exposure: 0.0,
             bgra: true,
+            denoise: false,
         };
         for (label, moving) in [("refining (still camera)", false), ("camera moving", true)] {
             let (gpu, host, wall) = run_case(&mut vp, world, params, req, b.frames, moving)?;
@@ -519,6 +520,7 @@ pub(crate) fn edit_request(
         target_spp: u32::MAX,
         exposure: 0.0,
         bgra: true,
+        denoise: false,
     }
 }
 

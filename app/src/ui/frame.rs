@@ -242,6 +242,7 @@ impl Editor {
             target_spp: self.settings.target_spp,
             exposure: doc.scene.params.settings.exposure + self.settings.exposure,
             bgra: false,
+            denoise: self.settings.denoise,
         };
         let ui = (!capture_now).then(|| EguiFrame {
             primitives: &primitives,

@@ -20,6 +20,9 @@ pub struct ViewSettings {
     pub moving_scale: f32,
     /// Display exposure in stops.
     pub exposure: f32,
+    /// Show the viewport denoised (edge-aware, guided by the first hit; its blur fades as
+    /// samples accumulate). Renders and exports never are.
+    pub denoise: bool,
     /// Autosave period in seconds (0: off).
     pub autosave_secs: u64,
     /// The brush.
@@ -33,6 +36,7 @@ impl Default for ViewSettings {
             internal_scale: 1.0,
             moving_scale: 0.5,
             exposure: 0.0,
+            denoise: false,
             autosave_secs: 180,
             brush: Default::default(),
         }
@@ -315,6 +319,8 @@ pub fn draw(
                 );
                 ui.add(egui::Slider::new(&mut view.moving_scale, 0.125..=1.0).text("while moving"));
                 ui.add(egui::Slider::new(&mut view.exposure, -8.0..=8.0).text("exposure (stops)"));
+                ui.checkbox(&mut view.denoise, "denoise the viewport")
+                    .on_hover_text("Edge-aware filter guided by the first hit's normal, albedo and depth; it blurs less as samples accumulate. Renders and exports are never denoised.");
                 let mut settings = doc.scene.params.settings.clone();
                 if ui
                     .add(

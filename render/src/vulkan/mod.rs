@@ -5,6 +5,7 @@
 
 pub mod barrier;
 pub mod buffer;
+pub mod denoise;
 pub mod device;
 pub mod frame;
 pub mod instance;

@@ -153,6 +153,32 @@ impl Progressive {
         variant: Variant,
         spp: u32,
     ) -> Result<(Option<f64>, bool), GpuError> {
+        self.accumulate_with(
+            ctx,
+            tracer,
+            world,
+            view,
+            params,
+            variant,
+            spp,
+            |_, _| Ok(()),
+        )
+    }
+
+    /// [`Progressive::accumulate`], calling `after(accumulation, restarted)` once each
+    /// dispatch finished (its batch is in the buffer; `restarted`: it was the first).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn accumulate_with(
+        &mut self,
+        ctx: &GpuContext,
+        tracer: &mut PathTracer,
+        world: &GpuWorld,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        variant: Variant,
+        spp: u32,
+        mut after: impl FnMut(Binding, bool) -> Result<(), GpuError>,
+    ) -> Result<(Option<f64>, bool), GpuError> {
         let base = TraceParams::new(view, params, &self.job(spp));
         self.check_key(&base, variant);
         let restarted = self.samples == 0;
@@ -177,6 +203,8 @@ impl Progressive {
                 self.accum.binding(),
                 true,
             );
+            let first = self.samples == 0;
+            let t = t.and_then(|t| after(self.accum.binding(), first).map(|_| t));
             let t = match t {
                 Ok(t) => t,
                 Err(e) => {

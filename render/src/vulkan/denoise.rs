@@ -1,0 +1,337 @@
+//! The viewport's edge-aware denoiser: guides from the first hit of each pixel's centre ray
+//! (`shaders/guides.comp`: hit point, footprint, albedo, material kind and face), then an
+//! à-trous wavelet filter with a variance-guided luminance weight on the accumulation's mean
+//! divided by the albedo (`shaders/denoise.comp`). Its luminance weight is measured in
+//! standard deviations of each pixel's mean, estimated from the accumulation's batches (one
+//! per frame, `record_moments` after each), so the filter keeps less of the image's detail
+//! away only while the noise is high: its bias falls as samples accumulate (measured by
+//! `voxbrick bench-error`, choice "denoised"). Never used by reference renders.
+
+use super::barrier::barrier;
+use super::buffer::{Binding, HostBuffer};
+use super::pass::{ComputePass, Dispatch, SetCache};
+use super::world::GpuWorld;
+use super::{GpuContext, GpuError};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+const GUIDES: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/guides.comp.spv"));
+const FILTER: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/denoise.comp.spv"));
+
+/// À-trous steps (1, 2, 4, 8, 16 pixels apart: a 125-pixel-wide kernel at most).
+pub const ITERATIONS: u32 = 5;
+// Prepare writes ping and the steps alternate, so an odd count ends in pong.
+const _: () = assert!(ITERATIONS % 2 == 1);
+
+/// Push constants. Keep in sync with `Push` in shaders/denoise.comp.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Push {
+    size: [u32; 2],
+    mode: u32,
+    step: u32,
+    flags: u32,
+}
+const _: () = assert!(std::mem::size_of::<Push>() == 20);
+
+const MOMENTS: u32 = 0;
+const PREPARE: u32 = 1;
+const FILTER_STEP: u32 = 2;
+const RESTART: u32 = 1;
+const LAST: u32 = 2;
+
+/// The buffers of one image size.
+struct Buffers {
+    size: (u32, u32),
+    /// Two vec4 per pixel (shaders/guides.comp).
+    guides: HostBuffer,
+    /// Per pixel: previous luminance sum and count, Σ S²/k, batches.
+    moments: HostBuffer,
+    ping: HostBuffer,
+    /// The last step's output: remodulated radiance, count 1 (what the display reads).
+    pong: HostBuffer,
+}
+
+impl Buffers {
+    fn new(ctx: &GpuContext, size: (u32, u32)) -> Result<Self, GpuError> {
+        let pixels = size.0 as u64 * size.1 as u64;
+        let make = |name, bytes| HostBuffer::new(ctx, name, bytes, MemoryLocation::GpuOnly);
+        let guides = make("denoise guides", pixels * 32)?;
+        let rest = (|| {
+            let moments = make("denoise moments", pixels * 16)?;
+            let ping = match make("denoise ping", pixels * 16) {
+                Ok(b) => b,
+                Err(e) => {
+                    moments.destroy(ctx);
+                    return Err(e);
+                }
+            };
+            match make("denoise pong", pixels * 16) {
+                Ok(pong) => Ok((moments, ping, pong)),
+                Err(e) => {
+                    moments.destroy(ctx);
+                    ping.destroy(ctx);
+                    Err(e)
+                }
+            }
+        })();
+        match rest {
+            Ok((moments, ping, pong)) => Ok(Self {
+                size,
+                guides,
+                moments,
+                ping,
+                pong,
+            }),
+            Err(e) => {
+                guides.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    fn destroy(self, ctx: &GpuContext) {
+        for b in [self.guides, self.moments, self.ping, self.pong] {
+            b.destroy(ctx);
+        }
+    }
+}
+
+/// The descriptor sets of one filter: (accum, guides, moments, pong → ping) and
+/// (…, ping → pong).
+#[derive(Clone, Copy, Debug)]
+pub struct FilterSets {
+    to_ping: vk::DescriptorSet,
+    to_pong: vk::DescriptorSet,
+}
+
+/// The denoiser's pipelines and the buffers of the size it last ran at.
+pub struct Denoiser {
+    guides: ComputePass,
+    filter: ComputePass,
+    buffers: Option<Buffers>,
+    /// The guides and moments describe the current accumulation.
+    current: bool,
+}
+
+/// Orders one compute pass's writes before the next one's reads and writes.
+fn compute_to_compute(ctx: &GpuContext, cmd: vk::CommandBuffer) {
+    // SAFETY: callers record into a command buffer that is recording.
+    unsafe {
+        barrier(
+            ctx,
+            cmd,
+            vk::PipelineStageFlags::COMPUTE_SHADER,
+            vk::AccessFlags::SHADER_WRITE,
+            vk::PipelineStageFlags::COMPUTE_SHADER,
+            vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
+        );
+    }
+}
+
+impl Denoiser {
+    /// Builds the pipelines (buffers come with the first size).
+    pub fn new(ctx: &GpuContext) -> Result<Self, GpuError> {
+        let guides = ComputePass::new(ctx, GUIDES, 7, 0)?;
+        let filter = match ComputePass::new(ctx, FILTER, 5, std::mem::size_of::<Push>() as u32) {
+            Ok(f) => f,
+            Err(e) => {
+                guides.destroy(ctx);
+                return Err(e);
+            }
+        };
+        Ok(Self {
+            guides,
+            filter,
+            buffers: None,
+            current: false,
+        })
+    }
+
+    /// Forgets the guides and moments: the next [`Denoiser::record_batch`] starts them over
+    /// (a restarted accumulation, a new one, or the denoiser switched back on).
+    pub fn invalidate(&mut self) {
+        self.current = false;
+    }
+
+    /// Buffers for `size` (the caller made sure no submission still uses the old ones).
+    fn ensure(&mut self, ctx: &GpuContext, size: (u32, u32)) -> Result<&Buffers, GpuError> {
+        if self.buffers.as_ref().is_none_or(|b| b.size != size) {
+            if let Some(old) = self.buffers.take() {
+                old.destroy(ctx);
+            }
+            self.buffers = Some(Buffers::new(ctx, size)?);
+            self.current = false;
+        }
+        Ok(self.buffers.as_ref().expect("made above"))
+    }
+
+    /// Whether buffers of `size` exist (a new size waits for the GPU first).
+    pub fn has_size(&self, size: (u32, u32)) -> bool {
+        self.buffers.as_ref().is_some_and(|b| b.size == size)
+    }
+
+    /// Records what follows a batch of samples added to `accum` (size `size`): new guides
+    /// (from `params`, the batch's [`super::trace::TraceParams`]) when the accumulation
+    /// restarted or they are not current, then the batch's moments. `restarted`: this batch
+    /// started the accumulation. Orders its writes before later compute passes.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_batch(
+        &mut self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        sets: &mut SetCache,
+        world: &GpuWorld,
+        params: Binding,
+        accum: Binding,
+        size: (u32, u32),
+        restarted: bool,
+    ) -> Result<(), GpuError> {
+        let fresh = restarted || !self.current || !self.has_size(size);
+        self.ensure(ctx, size)?;
+        let b = self.buffers.as_ref().expect("ensured");
+        if fresh {
+            let mut bound = world.bindings();
+            bound.extend([params, b.guides.binding()]);
+            let set = sets.get(ctx, &self.guides, &bound)?;
+            self.guides.record(
+                ctx,
+                cmd,
+                set,
+                &[],
+                Dispatch::Groups(size.0.div_ceil(8), size.1.div_ceil(8), 1),
+            );
+            compute_to_compute(ctx, cmd);
+        }
+        let set = self.filter_set(ctx, sets, accum, false)?;
+        let push = Push {
+            size: [size.0, size.1],
+            mode: MOMENTS,
+            step: 0,
+            flags: if fresh { RESTART } else { 0 },
+        };
+        self.record_filter_pass(ctx, cmd, set, push);
+        compute_to_compute(ctx, cmd);
+        self.current = true;
+        Ok(())
+    }
+
+    /// The last filter's output (radiance, count 1 per pixel), if buffers exist.
+    pub fn output(&self) -> Option<Binding> {
+        self.buffers.as_ref().map(|b| b.pong.binding())
+    }
+
+    /// Whether the guides and moments describe the accumulation the last batch went to.
+    pub fn is_current(&self) -> bool {
+        self.current
+    }
+
+    /// Records the filter of `accum` (its guides and moments recorded by
+    /// [`Denoiser::record_batch`]); returns the denoised image (radiance, count 1 per pixel)
+    /// for the display pass, its writes ordered before later compute passes.
+    pub fn record_filter(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        sets: &mut SetCache,
+        accum: Binding,
+    ) -> Result<Binding, GpuError> {
+        let filter_sets = self.filter_sets(ctx, sets, accum)?;
+        Ok(self.record_filter_sets(ctx, cmd, filter_sets))
+    }
+
+    /// The two sets [`Denoiser::record_filter_sets`] binds (fetched first by callers that
+    /// record the filter in a closure).
+    pub fn filter_sets(
+        &self,
+        ctx: &GpuContext,
+        sets: &mut SetCache,
+        accum: Binding,
+    ) -> Result<FilterSets, GpuError> {
+        Ok(FilterSets {
+            to_ping: self.filter_set(ctx, sets, accum, false)?,
+            to_pong: self.filter_set(ctx, sets, accum, true)?,
+        })
+    }
+
+    /// [`Denoiser::record_filter`] with its sets fetched.
+    pub fn record_filter_sets(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        sets: FilterSets,
+    ) -> Binding {
+        let b = self.buffers.as_ref().expect("recorded after a batch");
+        let push = |mode, step, flags| Push {
+            size: [b.size.0, b.size.1],
+            mode,
+            step,
+            flags,
+        };
+        // Prepare writes ping; the steps alternate ping → pong → ping …, ending in pong.
+        self.record_filter_pass(ctx, cmd, sets.to_ping, push(PREPARE, 0, 0));
+        for step in 0..ITERATIONS {
+            compute_to_compute(ctx, cmd);
+            let last = step + 1 == ITERATIONS;
+            let set = if step % 2 == 0 {
+                sets.to_pong
+            } else {
+                sets.to_ping
+            };
+            self.record_filter_pass(
+                ctx,
+                cmd,
+                set,
+                push(FILTER_STEP, step, if last { LAST } else { 0 }),
+            );
+        }
+        compute_to_compute(ctx, cmd);
+        b.pong.binding()
+    }
+
+    /// The set binding (accum, guides, moments, src, dst): dst = pong when `to_pong`, else ping.
+    fn filter_set(
+        &self,
+        ctx: &GpuContext,
+        sets: &mut SetCache,
+        accum: Binding,
+        to_pong: bool,
+    ) -> Result<vk::DescriptorSet, GpuError> {
+        let b = self.buffers.as_ref().expect("ensured by record_batch");
+        let (src, dst) = if to_pong {
+            (b.ping.binding(), b.pong.binding())
+        } else {
+            (b.pong.binding(), b.ping.binding())
+        };
+        sets.get(
+            ctx,
+            &self.filter,
+            &[accum, b.guides.binding(), b.moments.binding(), src, dst],
+        )
+    }
+
+    fn record_filter_pass(
+        &self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        set: vk::DescriptorSet,
+        push: Push,
+    ) {
+        self.filter.record(
+            ctx,
+            cmd,
+            set,
+            bytemuck::bytes_of(&push),
+            Dispatch::Groups(push.size[0].div_ceil(8), push.size[1].div_ceil(8), 1),
+        );
+    }
+
+    /// Destroys the pipelines and buffers (the device is idle).
+    pub fn destroy(self, ctx: &GpuContext) {
+        if let Some(b) = self.buffers {
+            b.destroy(ctx);
+        }
+        self.guides.destroy(ctx);
+        self.filter.destroy(ctx);
+    }
+}
