@@ -182,6 +182,9 @@ enum Command {
         /// size and egui panels painted on it.
         #[arg(long)]
         ui: bool,
+        /// Also measure each case with the viewport's denoiser on.
+        #[arg(long)]
+        denoise: bool,
         /// Instead: edit → first frame showing it, on the default 512 × 256 × 512 scene, for
         /// live sphere strokes of these radii (comma-separated), and the brush preview's
         /// update time.
@@ -576,6 +579,7 @@ fn run(cli: Cli) -> Result<()> {
             spp,
             device,
             ui,
+            denoise,
             edits,
         } => {
             if let Some(s) = scales.iter().find(|s| !(**s > 0.0 && **s <= 1.0)) {
@@ -614,6 +618,7 @@ fn run(cli: Cli) -> Result<()> {
                 frames: frames.max(1),
                 spp: spp.clamp(1, 16),
                 ui,
+                denoise,
             };
             emit(&cli::bench_viewport::run(
                 session,

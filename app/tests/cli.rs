@@ -400,11 +400,21 @@ fn bench_error_measures_every_choice_against_a_checked_reference() {
             "{n}: the error falls with samples"
         );
     }
+    // The denoiser: measured (not checked: biased), its filter timed, the noise it removes
+    // at 1 spp worth more than its bias.
+    let denoised = named("denoised (viewport)");
+    assert!(denoised["same_image_rel_mse"].is_null());
+    for l in denoised["levels"].as_array().unwrap() {
+        assert!(l["filter_ms"].as_f64().unwrap() > 0.0);
+    }
+    assert!(rel(denoised, 0) < rel(named("defaults"), 0));
     // Light sampling and Sobol numbers beat BSDF sampling and independent numbers at 8 spp.
     assert!(rel(named("defaults"), 3) < rel(named("independent numbers"), 3));
     assert!(rel(named("defaults"), 3) < rel(named("no light sampling"), 3));
     let csv = std::fs::read_to_string(dir.join("error.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 4 * curves.len());
+    let md = std::fs::read_to_string(dir.join("error.md")).unwrap();
+    assert!(md.contains("Denoised (viewport)"), "{md}");
     for f in [
         "error.md",
         "relmse_spp_physical___lamps.png",

@@ -73,6 +73,20 @@ pub struct Frame {
     pub acquired: vk::Semaphore,
 }
 
+/// A render with the viewport's denoiser ([`Viewport::render_denoised`]).
+#[derive(Clone, Debug)]
+pub struct DenoisedRender {
+    /// The accumulation's mean (linear).
+    pub raw: Image,
+    /// The denoised image (linear).
+    pub denoised: Image,
+    /// GPU time of the trace dispatches (None when the queue cannot time).
+    pub trace_seconds: Option<f64>,
+    /// GPU time of one filter (guides and moments not included: they run with the batches),
+    /// the median of the timed repetitions; None when not timed.
+    pub filter_seconds: Option<f64>,
+}
+
 /// The GPU session. Fields are released in `Drop`, the context last.
 pub struct Viewport {
     world: ManuallyDrop<GpuWorld>,
@@ -207,9 +221,8 @@ impl Viewport {
     }
 
     /// Renders `job` with `variant` as the viewport does with its denoiser on, one batch per
-    /// dispatch (the tracer's batch shape), and waits: the linear image, the denoised one,
-    /// and the filter's GPU time (the median of `timed` repetitions; None when the queue
-    /// cannot time or `timed` is 0).
+    /// dispatch (the tracer's batch shape), and waits; the filter is timed over `timed`
+    /// repetitions (0: not timed).
     pub fn render_denoised(
         &mut self,
         view: &WorldView<'_>,
@@ -217,7 +230,7 @@ impl Viewport {
         job: &RenderJob,
         variant: Variant,
         timed: u32,
-    ) -> Result<(Image, Image, Option<f64>), GpuError> {
+    ) -> Result<DenoisedRender, GpuError> {
         let ctx = self.ctx.clone();
         // The denoiser's buffers may be the live accumulation's.
         self.wait_idle()?;
@@ -277,7 +290,7 @@ impl Viewport {
                     recorded
                 },
             )
-            .and_then(|_| {
+            .and_then(|(trace_seconds, _)| {
                 let filter_sets = denoiser.filter_sets(&ctx, &mut sets, acc.accumulation())?;
                 let record = |cmd| {
                     denoiser.record_filter_sets(&ctx, cmd, filter_sets);
@@ -287,7 +300,12 @@ impl Viewport {
                 let denoised = read_image(&ctx, denoiser.output().expect("filtered"), size)?;
                 let mut times: Vec<f64> = times;
                 times.sort_by(f64::total_cmp);
-                Ok((raw, denoised, times.get(times.len() / 2).copied()))
+                Ok(DenoisedRender {
+                    raw,
+                    denoised,
+                    trace_seconds,
+                    filter_seconds: times.get(times.len() / 2).copied(),
+                })
             });
         acc.destroy(&ctx);
         guide_params.destroy(&ctx);

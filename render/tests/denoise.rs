@@ -36,10 +36,11 @@ fn denoised(
 ) -> (Image, Image) {
     let view = world.read();
     let variant = Variant::for_scene(&view, params);
-    let (raw, out, _) = vp
+    let r = vp
         .render_denoised(&view, params, &job(size, spp, seed), variant, 0)
         .unwrap();
-    (raw, out)
+    assert!(r.filter_seconds.is_none(), "not timed");
+    (r.raw, r.denoised)
 }
 
 #[test]

@@ -24,6 +24,8 @@ pub struct BenchViewport {
     /// Also the window's half: the copy into an offscreen image of the window's size and
     /// egui panels painted on it (the context must be made with `draw_ui`).
     pub ui: bool,
+    /// Also each case with the viewport's denoiser on.
+    pub denoise: bool,
 }
 
 fn scaled((w, h): (u32, u32), f: f32) -> (u32, u32) {
@@ -274,7 +276,18 @@ pub fn run(
             bgra: true,
             denoise: false,
         };
-        for (label, moving) in [("refining (still camera)", false), ("camera moving", true)] {
+        let mut cases = vec![
+            ("refining (still camera)", false, false),
+            ("camera moving", true, false),
+        ];
+        if b.denoise {
+            cases.extend([
+                ("refining, denoised", false, true),
+                ("moving, denoised", true, true),
+            ]);
+        }
+        for (label, moving, denoise) in cases {
+            let req = FrameRequest { denoise, ..req };
             let (gpu, host, wall) = run_case(&mut vp, world, params, req, b.frames, moving)?;
             if let Some(presenter) = &mut presenter {
                 let (gpu, host, wall) =
