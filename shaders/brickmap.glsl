@@ -30,6 +30,14 @@ layout(std430, set = 0, binding = 4) readonly buffer MaterialTables {
 #define COUNT_STEPS false
 #endif
 uint g_steps;
+
+// Benchmark only (`voxbrick bench-skips`): skips turned off, bit 0 the coarse grid's, bit 1
+// the 4³ / 2³ blocks inside bricks, bit 2 a brick full of the medium inside a dielectric,
+// bit 3 full cells read as stored bricks would be (their mask words loaded). trace.comp and
+// shadow.comp define it from their EXPERIMENT bits 7..10; 0 everywhere else.
+#ifndef SKIPS_OFF
+#define SKIPS_OFF 0u
+#endif
 // COUNT_STEPS shaders only: iteration caps hit (a traversal that ran out of its step budget,
 // a cell_at that ran out of its corrections); every one is a bug (`voxbrick stress`).
 uint g_capped;
@@ -88,6 +96,13 @@ int brick_block(uint w, ivec3 v, out bool hit) {
     return 0;
 }
 
+// Whether voxel v of stored brick w is solid (its mask bit alone).
+bool voxel_bit(uint w, ivec3 v) {
+    ivec3 l = v & 7;
+    uint bit = uint(l.x + 8 * l.y + 64 * l.z);
+    return ((bricks[w].mask[bit >> 5] >> (bit & 31u)) & 1u) != 0u;
+}
+
 // Material of voxel v of the cell whose brick-index word is w, or -1 when empty. Brick fields
 // are read from the buffer where needed; copying the Brick to a local made a 68-byte
 // local-memory array (the two were equally fast on the H100, and this one uses no local
@@ -95,9 +110,9 @@ int brick_block(uint w, ivec3 v, out bool hit) {
 int material_in(uint w, ivec3 v) {
     if (w == EMPTY) return -1;
     if (w >= FULL_BASE) return int(w & 0xFFu);
+    if (!voxel_bit(w, v)) return -1;
     ivec3 l = v & 7;
     uint bit = uint(l.x + 8 * l.y + 64 * l.z);
-    if (((bricks[w].mask[bit >> 5] >> (bit & 31u)) & 1u) == 0u) return -1;
     uint material = bricks[w].material;
     if ((material & UNIFORM_FLAG) != 0u) return int(material & 0xFFu);
     uint rank = 0u;
@@ -158,19 +173,30 @@ bool dda(ivec3 cell, float t, int axis, int medium, float t_max, out ivec3 voxel
         if (inside) {
             bool hit = false;
             if (!MEDIUM_POSSIBLE || medium == AIR) {
-                if (!coarse_occupied(cell >> 5)) {
+                if ((SKIPS_OFF & 1u) == 0u && !coarse_occupied(cell >> 5)) {
                     shift = 5;
                 } else {
                     uint w = cell_word(cell >> 3);
                     if (w == EMPTY) shift = 3;
-                    else if (w >= FULL_BASE) hit = true;
+                    else if (w >= FULL_BASE) {
+                        hit = true;
+                        if ((SKIPS_OFF & 8u) != 0u) {
+                            // A stored brick's loads, from a brick near in memory the way a
+                            // slab's bricks are (the result never changes: blocks are 0..2).
+                            ivec3 b = cell >> 3;
+                            uint probe = (uint(b.x) * g_dims.z + uint(b.z)) * g_dims.y + uint(b.y);
+                            bool solid;
+                            if (brick_block(probe % uint(bricks.length()), cell, solid) > 2) hit = solid;
+                        }
+                    }
+                    else if ((SKIPS_OFF & 2u) != 0u) hit = voxel_bit(w, cell);
                     else shift = brick_block(w, cell, hit);
                 }
             } else {
                 // Inside a medium a brick full of it is skipped whole, like an empty brick in
                 // air (the first voxel that is not the medium is found by the same event rule).
                 uint w = cell_word(cell >> 3);
-                if (w == FULL_BASE + uint(medium)) shift = 3;
+                if ((SKIPS_OFF & 4u) == 0u && w == FULL_BASE + uint(medium)) shift = 3;
                 else hit = material_in(w, cell) != medium;
             }
             if (hit) {

@@ -15,6 +15,7 @@ layout(constant_id = 2) const bool LIGHTS = false;
 // Shadow rays travel in air.
 #define MEDIUM_POSSIBLE false
 #define COUNT_STEPS COUNT_RAYS
+#define SKIPS_OFF ((EXPERIMENT >> 7) & 15u)
 #include "brickmap.glsl"
 
 // The trace pass's bindings: only the grid size (Params.grid) is read here.

@@ -28,7 +28,8 @@ layout(constant_id = 7) const bool COUNT_RAYS = false;
 // Benchmark experiments (bench-gpu --experiment), 0 in every real render: bit 0 ends paths
 // at the first hit (primary rays only), bit 1 decodes colours without pow, bit 2 counts
 // every shadow ray as unblocked without tracing it, bit 3 skips sun sampling (NEE), bit 4
-// makes shaders/shadow.comp skip its work, bit 6 starts a subgroup's next samples together.
+// makes shaders/shadow.comp skip its work, bit 6 starts a subgroup's next samples together,
+// bits 7..10 turn traversal skips off (brickmap.glsl SKIPS_OFF).
 layout(constant_id = 8) const uint EXPERIMENT = 0u;
 // Shadow rays go to a queue that shaders/shadow.comp traces next, one per invocation, instead
 // of being traced here: in a warp only some lanes have a shadow ray at a vertex, and tracing
@@ -45,6 +46,7 @@ layout(constant_id = 11) const bool SOBOL = false;
 // Without dielectrics every ray travels in air: the traversal drops its medium branch.
 #define MEDIUM_POSSIBLE HAS_DIELECTRIC
 #define COUNT_STEPS COUNT_RAYS
+#define SKIPS_OFF ((EXPERIMENT >> 7) & 15u)
 #include "brickmap.glsl"
 #include "scene.glsl"
 // Per pixel: the sum of its samples' radiance (rgb) and their count (a).

@@ -302,6 +302,27 @@ enum Command {
         #[arg(long, default_value = "error-report")]
         out: PathBuf,
     },
+    /// What each skip buys: the pipeline variants, the coarse-grid and in-brick empty-space
+    /// skips, uniform media, full cells, accumulation when still and the lower resolution while
+    /// moving, with and without each, on the thesis scene and on a scene that needs it. Writes
+    /// skips.md and skips.json.
+    BenchSkips {
+        /// Device name filter ("gpu": the best).
+        #[arg(long, default_value = "gpu")]
+        device: String,
+        /// Internal resolution of the traversal and pipeline cases, WxH.
+        #[arg(long, default_value = "1024x576", value_parser = parse_resolution)]
+        size: (u32, u32),
+        /// Window size of the moving-resolution case, WxH.
+        #[arg(long, default_value = "1920x1080", value_parser = parse_resolution)]
+        window: (u32, u32),
+        /// Timed rounds of 10 dispatches per variant (after two of warm-up).
+        #[arg(long, default_value_t = 5)]
+        rounds: usize,
+        /// Folder for the report.
+        #[arg(long, default_value = "skips-report")]
+        out: PathBuf,
+    },
     /// The numerical stress suite: random and adversarial rays through the GPU traversal
     /// against the exact CPU ray cast, and adversarial scenes' images (NaN, infinite and
     /// negative samples, white-furnace energy, iteration caps) on the GPU and the CPU
@@ -689,6 +710,22 @@ fn run(cli: Cli) -> Result<()> {
             )?;
             emit(&text)
         }
+        Command::BenchSkips {
+            device,
+            size,
+            window,
+            rounds,
+            out,
+        } => emit(&cli::bench_skips::bench_skips(
+            cli::bench_skips::BenchSkips {
+                device,
+                size,
+                window,
+                rounds,
+                out,
+            },
+            workers,
+        )?),
         Command::BenchError {
             device,
             path,

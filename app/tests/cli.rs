@@ -447,3 +447,60 @@ fn bench_error_measures_every_choice_against_a_checked_reference() {
     ]);
     assert_eq!(std::fs::read_dir(&bad).unwrap().count(), 0);
 }
+
+#[test]
+fn bench_skips_measures_each_skip_on_two_scenes() {
+    let dir = scratch("bench-skips");
+    let out = voxbrick(&[
+        "bench-skips",
+        "--size",
+        "32x18",
+        "--window",
+        "64x36",
+        "--rounds",
+        "1",
+        "--out",
+        s(&dir),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success()
+        && err.contains("no usable Vulkan device")
+        && std::env::var("VOXBRICK_REQUIRE_GPU").as_deref() != Ok("1")
+    {
+        eprintln!(
+            "SKIPPED: no Vulkan driver on this machine; VOXBRICK_REQUIRE_GPU=1 makes this a failure"
+        );
+        return;
+    }
+    assert!(out.status.success(), "{err}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("skips.json")).unwrap()).unwrap();
+    let rows = v["rows"].as_array().unwrap();
+    // Seven skips, each on the benchmark scene and on one that needs it.
+    assert_eq!(rows.len(), 14);
+    for pair in rows.chunks(2) {
+        assert_eq!(pair[0]["skip"], pair[1]["skip"]);
+        assert!(pair[0]["scene"].as_str().unwrap().starts_with("thesis"));
+        assert_ne!(pair[0]["scene"], pair[1]["scene"]);
+    }
+    for r in rows {
+        for k in ["with", "without", "gain"] {
+            let x = r[k].as_f64().unwrap();
+            assert!(x.is_finite() && x > 0.0, "{}: {k} {x}", r["name"]);
+        }
+        // A traversal or pipeline skip changes the time, never the image.
+        if let Some(same) = r["same_image_rel_mse"].as_f64() {
+            assert!(same < 1e-8, "{}: {same}", r["name"]);
+        }
+        // A second of accumulated frames: far less error than one frame's samples.
+        if r["skip"] == "Accumulation" {
+            assert!(r["gain"].as_f64().unwrap() > 10.0, "{r}");
+        }
+    }
+    let md = std::fs::read_to_string(dir.join("skips.md")).unwrap();
+    assert_eq!(md.lines().filter(|l| l.starts_with("| ")).count(), 15);
+    let bad = scratch("bench-skips-bad");
+    fails(&["bench-skips", "--size", "0x5", "--out", s(&bad)]);
+    fails(&["bench-skips", "--window", "big", "--out", s(&bad)]);
+    assert_eq!(std::fs::read_dir(&bad).unwrap().count(), 0);
+}
