@@ -379,7 +379,7 @@ fn needy_scene(skip: Skip, base: &SceneParams, workers: usize) -> Result<Case> {
                         state ^= state << 13;
                         state ^= state >> 17;
                         state ^= state << 5;
-                        if state % 50 == 0 {
+                        if state.is_multiple_of(50) {
                             edits.push(VoxelEdit {
                                 pos: IVec3::new(x, y, z),
                                 op: VoxelOp::Set(m),
