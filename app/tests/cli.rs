@@ -21,6 +21,25 @@ fn ok(args: &[&str]) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
+/// Runs voxbrick with a GPU command's arguments: true when it succeeded, false (saying so)
+/// when this machine has no Vulkan driver, unless VOXBRICK_REQUIRE_GPU=1 (CI) makes that a
+/// failure; any other failure fails the test.
+fn succeeds_on_gpu(args: &[&str]) -> bool {
+    let out = voxbrick(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success()
+        && err.contains("no usable Vulkan device")
+        && std::env::var("VOXBRICK_REQUIRE_GPU").as_deref() != Ok("1")
+    {
+        eprintln!(
+            "SKIPPED: no Vulkan driver on this machine; VOXBRICK_REQUIRE_GPU=1 makes this a failure"
+        );
+        return false;
+    }
+    assert!(out.status.success(), "{args:?}: {err}");
+    true
+}
+
 fn fails(args: &[&str]) -> String {
     let out = voxbrick(args);
     assert!(!out.status.success(), "{args:?} succeeded");
@@ -256,7 +275,7 @@ fn stress_on_the_cpu_reference_writes_its_report() {
 #[test]
 fn bench_plays_the_path_and_writes_its_report() {
     let dir = scratch("bench");
-    let out = voxbrick(&[
+    if !succeeds_on_gpu(&[
         "bench",
         "--sizes",
         "32x18",
@@ -276,18 +295,9 @@ fn bench_plays_the_path_and_writes_its_report() {
         "2",
         "--out",
         s(&dir),
-    ]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    if !out.status.success()
-        && err.contains("no usable Vulkan device")
-        && std::env::var("VOXBRICK_REQUIRE_GPU").as_deref() != Ok("1")
-    {
-        eprintln!(
-            "SKIPPED: no Vulkan driver on this machine; VOXBRICK_REQUIRE_GPU=1 makes this a failure"
-        );
+    ]) {
         return;
     }
-    assert!(out.status.success(), "{err}");
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("bench.json")).unwrap()).unwrap();
     let gpu = v["gpu"].as_array().unwrap();
@@ -336,7 +346,7 @@ fn bench_plays_the_path_and_writes_its_report() {
 #[test]
 fn bench_error_measures_every_choice_against_a_checked_reference() {
     let dir = scratch("bench-error");
-    let out = voxbrick(&[
+    if !succeeds_on_gpu(&[
         "bench-error",
         "--size",
         "32x18",
@@ -350,18 +360,9 @@ fn bench_error_measures_every_choice_against_a_checked_reference() {
         "lamps",
         "--out",
         s(&dir),
-    ]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    if !out.status.success()
-        && err.contains("no usable Vulkan device")
-        && std::env::var("VOXBRICK_REQUIRE_GPU").as_deref() != Ok("1")
-    {
-        eprintln!(
-            "SKIPPED: no Vulkan driver on this machine; VOXBRICK_REQUIRE_GPU=1 makes this a failure"
-        );
+    ]) {
         return;
     }
-    assert!(out.status.success(), "{err}");
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("error.json")).unwrap()).unwrap();
     let cases = v["cases"].as_array().unwrap();
@@ -451,7 +452,7 @@ fn bench_error_measures_every_choice_against_a_checked_reference() {
 #[test]
 fn bench_skips_measures_each_skip_on_two_scenes() {
     let dir = scratch("bench-skips");
-    let out = voxbrick(&[
+    if !succeeds_on_gpu(&[
         "bench-skips",
         "--size",
         "32x18",
@@ -461,18 +462,9 @@ fn bench_skips_measures_each_skip_on_two_scenes() {
         "1",
         "--out",
         s(&dir),
-    ]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    if !out.status.success()
-        && err.contains("no usable Vulkan device")
-        && std::env::var("VOXBRICK_REQUIRE_GPU").as_deref() != Ok("1")
-    {
-        eprintln!(
-            "SKIPPED: no Vulkan driver on this machine; VOXBRICK_REQUIRE_GPU=1 makes this a failure"
-        );
+    ]) {
         return;
     }
-    assert!(out.status.success(), "{err}");
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("skips.json")).unwrap()).unwrap();
     let rows = v["rows"].as_array().unwrap();

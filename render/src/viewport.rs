@@ -12,7 +12,7 @@
 use crate::cpu::RenderJob;
 use crate::image::Image;
 use crate::params::SceneParams;
-use crate::vulkan::barrier::{after_earlier_passes, barrier};
+use crate::vulkan::barrier::{after_earlier_passes, barrier, between_passes};
 use crate::vulkan::buffer::{Binding, HostBuffer, read_device};
 use crate::vulkan::denoise::Denoiser;
 use crate::vulkan::frame::{FRAMES_IN_FLIGHT, FrameSlot};
@@ -500,16 +500,7 @@ impl Viewport {
             )?
         };
         // SAFETY: recording: the trace's writes before the display pass reads them.
-        unsafe {
-            barrier(
-                &ctx,
-                frame.cmd,
-                vk::PipelineStageFlags::COMPUTE_SHADER,
-                vk::AccessFlags::SHADER_WRITE,
-                vk::PipelineStageFlags::COMPUTE_SHADER,
-                vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
-            );
-        }
+        unsafe { between_passes(&ctx, frame.cmd) };
         let mut shown = live.accumulation();
         if req.denoise && live.has_image() {
             if self.denoiser.is_none() {

@@ -15,15 +15,6 @@ use render::vulkan::DeviceChoice;
 use render::vulkan::trace::Variant;
 use std::sync::Arc;
 
-fn job(size: (u32, u32), spp: u32, seed: u64) -> RenderJob {
-    RenderJob {
-        width: size.0,
-        height: size.1,
-        spp,
-        seed,
-    }
-}
-
 /// A raw and a denoised render of `spp` samples added one per dispatch (as a viewport adds a
 /// batch per frame).
 fn denoised(
@@ -37,7 +28,13 @@ fn denoised(
     let view = world.read();
     let variant = Variant::for_scene(&view, params);
     let r = vp
-        .render_denoised(&view, params, &job(size, spp, seed), variant, 0)
+        .render_denoised(
+            &view,
+            params,
+            &RenderJob::sized(size, spp, seed),
+            variant,
+            0,
+        )
         .unwrap();
     assert!(r.filter_seconds.is_none(), "not timed");
     (r.raw, r.denoised)
@@ -52,7 +49,7 @@ fn denoising_cuts_the_error_and_its_bias_falls_with_samples() {
     let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
     let size = (64, 40);
     let reference = vp
-        .render(&world.read(), &params, &job(size, 1024, 99))
+        .render(&world.read(), &params, &RenderJob::sized(size, 1024, 99))
         .unwrap()
         .0;
     // One sample per dispatch: a batch per sample, as a viewport adding one per frame.
@@ -112,7 +109,7 @@ fn interactive_frames_display_the_denoised_image_when_asked() {
     let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
     let size = (48, 32);
     let reference = vp
-        .render(&world.read(), &params, &job(size, 512, 5))
+        .render(&world.read(), &params, &RenderJob::sized(size, 512, 5))
         .unwrap()
         .0;
     let mut req = FrameRequest {

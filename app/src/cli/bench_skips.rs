@@ -156,15 +156,6 @@ fn everything(v: Variant) -> Variant {
     }
 }
 
-fn job(size: (u32, u32), spp: u32, seed: u64) -> RenderJob {
-    RenderJob {
-        width: size.0,
-        height: size.1,
-        spp,
-        seed,
-    }
-}
-
 /// With and without a traversal or pipeline skip: times and the same-image check.
 fn traversal_row(
     session: &mut Viewport,
@@ -181,8 +172,14 @@ fn traversal_row(
         },
         None => everything(with),
     };
-    let (a, _) = session.render_variant(&view, &case.params, &job(size, spp, 5), with)?;
-    let (b, _) = session.render_variant(&view, &case.params, &job(size, spp, 5), without)?;
+    let (a, _) =
+        session.render_variant(&view, &case.params, &RenderJob::sized(size, spp, 5), with)?;
+    let (b, _) = session.render_variant(
+        &view,
+        &case.params,
+        &RenderJob::sized(size, spp, 5),
+        without,
+    )?;
     let same = rel_mse(&b, &a).context("image sizes differ")?;
     if same > SAME_IMAGE {
         bail!(
@@ -216,11 +213,21 @@ fn accumulation_row(
 ) -> Result<Row> {
     let view = case.world.read();
     let reference = session
-        .render(&view, &case.params, &job(size, 64 * SECOND * spp, 1))?
+        .render(
+            &view,
+            &case.params,
+            &RenderJob::sized(size, 64 * SECOND * spp, 1),
+        )?
         .0;
-    let one = session.render(&view, &case.params, &job(size, spp, 2))?.0;
+    let one = session
+        .render(&view, &case.params, &RenderJob::sized(size, spp, 2))?
+        .0;
     let second = session
-        .render(&view, &case.params, &job(size, SECOND * spp, 3))?
+        .render(
+            &view,
+            &case.params,
+            &RenderJob::sized(size, SECOND * spp, 3),
+        )?
         .0;
     let (e1, e60) = (
         rel_mse(&one, &reference).context("sizes")?,

@@ -70,6 +70,18 @@ pub struct RenderJob {
     pub seed: u64,
 }
 
+impl RenderJob {
+    /// `spp` samples per pixel of an image of `size` (width, height) with `seed`.
+    pub fn sized(size: (u32, u32), spp: u32, seed: u64) -> Self {
+        Self {
+            width: size.0,
+            height: size.1,
+            spp,
+            seed,
+        }
+    }
+}
+
 /// Occupancy inside a dielectric medium: the next interaction is the first voxel that is not
 /// this material (no empty-space skipping: empty space is what ends the medium).
 struct InMedium<'a, 'w> {

@@ -42,6 +42,24 @@ pub(crate) unsafe fn after_transfer(ctx: &GpuContext, cmd: vk::CommandBuffer) {
     }
 }
 
+/// Orders one compute pass's writes before the next compute pass's reads and writes.
+///
+/// # Safety
+/// `cmd` must be recording.
+pub(crate) unsafe fn between_passes(ctx: &GpuContext, cmd: vk::CommandBuffer) {
+    // SAFETY: forwarded from the caller.
+    unsafe {
+        barrier(
+            ctx,
+            cmd,
+            vk::PipelineStageFlags::COMPUTE_SHADER,
+            vk::AccessFlags::SHADER_WRITE,
+            vk::PipelineStageFlags::COMPUTE_SHADER,
+            vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
+        )
+    }
+}
+
 /// A global memory barrier.
 ///
 /// # Safety

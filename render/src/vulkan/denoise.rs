@@ -7,7 +7,7 @@
 //! away only while the noise is high: its bias falls as samples accumulate (measured by
 //! `voxbrick bench-error`, choice "denoised"). Never used by reference renders.
 
-use super::barrier::barrier;
+use super::barrier::between_passes;
 use super::buffer::{Binding, HostBuffer};
 use super::pass::{ComputePass, Dispatch, SetCache};
 use super::world::GpuWorld;
@@ -114,21 +114,6 @@ pub struct Denoiser {
     current: bool,
 }
 
-/// Orders one compute pass's writes before the next one's reads and writes.
-fn compute_to_compute(ctx: &GpuContext, cmd: vk::CommandBuffer) {
-    // SAFETY: callers record into a command buffer that is recording.
-    unsafe {
-        barrier(
-            ctx,
-            cmd,
-            vk::PipelineStageFlags::COMPUTE_SHADER,
-            vk::AccessFlags::SHADER_WRITE,
-            vk::PipelineStageFlags::COMPUTE_SHADER,
-            vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
-        );
-    }
-}
-
 impl Denoiser {
     /// Builds the pipelines (buffers come with the first size).
     pub fn new(ctx: &GpuContext) -> Result<Self, GpuError> {
@@ -201,7 +186,8 @@ impl Denoiser {
                 &[],
                 Dispatch::Groups(size.0.div_ceil(8), size.1.div_ceil(8), 1),
             );
-            compute_to_compute(ctx, cmd);
+            // SAFETY: recording.
+            unsafe { between_passes(ctx, cmd) };
         }
         let set = self.filter_set(ctx, sets, accum, false)?;
         let push = Push {
@@ -211,7 +197,8 @@ impl Denoiser {
             flags: if fresh { RESTART } else { 0 },
         };
         self.record_filter_pass(ctx, cmd, set, push);
-        compute_to_compute(ctx, cmd);
+        // SAFETY: recording.
+        unsafe { between_passes(ctx, cmd) };
         self.current = true;
         Ok(())
     }
@@ -271,7 +258,8 @@ impl Denoiser {
         // Prepare writes ping; the steps alternate ping → pong → ping …, ending in pong.
         self.record_filter_pass(ctx, cmd, sets.to_ping, push(PREPARE, 0, 0));
         for step in 0..ITERATIONS {
-            compute_to_compute(ctx, cmd);
+            // SAFETY: recording.
+            unsafe { between_passes(ctx, cmd) };
             let last = step + 1 == ITERATIONS;
             let set = if step % 2 == 0 {
                 sets.to_pong
@@ -285,7 +273,8 @@ impl Denoiser {
                 push(FILTER_STEP, step, if last { LAST } else { 0 }),
             );
         }
-        compute_to_compute(ctx, cmd);
+        // SAFETY: recording.
+        unsafe { between_passes(ctx, cmd) };
         b.pong.binding()
     }
 
