@@ -242,7 +242,8 @@ impl Editor {
             target_spp: self.settings.target_spp,
             exposure: doc.scene.params.settings.exposure + self.settings.exposure,
             bgra: false,
-            denoise: self.settings.denoise,
+            // A script run's capture is compared with headless renders: never denoised.
+            denoise: self.settings.denoise && self.script.is_none(),
         };
         let ui = (!capture_now).then(|| EguiFrame {
             primitives: &primitives,
