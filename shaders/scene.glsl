@@ -75,3 +75,19 @@ void camera_ray(vec2 f, out vec3 o, out vec3 d) {
         d = normalize(p.cam_forward.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v);
     }
 }
+
+// Unpolarized Fresnel reflectance of a smooth interface from index eta_i into eta_t at
+// cos_i; 1 under total internal reflection. `cos_t`: the refracted ray's cosine (0 then).
+float fresnel(float cos_i, float eta_i, float eta_t, out float cos_t) {
+    float eta = eta_i / eta_t;
+    float sin2_t = eta * eta * max(0.0, 1.0 - cos_i * cos_i);
+    float f = 1.0;
+    cos_t = 0.0;
+    if (sin2_t < 1.0) {
+        cos_t = sqrt(1.0 - sin2_t);
+        float rs = (eta_i * cos_i - eta_t * cos_t) / (eta_i * cos_i + eta_t * cos_t);
+        float rp = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
+        f = 0.5 * (rs * rs + rp * rp);
+    }
+    return f;
+}

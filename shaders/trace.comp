@@ -382,15 +382,8 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
         vec3 tint = here >= 0 ? s.albedo : material(medium).albedo;
         float cos_i = -dot(d, n);
         float eta = eta_i / eta_t;
-        float sin2_t = eta * eta * max(0.0, 1.0 - cos_i * cos_i);
-        float f = 1.0;
-        float cos_t = 0.0;
-        if (sin2_t < 1.0) {
-            cos_t = sqrt(1.0 - sin2_t);
-            float rs = (eta_i * cos_i - eta_t * cos_t) / (eta_i * cos_i + eta_t * cos_t);
-            float rp = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
-            f = 0.5 * (rs * rs + rp * rp);
-        }
+        float cos_t;
+        float f = fresnel(cos_i, eta_i, eta_t, cos_t);
         dims(vertex_dims(path_vertex) + 6u);
         if (rand() < f) {
             path_d = normalize(d + n * (2.0 * cos_i));
