@@ -3,13 +3,15 @@
 // 2017), on the accumulation's mean divided by the first hit's albedo, guided by that hit's
 // plane, normal, material kind and albedo (shaders/guides.comp). Its luminance weight uses the
 // variance of each pixel's mean, estimated from the accumulation's batches (each frame adds
-// one), so the filter narrows as samples accumulate: the bias falls with the noise.
+// one), so the filter narrows as samples accumulate, and the last step gives way to the raw
+// mean between FADE_FROM and FADE_TO samples.
 // Modes (one pass each, `pc.mode`):
 //   0 moments: after a batch, the batch's luminance sum S and size k update the pixel's
 //     moments (previous luminance sum, previous count, Σ S²/k, batches);
 //   1 prepare: mean / albedo and the variance of the mean's luminance into `dst`;
-//   2 filter: one à-trous step of 2^step pixels from `src` to `dst` (the last remodulates:
-//     albedo × filtered, count 1, what the display pass reads).
+//   2 filter: one à-trous step of 2^step pixels from `src` to `dst` (the last fades to the
+//     raw mean with the sample count and remodulates: albedo × result, count 1, what the
+//     display pass reads).
 #version 450
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -27,6 +29,11 @@ const float SIGMA_LUMINANCE = 4.0;
 const float SIGMA_ALBEDO = 0.25;
 // Batches before the per-pixel variance is trusted; until then the 3 × 3 spatial variance.
 const float MIN_BATCHES = 4.0;
+// The filtered image gives way to the raw mean between these sample counts (linear in
+// log2 spp): measured on the H200 (BENCHMARKS.md), the filter's bias outweighs the noise it
+// removes beyond 16–64 spp; a converged viewport shows the unbiased image.
+const float FADE_FROM = 8.0;
+const float FADE_TO = 64.0;
 
 float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
 
@@ -156,7 +163,12 @@ void filter_step(ivec2 px, uint i) {
         }
     }
     vec3 result = sum / wsum;
-    dst[i] = last ? vec4(result * albedo, 1.0) : vec4(result, vsum / (wsum * wsum));
+    if (last) {
+        float raw = clamp(log2(max(accum[i].w, 1.0) / FADE_FROM) / log2(FADE_TO / FADE_FROM), 0.0, 1.0);
+        dst[i] = vec4(mix(result, demodulated(i), raw) * albedo, 1.0);
+    } else {
+        dst[i] = vec4(result, vsum / (wsum * wsum));
+    }
 }
 
 void main() {

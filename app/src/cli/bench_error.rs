@@ -790,10 +790,15 @@ fn report(b: &BenchError, ctx: &render::vulkan::GpuContext, runs: &[CaseRun]) ->
                 .map(|v| v.curves.get(k).and_then(|c| speedup(&v.curves[0], c)))
                 .collect();
             let known: Vec<f64> = ratios.iter().flatten().copied().collect();
-            let geo = (known.iter().map(|r| r.ln()).sum::<f64>() / known.len().max(1) as f64).exp();
+            let geo = if known.is_empty() {
+                "–".to_string()
+            } else {
+                let g = (known.iter().map(|r| r.ln()).sum::<f64>() / known.len() as f64).exp();
+                format!("{g:.3}")
+            };
             let _ = writeln!(
                 md,
-                "| {} |{} {geo:.3} |",
+                "| {} |{} {geo} |",
                 curve.name,
                 ratios
                     .iter()

@@ -188,8 +188,21 @@ fn traversal_row(
             case.name
         );
     }
+    let memory = view.memory();
     drop(view);
     let t = steady(session, case, &[(size, with), (size, without)], spp, rounds)?;
+    let mut note = format!("{spp} spp per dispatch");
+    if skip == Skip::FullCells {
+        // What full cells save: each would be a stored uniform brick (68 bytes, no material
+        // bytes), the brick index unchanged.
+        let used = memory.gpu_used() as f64 / 1e6;
+        let _ = write!(
+            note,
+            "; world GPU memory {used:.1} MB with full cells, {:.1} MB with its {} full cells stored as bricks",
+            used + memory.full_cells as f64 * 68.0 / 1e6,
+            memory.full_cells
+        );
+    }
     Ok(Row {
         skip,
         name: skip.name(),
@@ -199,7 +212,7 @@ fn traversal_row(
         without: t[1],
         gain: t[1] / t[0],
         same_image_rel_mse: Some(same),
-        note: format!("{spp} spp per dispatch"),
+        note,
     })
 }
 
