@@ -509,6 +509,15 @@ pub(crate) fn bench_skips(b: BenchSkips, workers: usize) -> Result<String> {
     report(&b, &ctx, &rows)
 }
 
+/// Milliseconds to four places; small errors in scientific notation.
+fn figure(x: f64) -> String {
+    if x < 0.01 {
+        format!("{x:.3e}")
+    } else {
+        format!("{x:.4}")
+    }
+}
+
 fn report(b: &BenchSkips, ctx: &render::vulkan::GpuContext, rows: &[Row]) -> Result<String> {
     let mut md = format!(
         "# What each skip buys\n\n{} ({}), {}x{} internal ({}x{} window for the moving case); GPU times are medians of {} rounds of {ROUND} back-to-back dispatches after two rounds of warm-up, with and without in turn. Gain = without / with (> 1: the skip pays).\n\n| skip | scene | measure | with | without | gain | same image (relMSE) | note |\n|---|---|---|---|---|---|---|---|\n",
@@ -517,12 +526,12 @@ fn report(b: &BenchSkips, ctx: &render::vulkan::GpuContext, rows: &[Row]) -> Res
     for r in rows {
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {:.4} | {:.4} | {:.2} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {:.2} | {} | {} |",
             r.name,
             r.scene,
             r.measure,
-            r.with,
-            r.without,
+            figure(r.with),
+            figure(r.without),
             r.gain,
             r.same_image_rel_mse
                 .map_or("–".into(), |s| format!("{s:.1e}")),
