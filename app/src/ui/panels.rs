@@ -20,8 +20,8 @@ pub struct ViewSettings {
     pub moving_scale: f32,
     /// Display exposure in stops.
     pub exposure: f32,
-    /// Show the viewport denoised (edge-aware, guided by the first hit; its blur fades as
-    /// samples accumulate). Renders and exports never are.
+    /// Show the viewport denoised (edge-aware, guided by the first hit; it gives way to the
+    /// raw image between 8 and 64 spp). Renders and exports never are.
     pub denoise: bool,
     /// Autosave period in seconds (0: off).
     pub autosave_secs: u64,
@@ -320,7 +320,7 @@ pub fn draw(
                 ui.add(egui::Slider::new(&mut view.moving_scale, 0.125..=1.0).text("while moving"));
                 ui.add(egui::Slider::new(&mut view.exposure, -8.0..=8.0).text("exposure (stops)"));
                 ui.checkbox(&mut view.denoise, "denoise the viewport")
-                    .on_hover_text("Edge-aware filter guided by the first hit's normal, albedo and depth; it blurs less as samples accumulate. Renders and exports are never denoised.");
+                    .on_hover_text("Edge-aware filter guided by the first hit's normal, albedo and depth; between 8 and 64 samples it gives way to the path-traced image. Renders and exports are never denoised.");
                 let mut settings = doc.scene.params.settings.clone();
                 if ui
                     .add(

@@ -1,11 +1,11 @@
-//! The viewport's edge-aware denoiser: guides from the first hit of each pixel's centre ray
-//! (`shaders/guides.comp`: hit point, footprint, albedo, material kind and face), then an
-//! à-trous wavelet filter with a variance-guided luminance weight on the accumulation's mean
-//! divided by the albedo (`shaders/denoise.comp`). Its luminance weight is measured in
-//! standard deviations of each pixel's mean, estimated from the accumulation's batches (one
-//! per frame, `record_moments` after each), so the filter keeps less of the image's detail
-//! away only while the noise is high: its bias falls as samples accumulate (measured by
-//! `voxbrick bench-error`, choice "denoised"). Never used by reference renders.
+//! The viewport's edge-aware denoiser: guides from the first surface each pixel's centre ray
+//! meets past mirrors and glass (`shaders/guides.comp`: hit point, footprint, albedo, material
+//! kind and face), then an à-trous wavelet filter with a variance-guided luminance weight on
+//! the accumulation's mean divided by the albedo (`shaders/denoise.comp`). Its luminance
+//! weight is measured in standard deviations of each pixel's mean, estimated from the
+//! accumulation's batches (one per frame, `record_batch` after each); its last step gives way
+//! to the raw mean between 8 and 64 spp, where its bias would outweigh the noise it removes
+//! (measured by `voxbrick bench-error`, choice "denoised"). Never used by reference renders.
 
 use super::barrier::between_passes;
 use super::buffer::{Binding, HostBuffer};
