@@ -21,10 +21,10 @@ fn ok(args: &[&str]) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
-/// Runs voxbrick with a GPU command's arguments: true when it succeeded, false (saying so)
-/// when this machine has no Vulkan driver, unless VOXBRICK_REQUIRE_GPU=1 (CI) makes that a
-/// failure; any other failure fails the test.
-fn succeeds_on_gpu(args: &[&str]) -> bool {
+/// Runs voxbrick with a GPU command's arguments: its standard output when it succeeded, None
+/// (saying so) when this machine has no Vulkan driver, unless VOXBRICK_REQUIRE_GPU=1 (CI)
+/// makes that a failure; any other failure fails the test.
+fn succeeds_on_gpu(args: &[&str]) -> Option<String> {
     let out = voxbrick(args);
     let err = String::from_utf8_lossy(&out.stderr);
     if !out.status.success()
@@ -34,10 +34,10 @@ fn succeeds_on_gpu(args: &[&str]) -> bool {
         eprintln!(
             "SKIPPED: no Vulkan driver on this machine; VOXBRICK_REQUIRE_GPU=1 makes this a failure"
         );
-        return false;
+        return None;
     }
     assert!(out.status.success(), "{args:?}: {err}");
-    true
+    Some(String::from_utf8_lossy(&out.stdout).into_owned())
 }
 
 fn fails(args: &[&str]) -> String {
@@ -275,7 +275,7 @@ fn stress_on_the_cpu_reference_writes_its_report() {
 #[test]
 fn bench_plays_the_path_and_writes_its_report() {
     let dir = scratch("bench");
-    if !succeeds_on_gpu(&[
+    if succeeds_on_gpu(&[
         "bench",
         "--sizes",
         "32x18",
@@ -295,7 +295,9 @@ fn bench_plays_the_path_and_writes_its_report() {
         "2",
         "--out",
         s(&dir),
-    ]) {
+    ])
+    .is_none()
+    {
         return;
     }
     let v: serde_json::Value =
@@ -346,7 +348,7 @@ fn bench_plays_the_path_and_writes_its_report() {
 #[test]
 fn bench_error_measures_every_choice_against_a_checked_reference() {
     let dir = scratch("bench-error");
-    if !succeeds_on_gpu(&[
+    if succeeds_on_gpu(&[
         "bench-error",
         "--size",
         "32x18",
@@ -360,7 +362,9 @@ fn bench_error_measures_every_choice_against_a_checked_reference() {
         "lamps",
         "--out",
         s(&dir),
-    ]) {
+    ])
+    .is_none()
+    {
         return;
     }
     let v: serde_json::Value =
@@ -452,7 +456,7 @@ fn bench_error_measures_every_choice_against_a_checked_reference() {
 #[test]
 fn bench_skips_measures_each_skip_on_two_scenes() {
     let dir = scratch("bench-skips");
-    if !succeeds_on_gpu(&[
+    if succeeds_on_gpu(&[
         "bench-skips",
         "--size",
         "32x18",
@@ -462,7 +466,9 @@ fn bench_skips_measures_each_skip_on_two_scenes() {
         "1",
         "--out",
         s(&dir),
-    ]) {
+    ])
+    .is_none()
+    {
         return;
     }
     let v: serde_json::Value =
@@ -495,4 +501,41 @@ fn bench_skips_measures_each_skip_on_two_scenes() {
     fails(&["bench-skips", "--size", "0x5", "--out", s(&bad)]);
     fails(&["bench-skips", "--window", "big", "--out", s(&bad)]);
     assert_eq!(std::fs::read_dir(&bad).unwrap().count(), 0);
+}
+
+#[test]
+fn bench_viewport_times_the_frames_with_the_denoiser_too() {
+    let args = [
+        "bench-viewport",
+        "--size",
+        "64x64",
+        "--scales",
+        "1.0",
+        "--frames",
+        "4",
+        "--denoise",
+    ];
+    let Some(text) = succeeds_on_gpu(&args) else {
+        return;
+    };
+    for case in [
+        "refining (still camera)",
+        "camera moving",
+        "refining, denoised",
+        "moving, denoised",
+    ] {
+        let line = text
+            .lines()
+            .find(|l| l.contains(case))
+            .unwrap_or_else(|| panic!("no {case}: {text}"));
+        // min / median / p99 / max GPU ms, each a positive number.
+        let times: Vec<f64> = line
+            .split_whitespace()
+            .filter_map(|w| w.parse().ok())
+            .collect();
+        assert!(
+            times.len() >= 5 && times[..5].iter().all(|t| *t > 0.0),
+            "{line}"
+        );
+    }
 }
