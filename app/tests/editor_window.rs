@@ -513,8 +513,16 @@ fn strokes_drawn_with_the_mouse_replay_headlessly_to_the_same_scene() {
     pause(1.0);
     xdotool(d, &["key", "ctrl+f"]);
     pause(1.0);
+    // Quit once the save is on disk (a quit before it would ask about unsaved changes; on a
+    // loaded machine the save can take longer than a fixed pause).
+    let modified = || std::fs::metadata(&work).and_then(|m| m.modified()).ok();
+    let before = modified();
     xdotool(d, &["key", "ctrl+s"]);
-    pause(2.0);
+    let asked = Instant::now();
+    while modified() == before && asked.elapsed() < Duration::from_secs(30) {
+        pause(0.2);
+    }
+    pause(1.0);
     xdotool(d, &["key", "ctrl+q"]);
     let started = Instant::now();
     while started.elapsed() < Duration::from_secs(60) {
