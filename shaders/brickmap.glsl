@@ -186,7 +186,7 @@ bool dda(ivec3 cell, float t, int axis, int medium, float t_max, out ivec3 voxel
                             ivec3 b = cell >> 3;
                             uint probe = (uint(b.x) * g_dims.z + uint(b.z)) * g_dims.y + uint(b.y);
                             bool solid;
-                            if (brick_block(probe % uint(bricks.length()), cell, solid) > 2) hit = solid;
+                            if (brick_block(probe % max(uint(bricks.length()), 1u), cell, solid) > 2) hit = solid;
                         }
                     }
                     else if ((SKIPS_OFF & 2u) != 0u) hit = voxel_bit(w, cell);

@@ -105,8 +105,6 @@ pub struct Viewport {
     held: u32,
     /// The edge-aware denoiser (made when first asked for).
     denoiser: Option<Denoiser>,
-    /// The denoiser's output holds the live accumulation's filtered image.
-    denoised: bool,
     ctx: Arc<GpuContext>,
 }
 
@@ -169,7 +167,6 @@ impl Viewport {
             last_gpu_seconds: None,
             held: 0,
             denoiser: None,
-            denoised: false,
             ctx,
         })
     }
@@ -237,7 +234,6 @@ impl Viewport {
         if self.denoiser.is_none() {
             self.denoiser = Some(Denoiser::new(&ctx)?);
         }
-        self.denoised = false;
         let size = (job.width, job.height);
         let mut acc = Progressive::new(&ctx, size, size, job.seed)?;
         let mut guide_params = match HostBuffer::new(
@@ -398,12 +394,9 @@ impl Viewport {
         let (Some(live), Some(d)) = (&self.live, &self.denoiser) else {
             return Ok(None);
         };
-        match d.output() {
-            Some(out) if self.denoised && d.is_current() => {
-                read_image(&self.ctx, out, live.internal()).map(Some)
-            }
-            _ => Ok(None),
-        }
+        d.filtered_output()
+            .map(|out| read_image(&self.ctx, out, live.internal()))
+            .transpose()
     }
 
     /// The next frame slot, if its previous submission finished; never blocks.
@@ -460,7 +453,6 @@ impl Viewport {
                 s.sets.clear(&ctx);
             }
             self.live = Some(Progressive::new(&ctx, internal, output, 1)?);
-            self.denoised = false;
             if let Some(d) = &mut self.denoiser {
                 d.invalidate();
             }
@@ -533,14 +525,12 @@ impl Viewport {
                     restarted,
                 )?;
                 shown = d.record_filter(&ctx, frame.cmd, &mut slot.sets, live.accumulation())?;
-                self.denoised = true;
-            } else if self.denoised && d.is_current() {
-                shown = d.output().expect("filtered before");
+            } else if let Some(out) = d.filtered_output() {
+                shown = out;
             }
         } else if let Some(d) = &mut self.denoiser {
             // Batches added meanwhile are not in its moments.
             d.invalidate();
-            self.denoised = false;
         }
         let slot = &mut self.frames[frame.slot];
         let ldr = slot.ldr.as_ref().expect("ensured above").binding();

@@ -112,6 +112,8 @@ pub struct Denoiser {
     buffers: Option<Buffers>,
     /// The guides and moments describe the current accumulation.
     current: bool,
+    /// The output holds the filter of the accumulation's latest batch.
+    filtered: bool,
 }
 
 impl Denoiser {
@@ -130,6 +132,7 @@ impl Denoiser {
             filter,
             buffers: None,
             current: false,
+            filtered: false,
         })
     }
 
@@ -137,6 +140,7 @@ impl Denoiser {
     /// (a restarted accumulation, a new one, or the denoiser switched back on).
     pub fn invalidate(&mut self) {
         self.current = false;
+        self.filtered = false;
     }
 
     /// Buffers for `size` (the caller made sure no submission still uses the old ones).
@@ -146,7 +150,7 @@ impl Denoiser {
                 old.destroy(ctx);
             }
             self.buffers = Some(Buffers::new(ctx, size)?);
-            self.current = false;
+            self.invalidate();
         }
         Ok(self.buffers.as_ref().expect("made above"))
     }
@@ -200,6 +204,7 @@ impl Denoiser {
         // SAFETY: recording.
         unsafe { between_passes(ctx, cmd) };
         self.current = true;
+        self.filtered = false;
         Ok(())
     }
 
@@ -213,18 +218,30 @@ impl Denoiser {
         self.current
     }
 
+    /// The output, when it holds the filter of the current accumulation's latest batch (what a
+    /// frame that adds no samples displays again).
+    pub fn filtered_output(&self) -> Option<Binding> {
+        if self.current && self.filtered {
+            self.output()
+        } else {
+            None
+        }
+    }
+
     /// Records the filter of `accum` (its guides and moments recorded by
     /// [`Denoiser::record_batch`]); returns the denoised image (radiance, count 1 per pixel)
     /// for the display pass, its writes ordered before later compute passes.
     pub fn record_filter(
-        &self,
+        &mut self,
         ctx: &GpuContext,
         cmd: vk::CommandBuffer,
         sets: &mut SetCache,
         accum: Binding,
     ) -> Result<Binding, GpuError> {
         let filter_sets = self.filter_sets(ctx, sets, accum)?;
-        Ok(self.record_filter_sets(ctx, cmd, filter_sets))
+        let out = self.record_filter_sets(ctx, cmd, filter_sets);
+        self.filtered = true;
+        Ok(out)
     }
 
     /// The two sets [`Denoiser::record_filter_sets`] binds (fetched first by callers that
