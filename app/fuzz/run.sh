@@ -7,7 +7,7 @@ cd "$(dirname "$0")"
 seconds=${1:-600}
 root=../..
 mkdir -p corpus/project_ron corpus/vox_import
-cp "$root"/assets/vox/*.vox corpus/vox_import/
+cp "$root"/assets/vox/*.vox seeds/vox_import/*.vox corpus/vox_import/
 cargo build --release --manifest-path "$root/Cargo.toml" -p app --bin voxbrick -q
 voxbrick=$root/target/release/voxbrick
 "$voxbrick" new --terrain --size 16x16x16 --water-level 6 --height-min 2 --height-max 12 corpus/project_ron/terrain.ron 2>/dev/null

@@ -1,6 +1,8 @@
 //! Atomic file replacement: write a temporary file in the target's folder, flush and fsync
 //! it, then rename it over the target (and fsync the folder). A failure at any step leaves
-//! the previous file as it was and removes the temporary file.
+//! the previous file as it was and removes the temporary file. A process killed mid-save
+//! leaves the previous file whole and its temporary file behind; the next save of the same
+//! file removes such leftovers of processes no longer running.
 
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Write};
@@ -43,8 +45,34 @@ pub fn write_atomic(
     })();
     if result.is_err() {
         let _ = fs::remove_file(&tmp);
+    } else {
+        remove_stale(&dir, &name.to_string_lossy());
     }
     result
+}
+
+/// Removes temporary files of `name` in `dir` left by processes that no longer run (killed
+/// mid-save). Only where `/proc` tells which processes run (Linux); errors are ignored.
+fn remove_stale(dir: &Path, name: &str) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let prefix = format!(".{name}.tmp-");
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file = entry.file_name();
+        let Some(rest) = file.to_str().and_then(|f| f.strip_prefix(&prefix)) else {
+            continue;
+        };
+        let Some(pid) = rest.split('-').next().and_then(|p| p.parse::<u32>().ok()) else {
+            continue;
+        };
+        if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = fs::remove_file(entry.path());
+        }
+    }
 }
 
 #[cfg(test)]
@@ -84,6 +112,25 @@ mod tests {
             fs::read_dir(&d).unwrap().count(),
             1,
             "temporary file removed"
+        );
+    }
+
+    #[test]
+    fn leftovers_of_killed_saves_are_removed_by_the_next_save() {
+        let d = scratch("stale");
+        let p = d.join("scene.ron");
+        // A process id that is not running (beyond the kernel's pid_max of 2^22) and this
+        // process's own in-flight name, which must stay.
+        let dead = d.join(".scene.ron.tmp-4999999-0");
+        let other = d.join(".other.ron.tmp-4999999-0");
+        fs::write(&dead, b"torn").unwrap();
+        fs::write(&other, b"another file's").unwrap();
+        write_atomic(&p, |w: &mut dyn Write| w.write_all(b"new")).unwrap();
+        assert_eq!(fs::read(&p).unwrap(), b"new");
+        assert!(!dead.exists(), "the dead process's temporary file is gone");
+        assert!(
+            other.exists(),
+            "another file's temporary file is not touched"
         );
     }
 

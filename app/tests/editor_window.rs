@@ -6,120 +6,15 @@
 //! (xwd) must show a window that is not blank. Without Xvfb/xwd or a Vulkan driver the test
 //! skips, saying so, unless VOXBRICK_REQUIRE_GPU=1 (CI) makes that a failure.
 
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+mod window;
+
+use std::path::Path;
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
+use window::{Xvfb, have, no_vulkan, read_png, scratch, skip};
 
 const SIZE: (u32, u32) = (160, 96);
 const SPP: u32 = 16;
-
-fn require() -> bool {
-    std::env::var("VOXBRICK_REQUIRE_GPU").as_deref() == Ok("1")
-}
-
-fn skip(why: &str) {
-    assert!(!require(), "{why}, and VOXBRICK_REQUIRE_GPU=1");
-    eprintln!("SKIPPED: {why}; VOXBRICK_REQUIRE_GPU=1 makes this a failure");
-}
-
-/// The editor exited because this machine has no Vulkan device that can draw a window.
-fn no_vulkan(out: &std::process::Output) -> bool {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    !out.status.success()
-        && (stderr.contains("no usable Vulkan") || stderr.contains("no Vulkan device"))
-}
-
-fn have(tool: &str) -> bool {
-    Command::new("sh")
-        .args(["-c", &format!("command -v {tool}")])
-        .stdout(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success())
-}
-
-/// An Xvfb server of our own, killed on drop.
-struct Xvfb {
-    child: Child,
-    display: String,
-}
-
-impl Xvfb {
-    fn start() -> Option<Self> {
-        Self::start_sized("320x240")
-    }
-
-    fn start_sized(size: &str) -> Option<Self> {
-        // Tests of this file run in parallel: each takes its own number, and a server that
-        // lost the race for a number (it exits at once) makes it try the next.
-        static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
-        for _ in 0..20 {
-            let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            let number = 90 + (std::process::id() * 7 + n) % 400;
-            if Path::new(&format!("/tmp/.X11-unix/X{number}")).exists()
-                || Path::new(&format!("/tmp/.X{number}-lock")).exists()
-            {
-                continue;
-            }
-            let display = format!(":{number}");
-            let child = Command::new("Xvfb")
-                .args([
-                    &display,
-                    "-screen",
-                    "0",
-                    &format!("{size}x24"),
-                    "-nolisten",
-                    "tcp",
-                ])
-                .stdout(Stdio::null())
-                .stderr(Stdio::null())
-                .spawn()
-                .ok()?;
-            let mut x = Xvfb { child, display };
-            let socket = format!("/tmp/.X11-unix/X{number}");
-            let started = Instant::now();
-            while started.elapsed() < Duration::from_secs(10) {
-                if Path::new(&socket).exists() {
-                    // Ours, not another one's: still running a moment later.
-                    std::thread::sleep(Duration::from_millis(200));
-                    if let Ok(None) = x.child.try_wait() {
-                        return Some(x);
-                    }
-                    break;
-                }
-                if let Ok(Some(_)) = x.child.try_wait() {
-                    break;
-                }
-                std::thread::sleep(Duration::from_millis(50));
-            }
-            let _ = x.child.kill();
-        }
-        None
-    }
-}
-
-impl Drop for Xvfb {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("voxbrick-window-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn read_png(path: &Path) -> (u32, u32, Vec<u8>) {
-    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
-    let mut reader = decoder.read_info().unwrap();
-    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
-    let info = reader.next_frame(&mut buf).unwrap();
-    assert_eq!(info.color_type, png::ColorType::Rgb, "{}", path.display());
-    buf.truncate(info.buffer_size());
-    (info.width, info.height, buf)
-}
 
 fn rms(a: &[u8], b: &[u8]) -> f64 {
     assert_eq!(a.len(), b.len());
@@ -297,6 +192,76 @@ fn the_live_editor_presents_what_a_headless_render_of_the_same_state_shows() {
     );
 }
 
+/// The editor's frame loop on the built-in default scene in a full-HD window with the
+/// validation layer: no message at all (warnings included), with the device's own limits and
+/// with them capped to 16 MiB of storage range and 64 MiB per allocation (the sized-down
+/// paths: the shadow-ray queue, one world buffer per region, a smaller internal image). At
+/// 1280 × 720 the shadow-ray queue once passed lavapipe's 128 MiB range (12 validation
+/// errors per session).
+#[test]
+fn the_default_scene_in_a_full_hd_window_stays_within_the_device_limits() {
+    if !have("Xvfb") {
+        return skip("Xvfb is not installed (package xvfb)");
+    }
+    let Some(x) = Xvfb::start_sized("1920x1080") else {
+        return skip("Xvfb did not start");
+    };
+    let dir = scratch("full-hd");
+    let script = dir.join("default.ron");
+    std::fs::write(
+        &script,
+        r#"(format_version: 1, start: Default, steps: [
+            Do(Stroke((mode: Attach, shape: Sphere, size: 6.0, material: 0, points: [(256.0, 226.0, 256.0), (300.0, 226.0, 280.0)]))),
+        ])"#,
+    )
+    .unwrap();
+    for caps in [None, Some(("16M", "64M"))] {
+        let capture = dir.join("capture.png");
+        let _ = std::fs::remove_file(&capture);
+        let mut command = Command::new(env!("CARGO_BIN_EXE_voxbrick"));
+        command
+            .arg("--script")
+            .arg(&script)
+            .arg("--capture")
+            .arg(&capture)
+            .args([
+                "--capture-spp",
+                "2",
+                "--window",
+                "1920x1080",
+                "--validation",
+            ])
+            .env("DISPLAY", &x.display)
+            .env_remove("WAYLAND_DISPLAY")
+            .env_remove("VOXBRICK_MAX_STORAGE_RANGE")
+            .env_remove("VOXBRICK_MAX_ALLOCATION")
+            .env("VOXBRICK_CONFIG_DIR", dir.join("config"));
+        if let Some((range, allocation)) = caps {
+            command
+                .env("VOXBRICK_MAX_STORAGE_RANGE", range)
+                .env("VOXBRICK_MAX_ALLOCATION", allocation);
+        }
+        let out = command.output().unwrap();
+        if no_vulkan(&out) {
+            return skip(&format!(
+                "no Vulkan device can draw a window: {}",
+                String::from_utf8_lossy(&out.stderr).trim()
+            ));
+        }
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            out.status.success(),
+            "caps {caps:?}: the editor failed: {stderr}"
+        );
+        assert!(
+            !stderr.contains("vulkan "),
+            "caps {caps:?}: validation messages:\n{stderr}"
+        );
+        let (w, h, _) = read_png(&capture);
+        assert_eq!((w, h), (1920, 1080), "caps {caps:?}");
+    }
+}
+
 #[test]
 fn without_a_display_the_editor_says_so_in_one_line() {
     let out = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
@@ -417,192 +382,4 @@ fn a_gpu_failure_mid_session_keeps_the_unsaved_work_in_the_recovery_file() {
     let command: app::editor::command::Command = ron::from_str(last).unwrap();
     command.apply(&mut expected, &dir).unwrap();
     assert_eq!(hash(&recovered), hash(&expected));
-}
-
-/// Runs xdotool with these arguments against the test's display.
-fn xdotool(display: &str, args: &[&str]) -> String {
-    let out = Command::new("xdotool")
-        .args(args)
-        .env("DISPLAY", display)
-        .output()
-        .expect("xdotool runs");
-    assert!(
-        out.status.success(),
-        "xdotool {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-#[test]
-fn strokes_drawn_with_the_mouse_replay_headlessly_to_the_same_scene() {
-    if !have("Xvfb") || !have("xdotool") {
-        return skip("Xvfb or xdotool is not installed (packages xvfb, xdotool)");
-    }
-    let Some(x) = Xvfb::start_sized("800x600") else {
-        return skip("Xvfb did not start");
-    };
-    let dir = scratch("strokes");
-    let work = dir.join("work.ron");
-    let made = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
-        .args(["new", "--terrain", "--size", "64x32x64"])
-        .arg(&work)
-        .output()
-        .unwrap();
-    assert!(made.status.success());
-    let session = dir.join("session.ron");
-    let mut editor = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
-        .arg(&work)
-        .arg("--record")
-        .arg(&session)
-        .args(["--window", "640x400", "--validation"])
-        .env("DISPLAY", &x.display)
-        .env_remove("WAYLAND_DISPLAY")
-        .env("VOXBRICK_CONFIG_DIR", dir.join("config"))
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("voxbrick starts");
-    let d = x.display.as_str();
-    let window = xdotool(d, &["search", "--sync", "--name", "voxbrick"]);
-    let window = window.lines().next().unwrap().to_string();
-    std::thread::sleep(Duration::from_secs(4));
-    xdotool(d, &["windowfocus", &window]);
-    let pause = |s: f64| std::thread::sleep(Duration::from_secs_f64(s));
-    // Each press waits for a frame or two with the cursor over the viewport (right of the
-    // tools window), so the panels know the pointer is not theirs.
-    let drag = |points: &[(i32, i32)]| {
-        let (x0, y0) = points[0];
-        xdotool(d, &["mousemove", &x0.to_string(), &y0.to_string()]);
-        pause(1.5);
-        xdotool(d, &["mousedown", "1"]);
-        for (x, y) in &points[1..] {
-            xdotool(d, &["mousemove", &x.to_string(), &y.to_string()]);
-            pause(0.3);
-        }
-        xdotool(d, &["mouseup", "1"]);
-        pause(1.0);
-    };
-    // A click that closes a menu draws nothing.
-    xdotool(d, &["mousemove", "20", "11"]);
-    pause(1.0);
-    xdotool(d, &["click", "1"]);
-    pause(1.5);
-    drag(&[(480, 220)]);
-    // Attach, paint, undo, redo, erase, save, quit.
-    drag(&[(480, 220), (490, 230), (500, 230), (510, 230), (520, 230)]);
-    xdotool(d, &["key", "p"]);
-    drag(&[(450, 300), (470, 300), (490, 310)]);
-    xdotool(d, &["key", "ctrl+z"]);
-    pause(1.0);
-    xdotool(d, &["key", "ctrl+shift+z"]);
-    pause(1.0);
-    xdotool(d, &["key", "x"]);
-    drag(&[(560, 260), (565, 262)]);
-    // Selection: a box, copy, move it, paste the copy elsewhere, fill the pasted region.
-    xdotool(d, &["key", "m"]);
-    drag(&[(430, 250), (450, 260), (470, 270)]);
-    xdotool(d, &["key", "ctrl+c"]);
-    pause(1.0);
-    xdotool(d, &["key", "Right"]);
-    pause(1.0);
-    xdotool(d, &["key", "ctrl+v"]);
-    xdotool(d, &["mousemove", "520", "200"]);
-    pause(1.5);
-    xdotool(d, &["click", "1"]);
-    pause(1.0);
-    xdotool(d, &["key", "ctrl+f"]);
-    pause(1.0);
-    // Quit once the save is on disk (a quit before it would ask about unsaved changes; on a
-    // loaded machine the save can take longer than a fixed pause).
-    let modified = || std::fs::metadata(&work).and_then(|m| m.modified()).ok();
-    let before = modified();
-    xdotool(d, &["key", "ctrl+s"]);
-    let asked = Instant::now();
-    while modified() == before && asked.elapsed() < Duration::from_secs(30) {
-        pause(0.2);
-    }
-    pause(1.0);
-    xdotool(d, &["key", "ctrl+q"]);
-    // On a loaded machine a key can go missing (no window manager keeps the focus): ask again,
-    // focused, every 15 s.
-    let started = Instant::now();
-    let mut asked_at = Instant::now();
-    while started.elapsed() < Duration::from_secs(90) {
-        if let Ok(Some(_)) = editor.try_wait() {
-            break;
-        }
-        if asked_at.elapsed() > Duration::from_secs(15) {
-            eprintln!(
-                "the editor has not quit after {:?}: ctrl+q again",
-                started.elapsed()
-            );
-            let _ = Command::new("xdotool")
-                .args(["windowfocus", &window, "key", "ctrl+q"])
-                .env("DISPLAY", d)
-                .output();
-            asked_at = Instant::now();
-        }
-        pause(0.1);
-    }
-    let _ = editor.kill();
-    let out = editor.wait_with_output().unwrap();
-    if no_vulkan(&out) {
-        return skip(&format!(
-            "no Vulkan device can draw a window: {}",
-            String::from_utf8_lossy(&out.stderr).trim()
-        ));
-    }
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        out.status.success(),
-        "the editor (validation on) failed: {stderr}"
-    );
-    // What the mouse and keys did, as recorded.
-    let text = std::fs::read_to_string(&session).expect("the session was recorded");
-    for what in [
-        "mode: Attach",
-        "mode: Paint",
-        "Undo",
-        "Redo",
-        "mode: Erase",
-        "Select(Replace",
-        "Copy",
-        "MoveSelection",
-        "Paste(",
-        "FillSelection",
-        "Save(\"work.ron\")",
-    ] {
-        assert!(
-            text.contains(what),
-            "{what} missing from the session:\n{text}"
-        );
-    }
-    assert_eq!(
-        text.matches("Stroke(").count(),
-        3,
-        "attach, paint and erase; the click that closed the menu drew nothing:\n{text}"
-    );
-    // The same actions replayed headlessly give the scene the window saved.
-    let replayed = dir.join("replayed");
-    let replay = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
-        .arg("replay")
-        .arg(&session)
-        .arg("--out-dir")
-        .arg(&replayed)
-        .output()
-        .unwrap();
-    assert!(
-        replay.status.success(),
-        "{}",
-        String::from_utf8_lossy(&replay.stderr)
-    );
-    let hash = |p: &Path| app::Scene::load(p, 1).unwrap().world.read().content_hash();
-    let saved = hash(&work);
-    assert_ne!(
-        saved,
-        hash(&dir.join("session-start.ron")),
-        "the session changed the scene"
-    );
-    assert_eq!(saved, hash(&replayed.join("work.ron")));
 }

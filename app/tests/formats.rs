@@ -556,3 +556,137 @@ fn matl_materials_map_to_voxbrick_materials() {
         report.dropped
     );
 }
+
+/// Hostile or damaged .vox files are refused with the chunk and its byte offset, and nothing
+/// is written; a file whose every model is left out is an error saying why, not an empty
+/// success. (The seeds in app/fuzz/seeds/vox_import are these files.)
+#[test]
+fn hostile_vox_files_are_refused_and_nothing_left_out_silently() {
+    let seeds = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/vox_import");
+    let dir = std::env::temp_dir().join(format!("voxbrick-hostile-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (file, want) in [
+        (
+            "huge_model_empty_xyzi.vox",
+            "chunk SIZE at byte 20 declares a 2000000000 × 2000000000 × 2000000000 model",
+        ),
+        (
+            "count_beyond_bytes.vox",
+            "chunk XYZI at byte 44 claims 1000 voxels but holds 1",
+        ),
+        (
+            "voxel_outside_model.vox",
+            "voxel 1 at (9, 0, 0) lies outside its 4 × 4 × 4 model",
+        ),
+        ("truncated.vox", "the file ends 5 bytes short (truncated)"),
+        ("size_without_xyzi.vox", "has no XYZI chunk after it"),
+        ("zero_size.vox", "declares a 0 × 4 × 4 model"),
+    ] {
+        let e = vox::import_file(&seeds.join(file), &vox::ImportOptions::default(), 1)
+            .map(|_| ())
+            .unwrap_err();
+        assert!(matches!(e, FormatError::Invalid { .. }), "{file}: {e}");
+        assert!(e.to_string().contains(want), "{file}: {e}");
+        // The command line: a one-line error, exit non-zero, nothing written.
+        let out = dir.join(format!("{file}.ron"));
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_voxbrick"))
+            .arg("convert")
+            .arg(seeds.join(file))
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(!run.status.success(), "{file}");
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{file}: {stderr}");
+        assert!(!out.exists(), "{file}: nothing is written");
+    }
+
+    // Every model on a hidden layer: an error naming why; with hidden nodes included, the
+    // import works.
+    use dot_vox::*;
+    let model = Model {
+        size: Size { x: 2, y: 2, z: 2 },
+        voxels: vec![
+            Voxel {
+                x: 0,
+                y: 0,
+                z: 0,
+                i: 5,
+            },
+            Voxel {
+                x: 1,
+                y: 1,
+                z: 1,
+                i: 6,
+            },
+        ],
+    };
+    let mut hidden_layer = Dict::new();
+    hidden_layer.insert("_hidden".into(), "1".into());
+    let scenes = vec![
+        SceneNode::Transform {
+            attributes: Dict::new(),
+            frames: vec![Frame::new(Dict::new())],
+            child: 1,
+            layer_id: 0,
+        },
+        SceneNode::Shape {
+            attributes: Dict::new(),
+            models: vec![ShapeModel {
+                model_id: 0,
+                attributes: Dict::new(),
+            }],
+        },
+    ];
+    let bytes = common::vox_bytes(
+        vec![model],
+        vec![],
+        scenes,
+        vec![Layer {
+            attributes: hidden_layer,
+        }],
+    );
+    let e = vox::import_bytes(
+        &bytes,
+        Path::new("hidden.vox"),
+        &vox::ImportOptions::default(),
+        1,
+    )
+    .map(|_| ())
+    .unwrap_err();
+    let text = e.to_string();
+    assert!(
+        text.contains("nothing to import") && text.contains("hidden layer 0 skipped"),
+        "{text}"
+    );
+    let (scene, report) = vox::import_bytes(
+        &bytes,
+        Path::new("hidden.vox"),
+        &vox::ImportOptions {
+            include_hidden: true,
+            ..Default::default()
+        },
+        1,
+    )
+    .unwrap();
+    assert_eq!(report.voxels, 2);
+    assert_eq!(scene.world.read().solid_count(), 2);
+    // Importing into a world where every voxel lands outside the grid: an error, no edit.
+    let world = Scene::empty(GridDims::new(1, 1, 1).unwrap(), 1)
+        .unwrap()
+        .world;
+    let before = world.read().content_hash();
+    let e = vox::import_into(
+        &world,
+        &bytes,
+        &vox::ImportOptions {
+            include_hidden: true,
+            offset: IVec3::new(100, 0, 0),
+        },
+        None,
+    )
+    .map(|_| ())
+    .unwrap_err();
+    assert!(e.contains("outside the"), "{e}");
+    assert_eq!(world.read().content_hash(), before);
+}

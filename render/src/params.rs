@@ -154,7 +154,25 @@ impl Camera {
         (camera, distance)
     }
 
-    /// A camera at `position` looking at `target`.
+    /// A camera at `position` looking at `target`, refusing a target that gives no direction
+    /// (at the eye, or within 10⁻⁶ voxels of it) and non-finite points: what every target a
+    /// user types goes through.
+    pub fn aimed(position: DVec3, target: DVec3, fov_y_deg: f64) -> Result<Self, ParamError> {
+        check(finite3(position), "camera eye", position, "finite numbers")?;
+        check(finite3(target), "camera target", target, "finite numbers")?;
+        check(
+            position.distance(target) > 1e-6,
+            "camera target",
+            target,
+            "the points away from the eye (this one is the eye: the view would have no direction)",
+        )?;
+        let camera = Self::looking_at(position, target, fov_y_deg);
+        camera.validate()?;
+        Ok(camera)
+    }
+
+    /// A camera at `position` looking at `target` (a target at the eye looks along −z; user
+    /// input goes through [`Camera::aimed`], which refuses it).
     pub fn looking_at(position: DVec3, target: DVec3, fov_y_deg: f64) -> Self {
         let d = (target - position).normalize_or(DVec3::NEG_Z);
         let pitch = d.y.clamp(-1.0, 1.0).asin().to_degrees().clamp(-89.0, 89.0);
@@ -455,6 +473,19 @@ mod tests {
         let want = (DVec3::new(10.0, 0.0, -7.0) - DVec3::new(1.0, 5.0, 2.0)).normalize();
         assert!((c.forward() - want).length() < 1e-12);
         c.validate().unwrap();
+    }
+
+    #[test]
+    fn a_target_at_the_eye_is_refused() {
+        let eye = DVec3::new(3.0, 4.0, 5.0);
+        let e = Camera::aimed(eye, eye, 45.0).unwrap_err();
+        assert_eq!(e.what, "camera target");
+        assert!(e.to_string().contains("no direction"), "{e}");
+        assert!(Camera::aimed(eye, eye + DVec3::splat(1e-9), 45.0).is_err());
+        assert!(Camera::aimed(eye, DVec3::new(f64::NAN, 0.0, 0.0), 45.0).is_err());
+        assert!(Camera::aimed(DVec3::INFINITY, eye, 45.0).is_err());
+        let c = Camera::aimed(eye, eye + DVec3::X, 45.0).unwrap();
+        assert!((c.forward() - DVec3::X).length() < 1e-12);
     }
 
     #[test]

@@ -28,6 +28,11 @@ use brickmap::{World, WorldView};
 use std::mem::ManuallyDrop;
 use std::sync::Arc;
 
+/// The most bytes per traced pixel one buffer of a frame holds (the denoiser's guides; the
+/// accumulation holds 16): the internal size is fitted so that it stays within the device's
+/// limits ([`Viewport::fit_internal`]).
+pub const IMAGE_BYTES_PER_PIXEL: u64 = 32;
+
 /// What the interactive loop asks of one frame.
 #[derive(Clone, Copy, Debug)]
 pub struct FrameRequest<'a> {
@@ -420,6 +425,15 @@ impl Viewport {
         }))
     }
 
+    /// The internal size a frame asked at `size` is traced at: `size` itself, or the largest
+    /// of its aspect whose per-pixel buffers (at most [`IMAGE_BYTES_PER_PIXEL`]: the
+    /// denoiser's guides) fit the device's limits.
+    pub fn fit_internal(&self, size: (u32, u32)) -> (u32, u32) {
+        self.ctx
+            .limits
+            .fit_image((size.0.max(1), size.1.max(1)), IMAGE_BYTES_PER_PIXEL)
+    }
+
     /// Records the frame's GPU work: the world's changed bytes are uploaded (staging ring),
     /// up to `req.spp` samples added (restarting on any change), and the display pass writes
     /// the output buffer ([`Viewport::output`]).
@@ -437,7 +451,7 @@ impl Viewport {
                 s.sets.clear(&ctx);
             }
         }
-        let internal = (req.internal.0.max(1), req.internal.1.max(1));
+        let internal = self.fit_internal(req.internal);
         let output = (req.output.0.max(1), req.output.1.max(1));
         if self
             .live

@@ -79,9 +79,11 @@ pub(crate) fn render_command(a: RenderArgs, workers: usize) -> Result<()> {
             .context("--camera wants EYE:TARGET, each X,Y,Z")?;
         let eye = parse_ivec3_f(eye)?;
         let target = parse_ivec3_f(target)?;
+        let aimed =
+            render::Camera::aimed(eye, target, params.camera.fov_y_deg).context("--camera")?;
         params.camera = render::Camera {
             projection: params.camera.projection,
-            ..render::Camera::looking_at(eye, target, params.camera.fov_y_deg)
+            ..aimed
         };
     }
     if let Some(height) = a.orthographic {

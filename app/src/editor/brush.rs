@@ -1,4 +1,11 @@
 //! Brush strokes: modes, shapes, mirror symmetry, and the world edits a stroke makes.
+//!
+//! A stroke is one connected piece at any mouse speed: consecutive points are joined by the
+//! brush's shape swept from one to the other. The sphere sweeps to capsules (exact); the
+//! voxel, cube and cylinder are stamped at [`sweep_points`], steps of at most one voxel along
+//! every axis, so consecutive stamps' voxels touch (the voxel brush draws a 26-connected 3D
+//! line, the cube a swept box). The line brush was capsules already; the box brush is its
+//! first and last points.
 
 use super::error::{EditError, Result, invalid};
 use crate::selection::Selection;
@@ -22,7 +29,7 @@ pub enum BrushMode {
 pub enum BrushShape {
     /// The voxel under the point.
     Voxel,
-    /// A ball of radius `size`.
+    /// A ball of radius `size` (swept to capsules between the stroke's points).
     Sphere,
     /// A cube of half-size `size` (edge 2·size + 1 voxels) centred on the point's voxel.
     Cube,
@@ -94,6 +101,67 @@ pub struct Stroke {
     pub in_selection: bool,
 }
 
+/// The most stamps one segment of a stroke takes (points farther apart than this many voxels
+/// are refused: no grid is that large).
+pub const MAX_SEGMENT_STEPS: f64 = 65_536.0;
+
+/// Where a brush is stamped between two consecutive stroke points: `a`, `b` and points between
+/// them at most one voxel apart along every axis (⌈largest axis distance⌉ equal steps), so
+/// the voxels under consecutive stamps are 26-neighbours or the same.
+pub fn sweep_points(a: DVec3, b: DVec3) -> Vec<DVec3> {
+    let n = (b - a).abs().max_element().ceil().max(1.0) as usize;
+    (0..=n)
+        .map(|k| {
+            if k == n {
+                b
+            } else {
+                a + (b - a) * (k as f64 / n as f64)
+            }
+        })
+        .collect()
+}
+
+/// Every stamp of a stroke through `points` ([`sweep_points`] of each consecutive pair; one
+/// point is one stamp).
+fn stamps(points: &[DVec3]) -> Result<Vec<DVec3>> {
+    if points.len() == 1 {
+        return Ok(points.to_vec());
+    }
+    let mut out = vec![points[0]];
+    for w in points.windows(2) {
+        if (w[1] - w[0]).abs().max_element() > MAX_SEGMENT_STEPS {
+            return Err(invalid(format!(
+                "stroke points {} and {} are more than {MAX_SEGMENT_STEPS} voxels apart",
+                w[0], w[1]
+            )));
+        }
+        out.extend(sweep_points(w[0], w[1]).into_iter().skip(1));
+    }
+    Ok(out)
+}
+
+/// The voxels of boxes ⌊p⌋ − h ..= ⌊p⌋ + h for every stamp p, as one set (a swept cube; a
+/// swept voxel for h = 0). Voxels outside the largest grid are left out (no world has them).
+fn swept_boxes(stamps: &[DVec3], h: i32) -> Shape {
+    let most = glam::UVec3::new(
+        brickmap::grid::MAX_BRICKS_X,
+        brickmap::grid::MAX_BRICKS_Y,
+        brickmap::grid::MAX_BRICKS_Z,
+    )
+    .as_ivec3()
+        * 8;
+    let mut set = brickmap::VoxelSet::new();
+    let mut last = None;
+    for p in stamps {
+        let c = p.floor().as_ivec3();
+        if last != Some(c) {
+            set.apply_box(c - h, c + h, most, false);
+            last = Some(c);
+        }
+    }
+    Shape::Set(std::sync::Arc::new(set))
+}
+
 /// The world edits of a stroke, mirror images included, validated before any is applied;
 /// a stroke `in_selection` changes only voxels of `selection` (all, when none).
 pub fn stroke_edits(s: &Stroke, selection: Option<&Selection>) -> Result<Vec<EditOp>> {
@@ -132,7 +200,7 @@ pub fn stroke_edits(s: &Stroke, selection: Option<&Selection>) -> Result<Vec<Edi
     for combo in 0..1usize << axes.len() {
         let pts: Vec<DVec3> = s.points.iter().map(|p| reflect(*p, combo)).collect();
         let shapes: Vec<Shape> = match s.shape {
-            BrushShape::Line => vec![Shape::Line {
+            BrushShape::Line | BrushShape::Sphere => vec![Shape::Line {
                 points: pts,
                 radius: s.size,
             }],
@@ -146,30 +214,22 @@ pub fn stroke_edits(s: &Stroke, selection: Option<&Selection>) -> Result<Vec<Edi
                     max: a.max(b),
                 }]
             }
-            BrushShape::Voxel => pts
-                .iter()
-                .map(|p| Shape::Voxel(p.floor().as_ivec3()))
-                .collect(),
-            BrushShape::Sphere => pts
-                .iter()
-                .map(|p| Shape::Sphere {
-                    centre: *p,
-                    radius: s.size,
-                })
-                .collect(),
+            BrushShape::Voxel if pts.len() == 1 => vec![Shape::Voxel(pts[0].floor().as_ivec3())],
+            BrushShape::Voxel => vec![swept_boxes(&stamps(&pts)?, 0)],
             BrushShape::Cube => {
-                let h = s.size.round().max(0.0) as i32;
-                pts.iter()
-                    .map(|p| {
+                let h = s.size.round().clamp(0.0, 4096.0) as i32;
+                match pts.as_slice() {
+                    [p] => {
                         let c = p.floor().as_ivec3();
-                        Shape::Box {
+                        vec![Shape::Box {
                             min: c - h,
                             max: c + h,
-                        }
-                    })
-                    .collect()
+                        }]
+                    }
+                    _ => vec![swept_boxes(&stamps(&pts)?, h)],
+                }
             }
-            BrushShape::Cylinder => pts
+            BrushShape::Cylinder => stamps(&pts)?
                 .iter()
                 .map(|p| Shape::Cylinder {
                     a: *p - s.axis.vector() * s.size,

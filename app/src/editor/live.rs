@@ -76,14 +76,15 @@ impl LiveStroke {
         Ok(())
     }
 
-    /// The edits of the segment that adds `points`: a polyline continues from the last
-    /// point; a box is applied only at the end.
+    /// The edits of the segment that adds `points`: the brush swept on from the last point
+    /// (so the stroke stays connected however far apart the points are); a box is applied
+    /// only at the end.
     fn segment(&self, scene: &Scene, points: &[DVec3]) -> Result<Vec<EditOp>> {
         let mut part = Stroke {
             points: points.to_vec(),
             ..self.stroke.clone()
         };
-        if self.stroke.shape == BrushShape::Line
+        if self.stroke.shape != BrushShape::Box
             && let Some(last) = self.stroke.points.last()
         {
             part.points.insert(0, *last);

@@ -65,6 +65,8 @@ pub enum Start {
     },
     /// A .ron or .vox file, relative to the script.
     File(String),
+    /// The built-in default scene (what the editor opens without a file).
+    Default,
 }
 
 /// Bounds on a rendered image.
@@ -270,6 +272,8 @@ impl ScriptRun {
                 doc.scene
             }
             Start::File(f) => Scene::load(&folder.join(f), workers).context("start")?,
+            Start::Default => crate::scene::default_scene(crate::scene::SceneSize::Full, workers)
+                .context("start: the default scene")?,
         };
         let mut document = Document::new(scene, history());
         document.folder = folder.to_path_buf();

@@ -1,10 +1,11 @@
 //! Scene file formats: RON projects (`project`, with the voxel payload in `payload`) and
-//! MagicaVoxel `.vox` (`vox`).
+//! MagicaVoxel `.vox` (`vox`, its chunk structure checked first by `vox_check`).
 
 pub mod palette;
 pub mod payload;
 pub mod project;
 pub mod vox;
+pub mod vox_check;
 
 use std::path::Path;
 

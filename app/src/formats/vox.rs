@@ -94,6 +94,7 @@ pub fn parse(bytes: &[u8]) -> Result<DotVoxData, String> {
             "this is a Ken Silverman SLAB6 .vox (a plain {x}×{y}×{z} volume with a 768-byte palette, no \"VOX \" header), which voxbrick does not import; MagicaVoxel or vengi can convert it"
         ));
     }
+    super::vox_check::check(bytes).map_err(|e| format!("not a valid .vox file: {e}"))?;
     let parsed = std::panic::catch_unwind(|| dot_vox::load_bytes(bytes));
     match parsed {
         Ok(Ok(data)) => Ok(data),
@@ -164,6 +165,12 @@ pub fn import_into(
     let dims = world.dims();
     let before = placed.len();
     placed.retain(|(p, _)| dims.contains_voxel(*p));
+    if placed.is_empty() && before > 0 {
+        return Err(format!(
+            "nothing to import: all {before} voxels land outside the {} voxel grid (try another offset)",
+            dims.voxels()
+        ));
+    }
     if placed.len() < before {
         report.dropped.push(format!(
             "{} voxels outside the grid dropped",
@@ -225,6 +232,19 @@ fn prepare(bytes: &[u8], options: &ImportOptions) -> Result<Prepared, String> {
             e
         }
     })?;
+    let declared: u64 = data.models.iter().map(|m| m.voxels.len() as u64).sum();
+    if placed.is_empty() && declared > 0 {
+        // Never less than the file declares without saying so: nothing placed is an error.
+        let why = if report.dropped.is_empty() {
+            "no model is placed by the scene graph".to_string()
+        } else {
+            report.dropped.join("; ")
+        };
+        return Err(format!(
+            "nothing to import: the file's {} models hold {declared} voxels, and every one was left out ({why})",
+            data.models.len()
+        ));
+    }
     if let Some((lo, _)) = bounds(&placed) {
         let shift = (-lo).max(IVec3::ZERO) + options.offset;
         if (lo + shift).cmplt(IVec3::ZERO).any() {

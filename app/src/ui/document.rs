@@ -46,19 +46,36 @@ impl Editor {
         self.edits.finished();
         match edited {
             Edited::Command(label, result) => {
+                let outcome = match &result {
+                    Ok(_) => "ok".to_string(),
+                    Err(e) => format!("error {e}"),
+                };
+                self.report
+                    .line(format_args!("edited command {label}: {outcome}"));
                 if let Err(e) = result {
                     self.panels.errors.push(format!("{label}: {e}"));
                 }
             }
             Edited::Undo(result) | Edited::Redo(result) => {
+                let outcome = match &result {
+                    Ok(label) => format!("ok {label}"),
+                    Err(e) => format!("error {e}"),
+                };
+                self.report.line(format_args!("edited history: {outcome}"));
                 if let Err(e) = result {
                     self.panels.errors.push(e.to_string());
                 }
             }
             // A segment: the statistics (a walk over every cell) wait for the stroke's end.
-            Edited::Stroke(Ok(None)) => return,
-            Edited::Stroke(Ok(Some(_))) => {}
+            Edited::Stroke(Ok(None)) => {
+                self.report.line(format_args!("edited stroke segment: ok"));
+                return;
+            }
+            Edited::Stroke(Ok(Some(_))) => {
+                self.report.line(format_args!("edited stroke end: ok"));
+            }
             Edited::Stroke(Err(e)) => {
+                self.report.line(format_args!("edited stroke: error {e}"));
                 // The stroke is undone and closed: stop sending it segments.
                 self.drawing = None;
                 self.panels.errors.push(format!("stroke: {e}"));
@@ -242,6 +259,16 @@ impl Editor {
                     }
                     self.awaiting_built_scene = false;
                     let recovered = std::mem::take(&mut self.recovering);
+                    if self.report.on() {
+                        let what = match (&path, recovered) {
+                            (Some(_), true) => "recovery".to_string(),
+                            (Some(p), false) => p.display().to_string(),
+                            (None, _) => "default scene".to_string(),
+                        };
+                        let hash = scene.world.read().content_hash();
+                        self.report
+                            .line(format_args!("loaded {what} hash {hash:016x}"));
+                    }
                     self.replace_document(scene, path.filter(|_| !recovered));
                     if recovered {
                         if let Ok(mut d) = self.doc.write() {
@@ -261,8 +288,12 @@ impl Editor {
                 revision,
                 result,
             } => match result {
-                Ok(()) if autosave => {}
+                Ok(()) if autosave => {
+                    self.report
+                        .line(format_args!("autosaved {}", path.display()));
+                }
                 Ok(()) => {
+                    self.report.line(format_args!("saved {}", path.display()));
                     self.saved.push((path.clone(), revision));
                     self.mark_saved();
                     let _ = self.config.add_recent(&path);

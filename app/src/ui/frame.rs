@@ -25,6 +25,7 @@ impl Editor {
             validation: self.options.validation,
             window: Some(handles),
             draw_ui: true,
+            ..Default::default()
         })
         .context("no Vulkan device can draw this window")?;
         let ctx = Arc::new(ctx);
@@ -133,7 +134,9 @@ impl Editor {
         let samples = gfx.viewport.samples();
         let gpu_ms = gfx.viewport.last_gpu_seconds().map_or(0.0, |s| s * 1e3);
         let size = gfx.window.inner_size();
-        let internal = self.internal_size((size.width, size.height));
+        let internal = gfx
+            .viewport
+            .fit_internal(self.internal_size((size.width, size.height)));
         let paths = internal.0 as f64 * internal.1 as f64 * self.last_added as f64;
         self.panels.status = format!(
             "{samples}/{} spp · GPU {gpu_ms:.2} ms/frame · {:.1} Mpaths/s · internal {}x{}{} · {}{}",
@@ -264,6 +267,11 @@ impl Editor {
                     self.pending_textures.clear();
                 }
                 self.last_added = status.added;
+                self.report.line(format_args!(
+                    "frame {} spp {}",
+                    self.frames,
+                    gfx.viewport.samples()
+                ));
                 if let Some(t) = self.move_event.take() {
                     self.latency = Some(t.elapsed());
                 }

@@ -14,6 +14,7 @@ pub mod jobs;
 pub mod keymap;
 pub mod panels;
 mod preview;
+pub mod report;
 mod selecting;
 pub mod tools;
 
@@ -212,6 +213,8 @@ pub struct Editor {
     selecting: Option<selecting::SelectDrag>,
     /// A paste follows the cursor until a click.
     pasting: bool,
+    /// The handshake log (`VOXBRICK_REPORT`).
+    report: report::Report,
     /// Tests only: the frame that fails as if the device were lost
     /// (`VOXBRICK_TEST_GPU_FAILURE_AT_FRAME`), to check nothing is lost when the GPU fails.
     fail_at_frame: Option<u64>,
@@ -314,6 +317,7 @@ impl Editor {
             preview: preview::Preview::new(wake_preview),
             selecting: None,
             pasting: false,
+            report: report::Report::from_env(),
             fail_at_frame: std::env::var("VOXBRICK_TEST_GPU_FAILURE_AT_FRAME")
                 .ok()
                 .and_then(|v| v.parse().ok()),
@@ -340,6 +344,9 @@ impl Editor {
             };
         } else {
             if let Some(recovery) = editor.config.pending_recovery() {
+                editor
+                    .report
+                    .line(format_args!("offered recovery {}", recovery.display()));
                 editor.panels.recovery = Some(recovery);
             }
             match editor.options.file.clone() {
@@ -555,6 +562,10 @@ impl Editor {
         let stroke = brush.stroke(vec![tools::centre(v)], view.dims().voxels());
         drop(view);
         drop(doc);
+        self.report.line(format_args!(
+            "stroke begin {} {} voxel {} {} {}",
+            self.cursor.0, self.cursor.1, v.x, v.y, v.z
+        ));
         self.drawing = Some(Drawing {
             layer,
             first: v,
@@ -578,6 +589,10 @@ impl Editor {
             if let Some(d) = &mut self.drawing {
                 d.last = v;
             }
+            self.report.line(format_args!(
+                "stroke point {} {} voxel {} {} {}",
+                self.cursor.0, self.cursor.1, v.x, v.y, v.z
+            ));
             self.edits
                 .submit(&self.doc, Edit::StrokeExtend(vec![tools::centre(v)]));
         }
@@ -744,8 +759,17 @@ impl ApplicationHandler<Wake> for Editor {
 }
 
 impl Editor {
-    /// One window event, the frame gate held (or not needed: redraw, resize).
+    /// One window event, the frame gate held (or not needed: redraw, resize); reported once
+    /// handled.
     fn handle_window_event(&mut self, event_loop: &ActiveEventLoop, event: WindowEvent) {
+        let line = self.report.on().then(|| report_line(&event)).flatten();
+        self.handle_event(event_loop, event);
+        if let Some(line) = line {
+            self.report.line(format_args!("input {line}"));
+        }
+    }
+
+    fn handle_event(&mut self, event_loop: &ActiveEventLoop, event: WindowEvent) {
         let Some(gfx) = &mut self.gfx else { return };
         let response = gfx.egui_state.on_window_event(&gfx.window, &event);
         // egui-winit asks to repaint after every RedrawRequested too; honouring that would
@@ -827,6 +851,14 @@ impl Editor {
                 match (state, button) {
                     (ElementState::Pressed, MouseButton::Left) if free => self.press(),
                     (ElementState::Released, MouseButton::Left) if self.drawing.is_some() => {
+                        // The release position is the stroke's last point.
+                        self.stroke_to_cursor();
+                        if let Some(d) = &self.drawing {
+                            self.report.line(format_args!(
+                                "stroke release {} {} voxel {} {} {}",
+                                self.cursor.0, self.cursor.1, d.last.x, d.last.y, d.last.z
+                            ));
+                        }
                         self.drawing = None;
                         self.edits.submit(&self.doc, Edit::StrokeEnd);
                         // Back to the full internal size shortly after, as after a move.
@@ -883,4 +915,31 @@ impl Drop for Editor {
         self.gfx = None;
         self.pending_textures.clear();
     }
+}
+
+/// How an input event appears in the report (None: not an input event).
+fn report_line(event: &WindowEvent) -> Option<String> {
+    Some(match event {
+        WindowEvent::CursorMoved { position, .. } => format!("move {} {}", position.x, position.y),
+        WindowEvent::MouseInput { state, button, .. } => format!(
+            "{} {button:?}",
+            if state.is_pressed() {
+                "press"
+            } else {
+                "release"
+            }
+        ),
+        WindowEvent::KeyboardInput { event, .. } => format!(
+            "key {:?} {}",
+            event.physical_key,
+            if event.state.is_pressed() {
+                "down"
+            } else {
+                "up"
+            }
+        ),
+        WindowEvent::MouseWheel { .. } => "wheel".into(),
+        WindowEvent::Resized(size) => format!("resized {} {}", size.width, size.height),
+        _ => return None,
+    })
 }

@@ -464,13 +464,20 @@ pub fn draw(
             "voxbrick did not exit cleanly last time. Recover the autosaved scene ({})?",
             path.display()
         );
+        // Enter recovers (the default answer), Escape discards.
+        let (enter, escape) = ctx.input(|i| {
+            (
+                i.key_pressed(egui::Key::Enter),
+                i.key_pressed(egui::Key::Escape),
+            )
+        });
         modal(ctx, "Recover unsaved work", |ui| {
             ui.label(text);
             ui.horizontal(|ui| {
-                if ui.button("Recover").clicked() {
+                if ui.button("Recover (Enter)").clicked() || enter {
                     out.push(UiEvent::Recover(true));
                 }
-                if ui.button("Discard").clicked() {
+                if ui.button("Discard (Esc)").clicked() || escape {
                     out.push(UiEvent::Recover(false));
                 }
             });

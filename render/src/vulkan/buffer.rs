@@ -37,6 +37,7 @@ impl HostBuffer {
         location: MemoryLocation,
     ) -> Result<Self, GpuError> {
         let size = size.max(4);
+        ctx.limits.check_allocation(name, size)?;
         let info = vk::BufferCreateInfo::default()
             .size(size)
             .usage(

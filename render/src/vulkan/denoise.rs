@@ -54,6 +54,7 @@ struct Buffers {
 
 impl Buffers {
     fn new(ctx: &GpuContext, size: (u32, u32)) -> Result<Self, GpuError> {
+        ctx.limits.check_image("the denoiser's guides", size, 32)?;
         let pixels = size.0 as u64 * size.1 as u64;
         let make = |name, bytes| HostBuffer::new(ctx, name, bytes, MemoryLocation::GpuOnly);
         let guides = make("denoise guides", pixels * 32)?;

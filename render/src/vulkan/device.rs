@@ -37,6 +37,11 @@ pub struct ContextOptions {
     /// Draw the editor's UI without a window (an offscreen target: headless measurement):
     /// a graphics + compute queue and dynamic rendering, as for a window.
     pub draw_ui: bool,
+    /// Lower `maxStorageBufferRange` to this many bytes (as `VOXBRICK_MAX_STORAGE_RANGE`
+    /// does; the smaller of the two holds).
+    pub max_storage_range: Option<u64>,
+    /// Lower `maxMemoryAllocationSize` to this many bytes (as `VOXBRICK_MAX_ALLOCATION`).
+    pub max_allocation: Option<u64>,
 }
 
 /// What presenting to a window needs from the device.
@@ -69,6 +74,9 @@ pub struct GpuContext {
     pub driver: String,
     /// Nanoseconds per timestamp tick (0 when the queue cannot time).
     pub timestamp_period: f32,
+    /// The limits every buffer, binding and dispatch stays within (lowered by the caps of
+    /// [`super::limits`]).
+    pub limits: super::DeviceLimits,
     /// `minStorageBufferOffsetAlignment`: storage bindings start at multiples of it.
     pub storage_alignment: u64,
     /// VK_KHR_pipeline_executable_properties, when the driver has it.
@@ -290,6 +298,15 @@ impl GpuContext {
                 return Err(e.into());
             }
         };
+        let device_limits = match super::DeviceLimits::read(raw, physical) {
+            Ok(l) => l.capped_by(options.max_storage_range, options.max_allocation),
+            Err(e) => {
+                drop(allocator);
+                // SAFETY: nothing else was created on the device yet.
+                unsafe { device.destroy_device(None) };
+                return Err(e);
+            }
+        };
         // SAFETY: plain queries.
         let limits = unsafe { raw.get_physical_device_properties(physical) }.limits;
         let families = unsafe { raw.get_physical_device_queue_family_properties(physical) };
@@ -308,6 +325,7 @@ impl GpuContext {
             driver,
             shadow_queue,
             timestamp_period,
+            limits: device_limits,
             storage_alignment: limits.min_storage_buffer_offset_alignment.max(4),
             pipeline_stats,
             presentation,

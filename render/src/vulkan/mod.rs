@@ -9,6 +9,7 @@ pub mod denoise;
 pub mod device;
 pub mod frame;
 pub mod instance;
+pub mod limits;
 pub mod pass;
 pub mod primary;
 pub mod progressive;
@@ -22,6 +23,7 @@ pub mod world;
 use ash::vk;
 
 pub use device::{ContextOptions, DeviceChoice, GpuContext, Presentation};
+pub use limits::DeviceLimits;
 pub use surface::WindowHandles;
 
 /// Everything that can go wrong on the GPU side.
@@ -44,6 +46,22 @@ pub enum GpuError {
         /// Its result code.
         result: vk::Result,
     },
+    /// A buffer, binding or dispatch would pass one of the device's limits (or a cap set by
+    /// `VOXBRICK_MAX_STORAGE_RANGE` / `VOXBRICK_MAX_ALLOCATION`).
+    #[error("{what} needs {bytes} where this device's {limit} is {max}")]
+    Limit {
+        /// What would pass the limit.
+        what: String,
+        /// How much it needs (bytes, or workgroups).
+        bytes: u64,
+        /// The Vulkan limit's name.
+        limit: &'static str,
+        /// Its value in force.
+        max: u64,
+    },
+    /// A setting (an environment variable) is malformed.
+    #[error("{0}")]
+    BadSetting(String),
     /// The allocator refused.
     #[error("GPU memory: {0}")]
     Memory(#[from] gpu_allocator::AllocationError),

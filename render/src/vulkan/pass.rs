@@ -255,6 +255,8 @@ impl ComputePass {
         count: u32,
         time: bool,
     ) -> Result<Vec<f64>, GpuError> {
+        ctx.limits
+            .check_groups("a compute dispatch", [groups[0], groups[1], 1])?;
         let set = self.allocate_set(ctx, buffers)?;
         let result = run_batch(ctx, count, time, |cmd| {
             self.record(
@@ -276,6 +278,7 @@ impl ComputePass {
         buffers: &[Binding],
     ) -> Result<vk::DescriptorSet, GpuError> {
         assert_eq!(buffers.len() as u32, self.buffers, "one buffer per binding");
+        check_bindings(ctx, buffers)?;
         let d = &ctx.device;
         let layouts = [self.set_layout];
         // SAFETY: the pool and layout are alive; the writes' infos outlive the update.
@@ -386,6 +389,16 @@ impl ComputePass {
     }
 }
 
+/// Refuses bindings whose range passes the device's `maxStorageBufferRange`: nothing is ever
+/// bound past it (see [`super::limits`]).
+fn check_bindings(ctx: &GpuContext, buffers: &[Binding]) -> Result<(), GpuError> {
+    for (i, b) in buffers.iter().enumerate() {
+        ctx.limits
+            .check_binding(&format!("storage binding {i}"), b.range)?;
+    }
+    Ok(())
+}
+
 /// Points `set`'s bindings 0.. at `buffers`.
 fn write_set(ctx: &GpuContext, set: vk::DescriptorSet, buffers: &[Binding]) {
     let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
@@ -468,6 +481,7 @@ impl SetCache {
         if let Some(&set) = self.sets.get(&key) {
             return Ok(set);
         }
+        check_bindings(ctx, buffers)?;
         let layouts = [pass.set_layout];
         // SAFETY: pool and layout are alive.
         let set = vk_call("vkAllocateDescriptorSets", unsafe {

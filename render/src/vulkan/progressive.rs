@@ -51,6 +51,7 @@ impl Progressive {
         seed: u64,
     ) -> Result<Self, GpuError> {
         let internal = (internal.0.max(1), internal.1.max(1));
+        ctx.limits.check_image("the accumulation", internal, 16)?;
         let pixels = internal.0 as u64 * internal.1 as u64;
         let accum = HostBuffer::new(ctx, "accumulation", pixels * 16, MemoryLocation::GpuOnly)?;
         let uniforms = match HostBuffer::new(

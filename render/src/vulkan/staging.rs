@@ -51,8 +51,10 @@ pub struct StagingRing {
 }
 
 impl StagingRing {
-    /// A ring of `slots` staging buffers of `slot_size` bytes each.
+    /// A ring of `slots` staging buffers of `slot_size` bytes each (at most the device's
+    /// allocation size: uploads larger than a slot span several flushes).
     pub fn new(ctx: &GpuContext, slots: usize, slot_size: u64) -> Result<Self, GpuError> {
+        let slot_size = slot_size.min(ctx.limits.allocation & !3).max(4);
         let d = &ctx.device;
         let info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)

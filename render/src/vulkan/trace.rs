@@ -37,6 +37,16 @@ const QUEUE_MAX: u64 = 1 << 21;
 /// those variants ask for one per vertex, up to 2²³ rays (384 MiB): a queue of one per
 /// sample overflowed at 1024 × 576, and rays traced in place cost several times a queued one.
 const QUEUE_MAX_LIGHTS: u64 = 1 << 23;
+/// The most shadow rays a queue may hold on a device: its buffer within the storage range and
+/// the allocation size, and its pass (`shadow.comp`, 64 rays per workgroup, one dimension)
+/// within the workgroup count. Rays past it are traced in place, so a device with small limits
+/// (2²⁷ bytes on lavapipe and many drivers: 2.8 M rays) renders the same image.
+pub fn queue_fit(limits: &super::DeviceLimits) -> u64 {
+    limits
+        .elements(SHADOW_RAY_BYTES)
+        .min(u64::from(limits.groups[0]) * 64)
+        .max(1)
+}
 /// The queue header before a trace dispatch: no groups, y = z = 1, no rays.
 const QUEUE_RESET: [u32; 4] = [0, 1, 1, 0];
 
@@ -453,7 +463,10 @@ impl PathTracer {
     /// is large enough (a smaller batch does not reallocate it), replaced when too small or
     /// above a lowered limit.
     fn ensure_queue(&mut self, ctx: &GpuContext, rays: u64, max: u64) -> Result<(), GpuError> {
-        let capacity = rays.clamp(QUEUE_MIN, max).min(self.queue_limit);
+        let capacity = rays
+            .clamp(QUEUE_MIN, max)
+            .min(self.queue_limit)
+            .min(queue_fit(&ctx.limits));
         if self
             .queue
             .as_ref()

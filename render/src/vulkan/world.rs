@@ -1,6 +1,9 @@
-//! The world on the GPU: one device-local buffer sub-allocated into five regions (brick
-//! index, bricks, coarse grid, material bytes, material tables), bound at 0..4 by every
+//! The world on the GPU: one device-local buffer per region (brick index, bricks, coarse
+//! grid, material bytes, material tables, light faces), bound at 0..4 (and 10) by every
 //! shader (`shaders/brickmap.glsl`), and kept equal to the CPU world by incremental uploads.
+//! One buffer per region keeps each within the device's allocation and storage-range limits
+//! (a single buffer of them all passed lavapipe's 2²⁷-byte range on large worlds); a region
+//! the limits cannot hold is refused ([`GpuError::Limit`]) rather than bound past them.
 //!
 //! Each frame [`GpuWorld::update`] drains the world's dirty ranges, reads their current bytes
 //! under one read lock, and compares them word by word with a host copy of what the GPU
@@ -8,8 +11,8 @@
 //! were coarsened (a whole 68-byte brick for one voxel, merged ranges) cost no upload
 //! beyond the words that differ. Queued uploads own their bytes and go through the
 //! [`StagingRing`]: one flush per frame, the rest deferred to the next frame. When the world
-//! outgrows a region, the buffer is replaced by a larger one and the old contents are copied
-//! on the GPU, so nothing is re-read or lost.
+//! outgrows a region, that region's buffer is replaced by a larger one (50 % headroom, within
+//! the limits) and its old contents are copied on the GPU, so nothing is re-read or lost.
 
 use super::barrier::{after_transfer, before_transfer};
 use super::buffer::{Binding, HostBuffer, read_device};
@@ -32,12 +35,6 @@ pub const RING_SLOT_BYTES: u64 = 4 << 20;
 /// stay within 1.5× of the changed words).
 const MERGE_GAP: usize = 4;
 
-#[derive(Clone, Copy, Debug, Default)]
-struct Region {
-    offset: u64,
-    capacity: u64,
-}
-
 /// What one update did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct UploadReport {
@@ -53,7 +50,7 @@ pub struct UploadReport {
     pub flushes: u32,
     /// Bytes still queued for later frames.
     pub deferred_bytes: u64,
-    /// Whether the buffer was replaced by a larger one.
+    /// Whether a region's buffer was replaced by a larger one.
     pub grew: bool,
 }
 
@@ -76,40 +73,55 @@ impl UploadReport {
 
 /// The world's buffers on the GPU.
 pub struct GpuWorld {
-    buffer: HostBuffer,
-    regions: [Region; N],
+    /// One device-local buffer per region, in [`GpuBuffer::ALL`] order.
+    buffers: Vec<HostBuffer>,
     shadow: [Vec<u8>; N],
     ring: StagingRing,
     queue: VecDeque<Upload>,
     dims: [u32; 3],
     words_per_column: u32,
-    alignment: u64,
 }
 
 fn align(x: u64, a: u64) -> u64 {
     x.div_ceil(a) * a
 }
 
-/// Lays out regions of the given capacities; returns them and the total size.
-fn layout(capacities: [u64; N], alignment: u64) -> ([Region; N], u64) {
-    let mut at = 0;
-    let regions = capacities.map(|c| {
-        let r = Region {
-            offset: at,
-            capacity: align(c.max(4), 4),
-        };
-        at = align(at + r.capacity, alignment);
-        r
-    });
-    (regions, at.max(4))
+/// What a region is called in errors.
+fn region_name(b: GpuBuffer) -> &'static str {
+    match b {
+        GpuBuffer::BrickIndex => "the world's brick index",
+        GpuBuffer::Bricks => "the world's bricks",
+        GpuBuffer::Coarse => "the world's coarse grid",
+        GpuBuffer::MaterialBytes => "the world's material bytes",
+        GpuBuffer::MaterialTables => "the world's material tables",
+        GpuBuffer::Lights => "the world's light faces",
+    }
 }
 
-/// Initial capacity: buffers that grow with the content get 25% headroom.
-fn initial_capacity(b: GpuBuffer, size: u64) -> u64 {
-    match b {
-        GpuBuffer::Bricks | GpuBuffer::MaterialBytes | GpuBuffer::Lights => size + size / 4,
-        _ => size,
+/// The capacity a region of `size` bytes gets, given its current capacity (0: none yet):
+/// regions that grow with the content get headroom (25 % at first, 50 % more when they
+/// outgrow it), never past `max` (the device's bound-buffer limit); a size above `max` is
+/// refused.
+fn region_capacity(b: GpuBuffer, size: u64, current: u64, max: u64) -> Result<u64, GpuError> {
+    let max = max & !3;
+    if size > max {
+        return Err(GpuError::Limit {
+            what: region_name(b).to_string(),
+            bytes: size,
+            limit: "maxStorageBufferRange / maxMemoryAllocationSize",
+            max,
+        });
     }
+    let grows = matches!(
+        b,
+        GpuBuffer::Bricks | GpuBuffer::MaterialBytes | GpuBuffer::Lights
+    );
+    let wanted = match (current, grows) {
+        (0, true) => size + size / 4,
+        (0, false) => size,
+        (cap, _) => size.max(cap + cap / 2),
+    };
+    Ok(align(wanted.max(4), 4).min(max).max(align(size.max(4), 4)))
 }
 
 /// A device-local buffer of `size` bytes, zero-filled.
@@ -174,29 +186,30 @@ impl GpuWorld {
         slot_bytes: u64,
     ) -> Result<Self, GpuError> {
         let sizes = GpuBuffer::ALL.map(|b| view.gpu_buffer_size(b));
-        let alignment = ctx.storage_alignment.max(16);
-        let (regions, total) = layout(
-            std::array::from_fn(|i| initial_capacity(GpuBuffer::ALL[i], sizes[i])),
-            alignment,
-        );
-        let buffer = zeroed_buffer(ctx, total)?;
-        let ring = match StagingRing::new(ctx, slots, slot_bytes.max(4)) {
+        let max = ctx.limits.bound_buffer();
+        let mut buffers: Vec<HostBuffer> = Vec::with_capacity(N);
+        let made = (|| {
+            for (i, b) in GpuBuffer::ALL.into_iter().enumerate() {
+                let capacity = region_capacity(b, sizes[i], 0, max)?;
+                buffers.push(zeroed_buffer(ctx, capacity)?);
+            }
+            StagingRing::new(ctx, slots, slot_bytes.max(4))
+        })();
+        let ring = match made {
             Ok(r) => r,
             Err(e) => {
-                buffer.destroy(ctx);
+                buffers.into_iter().for_each(|b| b.destroy(ctx));
                 return Err(e);
             }
         };
         let dims = view.dims();
         let mut world = Self {
-            buffer,
-            regions,
+            buffers,
             shadow: Default::default(),
             ring,
             queue: VecDeque::new(),
             dims: dims.bricks().to_array(),
             words_per_column: dims.coarse_words_per_column() as u32,
-            alignment,
         };
         let whole = sizes.map(|s| std::iter::once(0..s).collect());
         let staged = world
@@ -241,10 +254,8 @@ impl GpuWorld {
     }
 
     fn flush(&mut self, ctx: &GpuContext) -> Result<UploadReport, GpuError> {
-        let (buffer, regions) = (self.buffer.raw, self.regions);
-        let flushed = self
-            .ring
-            .flush(ctx, &mut self.queue, |r| (buffer, regions[r].offset))?;
+        let buffers: Vec<vk::Buffer> = self.buffers.iter().map(|b| b.raw).collect();
+        let flushed = self.ring.flush(ctx, &mut self.queue, |r| (buffers[r], 0))?;
         Ok(UploadReport {
             uploaded_bytes: flushed.bytes,
             copy_regions: flushed.regions,
@@ -263,11 +274,7 @@ impl GpuWorld {
     ) -> Result<UploadReport, GpuError> {
         let mut report = UploadReport::default();
         let sizes = GpuBuffer::ALL.map(|b| view.gpu_buffer_size(b));
-        if sizes
-            .iter()
-            .zip(&self.regions)
-            .any(|(s, r)| *s > r.capacity)
-        {
+        if sizes.iter().zip(&self.buffers).any(|(s, b)| *s > b.size) {
             self.grow(ctx, sizes)?;
             report.grew = true;
         }
@@ -302,53 +309,43 @@ impl GpuWorld {
         Ok(report)
     }
 
-    /// Replaces the buffer by one whose regions fit `sizes` (growing ones get 50% headroom),
-    /// copying the old contents on the GPU.
+    /// Replaces the buffers of the regions that outgrew them by larger ones, copying their
+    /// old contents on the GPU. A region the limits cannot hold fails before anything changes.
     fn grow(&mut self, ctx: &GpuContext, sizes: [u64; N]) -> Result<(), GpuError> {
-        let capacities = std::array::from_fn(|i| {
-            let cap = self.regions[i].capacity;
+        let max = ctx.limits.bound_buffer();
+        let mut plan = Vec::new();
+        for (i, b) in GpuBuffer::ALL.into_iter().enumerate() {
+            let cap = self.buffers[i].size;
             if sizes[i] > cap {
-                sizes[i].max(cap + cap / 2)
-            } else {
-                cap
+                plan.push((i, region_capacity(b, sizes[i], cap, max)?));
             }
-        });
-        let (regions, total) = layout(capacities, self.alignment);
-        self.ring.wait_idle(ctx)?;
-        let buffer = zeroed_buffer(ctx, total)?;
-        let copies: Vec<(vk::BufferCopy, usize)> = (0..N)
-            .filter(|&i| !self.shadow[i].is_empty())
-            .map(|i| {
-                (
-                    vk::BufferCopy {
-                        src_offset: self.regions[i].offset,
-                        dst_offset: regions[i].offset,
-                        size: self.shadow[i].len() as u64,
-                    },
-                    i,
-                )
-            })
-            .collect();
-        let copy: Vec<vk::BufferCopy> = copies.iter().map(|(c, _)| *c).collect();
-        let (old, new) = (self.buffer.raw, buffer.raw);
-        let copied = ctx.submit_and_wait(|cmd| {
-            // SAFETY: both buffers live until after the wait; barriers order the copy after
-            // earlier shader reads and copies and before later ones.
-            unsafe {
-                before_transfer(ctx, cmd);
-                if !copy.is_empty() {
-                    ctx.device.cmd_copy_buffer(cmd, old, new, &copy);
-                }
-                after_transfer(ctx, cmd);
-            }
-        });
-        if let Err(e) = copied {
-            buffer.destroy(ctx);
-            return Err(e);
         }
-        let old = std::mem::replace(&mut self.buffer, buffer);
-        old.destroy(ctx);
-        self.regions = regions;
+        self.ring.wait_idle(ctx)?;
+        for (i, capacity) in plan {
+            let buffer = zeroed_buffer(ctx, capacity)?;
+            let (old, new) = (self.buffers[i].raw, buffer.raw);
+            let copy = vk::BufferCopy {
+                src_offset: 0,
+                dst_offset: 0,
+                size: self.shadow[i].len() as u64,
+            };
+            let copied = ctx.submit_and_wait(|cmd| {
+                // SAFETY: both buffers live until after the wait; barriers order the copy
+                // after earlier shader reads and copies and before later ones.
+                unsafe {
+                    before_transfer(ctx, cmd);
+                    if copy.size > 0 {
+                        ctx.device.cmd_copy_buffer(cmd, old, new, &[copy]);
+                    }
+                    after_transfer(ctx, cmd);
+                }
+            });
+            if let Err(e) = copied {
+                buffer.destroy(ctx);
+                return Err(e);
+            }
+            std::mem::replace(&mut self.buffers[i], buffer).destroy(ctx);
+        }
         Ok(())
     }
 
@@ -359,40 +356,31 @@ impl GpuWorld {
         read_device(
             ctx,
             Binding {
-                buffer: self.buffer.raw,
-                offset: self.regions[i].offset,
+                buffer: self.buffers[i].raw,
+                offset: 0,
                 range: self.shadow[i].len() as u64,
             },
         )
     }
 
-    /// Frees the buffer and the ring (waits for pending copies).
+    /// Frees the buffers and the ring (waits for pending copies).
     pub fn destroy(self, ctx: &GpuContext) {
         self.ring.destroy(ctx);
-        self.buffer.destroy(ctx);
+        self.buffers.into_iter().for_each(|b| b.destroy(ctx));
     }
 }
 
 impl GpuWorld {
     /// The voxel regions as bindings 0..4 (not the lights).
     pub fn bindings(&self) -> Vec<Binding> {
-        self.regions[..GpuBuffer::Lights as usize]
+        self.buffers[..GpuBuffer::Lights as usize]
             .iter()
-            .map(|r| Binding {
-                buffer: self.buffer.raw,
-                offset: r.offset,
-                range: r.capacity,
-            })
+            .map(HostBuffer::binding)
             .collect()
     }
     /// The light faces' region ([`brickmap::lights`]; binding 10 of the tracer).
     pub fn light_binding(&self) -> Binding {
-        let r = self.regions[GpuBuffer::Lights as usize];
-        Binding {
-            buffer: self.buffer.raw,
-            offset: r.offset,
-            range: r.capacity,
-        }
+        self.buffers[GpuBuffer::Lights as usize].binding()
     }
     /// Grid size in bricks.
     pub fn dims(&self) -> [u32; 3] {
@@ -433,13 +421,37 @@ mod tests {
     }
 
     #[test]
-    fn regions_are_aligned_and_disjoint() {
-        let (r, total) = layout([10, 68 * 3, 4, 0, 2304, 1056], 256);
-        for w in r.windows(2) {
-            assert!(w[0].offset + w[0].capacity <= w[1].offset);
-            assert_eq!(w[1].offset % 256, 0);
-        }
-        assert!(r[5].offset + r[5].capacity <= total);
-        assert_eq!(r[0].capacity, 12);
+    fn region_capacities_have_headroom_within_the_limit() {
+        let max = 1 << 20;
+        // First sizes: growing regions 25 % more, fixed ones exact, in words.
+        assert_eq!(
+            region_capacity(GpuBuffer::Bricks, 680, 0, max).unwrap(),
+            852
+        );
+        assert_eq!(
+            region_capacity(GpuBuffer::BrickIndex, 10, 0, max).unwrap(),
+            12
+        );
+        assert_eq!(region_capacity(GpuBuffer::Coarse, 0, 0, max).unwrap(), 4);
+        // Outgrown: 50 % more, or the size when that is more.
+        assert_eq!(
+            region_capacity(GpuBuffer::MaterialBytes, 1100, 1000, max).unwrap(),
+            1500
+        );
+        assert_eq!(
+            region_capacity(GpuBuffer::MaterialBytes, 4000, 1000, max).unwrap(),
+            4000
+        );
+        // Headroom stops at the limit; the limit itself still fits; past it is refused.
+        assert_eq!(
+            region_capacity(GpuBuffer::Bricks, max - 8, 0, max).unwrap(),
+            max
+        );
+        assert_eq!(
+            region_capacity(GpuBuffer::Bricks, max, max - 8, max).unwrap(),
+            max
+        );
+        let e = region_capacity(GpuBuffer::MaterialBytes, max + 1, max, max).unwrap_err();
+        assert!(e.to_string().contains("material bytes"), "{e}");
     }
 }
