@@ -79,11 +79,14 @@ fn the_live_editor_presents_what_a_headless_render_of_the_same_state_shows() {
         .env("DISPLAY", &x.display)
         .env_remove("WAYLAND_DISPLAY")
         .env("VOXBRICK_CONFIG_DIR", dir.join("config"))
+        .env("VOXBRICK_REPORT", dir.join("report.log"))
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .expect("voxbrick starts");
-    // While the window lingers after the capture, photograph the screen.
+    let mut report = window::Report::new(dir.join("report.log"));
+    // While the window lingers after the capture, photograph the screen once a frame with
+    // the panels is shown again.
     let started = Instant::now();
     let mut screenshot = None;
     while started.elapsed() < Duration::from_secs(600) {
@@ -91,7 +94,8 @@ fn the_live_editor_presents_what_a_headless_render_of_the_same_state_shows() {
             break;
         }
         if capture.exists() && screenshot.is_none() {
-            std::thread::sleep(Duration::from_millis(1500));
+            report.skip_past();
+            report.frame();
             let shot = Command::new("xwd")
                 .args(["-root", "-silent", "-display", &x.display])
                 .output()
@@ -103,7 +107,7 @@ fn the_live_editor_presents_what_a_headless_render_of_the_same_state_shows() {
             );
             screenshot = Some(shot.stdout);
         }
-        std::thread::sleep(Duration::from_millis(100));
+        std::thread::sleep(Duration::from_millis(20));
     }
     let out = editor.wait_with_output().unwrap();
     if no_vulkan(&out) {

@@ -851,8 +851,8 @@ impl Editor {
                 match (state, button) {
                     (ElementState::Pressed, MouseButton::Left) if free => self.press(),
                     (ElementState::Released, MouseButton::Left) if self.drawing.is_some() => {
-                        // The release position is the stroke's last point.
-                        self.stroke_to_cursor();
+                        // The release position was the last move's, already taken (taking it
+                        // again would dig an erase stroke deeper where the cursor stopped).
                         if let Some(d) = &self.drawing {
                             self.report.line(format_args!(
                                 "stroke release {} {} voxel {} {} {}",

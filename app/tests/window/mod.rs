@@ -158,6 +158,21 @@ impl Report {
             .collect()
     }
 
+    /// Forgets what was consumed: the next wait looks at every line from the first.
+    pub fn rewind(&mut self) {
+        self.seen = 0;
+    }
+
+    /// How many lines are consumed.
+    pub fn position(&self) -> usize {
+        self.seen
+    }
+
+    /// Consumes exactly the first `seen` lines.
+    pub fn set_position(&mut self, seen: usize) {
+        self.seen = seen;
+    }
+
     /// Marks every line so far as consumed.
     pub fn skip_past(&mut self) {
         self.seen = self.lines().len();
