@@ -8,6 +8,7 @@ pub mod formats;
 pub mod gpu;
 pub mod scene;
 pub mod selection;
+pub mod soak;
 pub mod ui;
 
 pub use scene::Scene;

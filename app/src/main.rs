@@ -142,6 +142,11 @@ enum Command {
     },
     /// Render a scene offscreen to an image.
     Render(RenderArgs),
+    /// The soak test: a long seeded random session (strokes of every mode and shape, selections,
+    /// clipboard, palette, terrain, undo / redo bursts, camera, saves and re-opens, viewport
+    /// frames at changing sizes) through the editor's edit thread, checked after every event;
+    /// on a failure, the seed and the shortest failing prefix as a replay script.
+    Soak(cli::soak::SoakArgs),
     /// Replay an edit script headlessly, reporting each step; exits non-zero at the first
     /// failed step.
     Replay {
@@ -548,6 +553,7 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Render(args) => render_command(args, workers),
+        Command::Soak(args) => cli::soak::soak_command(args, workers),
         Command::Replay {
             script,
             save,

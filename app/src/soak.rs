@@ -61,6 +61,9 @@ pub struct SoakOptions {
     pub out_dir: PathBuf,
     /// History bound in bytes.
     pub history_budget: usize,
+    /// Tests of the soak itself: event number `n` fails on purpose (the shortest failing
+    /// prefix is then exactly `n` events).
+    pub fail_at: Option<u64>,
 }
 
 impl Default for SoakOptions {
@@ -77,6 +80,7 @@ impl Default for SoakOptions {
             workers: 2,
             out_dir: std::env::temp_dir(),
             history_budget: crate::editor::history::DEFAULT_BUDGET,
+            fail_at: None,
         }
     }
 }
@@ -84,8 +88,12 @@ impl Default for SoakOptions {
 /// What a clean soak did.
 #[derive(Clone, Debug, Default)]
 pub struct SoakReport {
-    /// Events fed.
+    /// Events fed: user actions (a whole stroke, an undo / redo burst, a command, a resize, a
+    /// save).
     pub events: u64,
+    /// Inputs those events are made of: each stroke point, undo, redo, command, resize and
+    /// frame, as the window's handlers would pass them on.
+    pub inputs: u64,
     /// Wall time.
     pub elapsed: Duration,
     /// Viewport frames drawn.
@@ -247,6 +255,7 @@ impl Session {
     /// Submits an edit and waits for its result (the window's loop polls; the soak waits, so
     /// each event's invariants are checked on its own).
     fn edit(&mut self, edit: Edit) -> Result<Edited> {
+        self.report.inputs += 1;
         self.edits.submit(&self.doc, edit);
         let edited = self
             .edits
@@ -481,11 +490,9 @@ impl Session {
                 material: self.material_spec(),
             },
             14 => Command::SetParam {
-                kind: self.rng.pick(&[
-                    KindSpec::Metal,
-                    KindSpec::Dielectric,
-                    KindSpec::Emissive,
-                ]),
+                kind: self
+                    .rng
+                    .pick(&[KindSpec::Metal, KindSpec::Dielectric, KindSpec::Emissive]),
                 index: self.rng.below(64) as u8,
                 value: (self.rng.unit() * 3.0 - 0.5) as f32,
             },
@@ -624,7 +631,7 @@ impl Session {
         let (history, world) = {
             let d = self.doc.read().unwrap_or_else(|p| p.into_inner());
             let m = d.scene.world.read().memory();
-            (d.history.bytes(), m.total_bytes())
+            (d.history.bytes(), m.gpu_reserved() + m.cpu_only)
         };
         ensure!(
             history <= self.opts.history_budget,
@@ -634,10 +641,7 @@ impl Session {
         let resident = rss();
         self.report.peak_history = self.report.peak_history.max(history);
         self.report.peak_rss = self.report.peak_rss.max(resident);
-        let allowed = self.baseline_rss
-            + self.opts.history_budget as u64
-            + 4 * world as u64
-            + (512 << 20);
+        let allowed = self.baseline_rss + self.opts.history_budget as u64 + 4 * world + (512 << 20);
         ensure!(
             resident == 0 || resident <= allowed,
             "resident memory {resident} bytes, over the history bound + the world + 512 MiB ({allowed})"
@@ -675,6 +679,7 @@ impl Session {
         drop(d);
         ensure!(drawn, "no frame slot came free");
         self.report.frames += 1;
+        self.report.inputs += 1;
         let errors = vp.ctx().validation_errors();
         ensure!(errors == 0, "{errors} Vulkan validation errors");
         Ok(())
@@ -688,6 +693,7 @@ impl Session {
             35..=44 => self.undo_redo_burst()?,
             45..=46 => {
                 *self.report.kinds.entry("resize").or_default() += 1;
+                self.report.inputs += 1;
                 self.view_size = (
                     self.rng.range(8, i64::from(self.opts.view.0)) as u32,
                     self.rng.range(8, i64::from(self.opts.view.1)) as u32,
@@ -736,6 +742,9 @@ impl Session {
             self.report.events = n;
             let step = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 self.event()?;
+                if self.opts.fail_at == Some(n) {
+                    bail!("failing on purpose at event {n} (a test of the soak)");
+                }
                 if n % self.opts.frame_every.max(1) == 0 {
                     self.frame()?;
                 }
@@ -836,11 +845,11 @@ pub fn soak(opts: &SoakOptions) -> std::result::Result<SoakReport, SoakFailure> 
         let p = opts
             .out_dir
             .join(format!("soak-failure-seed-{}.ron", opts.seed));
-        crate::atomic::write_atomic(&p, |w| w.write_all(text.as_bytes()))
-            .ok()
-            .map(|()| p)
+        crate::atomic::write_atomic(&p, |w: &mut dyn std::io::Write| {
+            w.write_all(text.as_bytes())
+        })
+        .ok()
+        .map(|()| p)
     });
     Err(fail(event, hi, message, path))
 }
-
-use std::io::Write as _;

@@ -8,6 +8,7 @@ pub mod bench_skips;
 pub mod bench_viewport;
 pub mod plot;
 pub mod render;
+pub mod soak;
 pub mod stats;
 pub mod stress;
 
