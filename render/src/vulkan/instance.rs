@@ -39,6 +39,10 @@ unsafe extern "system" fn count_errors(
             .map(|m| m.to_string_lossy().into_owned())
     };
     eprintln!("vulkan {severity:?}: {}", message.unwrap_or_default());
+    // Where the call came from (debugging a validation message: VOXBRICK_VALIDATION_BACKTRACE=1).
+    if std::env::var("VOXBRICK_VALIDATION_BACKTRACE").is_ok_and(|v| v == "1") {
+        eprintln!("{}", std::backtrace::Backtrace::force_capture());
+    }
     vk::FALSE
 }
 

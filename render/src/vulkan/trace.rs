@@ -8,7 +8,7 @@ use super::barrier::barrier;
 use super::buffer::{Binding, HostBuffer};
 use super::pass::{ComputePass, Dispatch, SetCache, run_batch};
 use super::world::GpuWorld;
-use super::{GpuContext, GpuError};
+use super::{GpuContext, GpuError, vk_call};
 use crate::cpu::RenderJob;
 use crate::params::{SceneParams, Sequence, Sky};
 use ash::vk;
@@ -475,6 +475,11 @@ impl PathTracer {
             return Ok(());
         }
         if let Some(old) = self.queue.take() {
+            // The viewport's other frame in flight may still trace with the old queue (found
+            // by the soak test: a scene gaining its first lamp asks for a larger queue while a
+            // frame runs); growing is rare, so wait for the device rather than track retirees.
+            // SAFETY: no command buffer of this thread is being submitted meanwhile.
+            vk_call("vkDeviceWaitIdle", unsafe { ctx.device.device_wait_idle() })?;
             old.rays.destroy(ctx);
             old.header.destroy(ctx);
         }
