@@ -215,3 +215,49 @@ fn an_edit_whose_upload_spans_frames_shows_only_once_it_is_all_there() {
     }
     assert_eq!(ctx.validation_errors(), 0, "validation errors");
 }
+
+/// When the interactive frames take more samples per frame (the editor raises them while the
+/// GPU keeps up) or more bounces, a lamp-lit scene asks for a larger shadow-ray queue (one ray
+/// per vertex) while the other frame slot still traces with the old one: the old queue must
+/// outlive that frame (the soak test found it freed under the frame in flight:
+/// VUID-vkDestroyBuffer-buffer-00922).
+#[test]
+fn a_larger_shadow_queue_keeps_the_frame_in_flight_valid() {
+    let Some(ctx) = context() else { return };
+    let (world, mut params, _) = common::sun_floor();
+    params.settings.max_bounces = 2;
+    let lamp = common::add_material(&world, brickmap::MaterialKind::Emissive, 0, [255, 240, 220]);
+    world
+        .apply(EditOp::Shape {
+            shape: Shape::Box {
+                min: glam::IVec3::new(30, 4, 30),
+                max: glam::IVec3::new(33, 5, 33),
+            },
+            mode: Mode::Add(lamp),
+        })
+        .unwrap();
+    assert!(!world.read().lights().is_empty());
+    let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
+    let small = request(&params, (96, 64), 1, 1 << 20);
+    let _ = frames(&mut vp, &world, &small, 3, |_| false);
+    // Frames in flight, then four times the samples per frame, with no wait in between.
+    let more = request(&params, (96, 64), 4, 1 << 20);
+    let mut drawn = 0;
+    for _ in 0..200_000 {
+        if drawn >= 6 {
+            break;
+        }
+        match vp.begin_frame().unwrap() {
+            Some(frame) => {
+                let req = if drawn < 2 { &small } else { &more };
+                vp.trace_frame(&frame, &world, req).unwrap();
+                vp.submit_frame(frame, &[], &[]).unwrap();
+                drawn += 1;
+            }
+            None => std::thread::sleep(std::time::Duration::from_micros(200)),
+        }
+    }
+    vp.wait_idle().unwrap();
+    assert_eq!(drawn, 6);
+    assert_eq!(ctx.validation_errors(), 0);
+}

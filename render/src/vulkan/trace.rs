@@ -476,8 +476,9 @@ impl PathTracer {
         }
         if let Some(old) = self.queue.take() {
             // The viewport's other frame in flight may still trace with the old queue (found
-            // by the soak test: a scene gaining its first lamp asks for a larger queue while a
-            // frame runs); growing is rare, so wait for the device rather than track retirees.
+            // by the soak test: more samples per frame, more bounces or a first lamp ask for a
+            // larger queue while a frame runs); growing is rare, so wait for the device rather
+            // than track retirees.
             // SAFETY: no command buffer of this thread is being submitted meanwhile.
             vk_call("vkDeviceWaitIdle", unsafe { ctx.device.device_wait_idle() })?;
             old.rays.destroy(ctx);
