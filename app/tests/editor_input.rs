@@ -78,6 +78,27 @@ impl Session {
         })
     }
 
+    /// The editor on a new 64 × 32 × 64 terrain `dir/work.ron`, recording the session to
+    /// `dir/session.ron`, in a window of `size`, once the file has loaded.
+    fn recorded(x: &Xvfb, dir: &Path, size: &str) -> Option<Self> {
+        let (work, session) = (dir.join("work.ron"), dir.join("session.ron"));
+        new_terrain(&work, "64x32x64");
+        let mut s = Self::start(
+            x,
+            dir,
+            &dir.join("config"),
+            &[
+                work.to_str().unwrap(),
+                "--record",
+                session.to_str().unwrap(),
+                "--window",
+                size,
+            ],
+        )?;
+        s.report.wait("the file", |l| l.starts_with("loaded "));
+        Some(s)
+    }
+
     fn xdotool(&self, args: &[&str]) {
         xdotool(&self.display, args);
     }
@@ -206,24 +227,10 @@ fn tools_ready() -> Option<Xvfb> {
 fn strokes_drawn_with_the_mouse_replay_headlessly_to_the_same_scene() {
     let Some(x) = tools_ready() else { return };
     let dir = scratch("strokes");
-    let work = dir.join("work.ron");
-    new_terrain(&work, "64x32x64");
-    let session = dir.join("session.ron");
-    let Some(mut s) = Session::start(
-        &x,
-        &dir,
-        &dir.join("config"),
-        &[
-            work.to_str().unwrap(),
-            "--record",
-            session.to_str().unwrap(),
-            "--window",
-            "640x400",
-        ],
-    ) else {
+    let (work, session) = (dir.join("work.ron"), dir.join("session.ron"));
+    let Some(mut s) = Session::recorded(&x, &dir, "640x400") else {
         return;
     };
-    s.report.wait("the file", |l| l.starts_with("loaded "));
     // A click that closes a menu draws nothing.
     s.mouse_to((20, 11));
     s.press();
@@ -335,26 +342,13 @@ fn solid(path: &Path) -> HashSet<(i32, i32, i32)> {
     out
 }
 
-/// The 26-connected components of a voxel set.
+/// The 26-connected pieces of a voxel set.
 fn components(set: &BTreeSet<(i32, i32, i32)>) -> usize {
-    let mut seen = HashSet::new();
-    let mut count = 0;
-    for &start in set {
-        if !seen.insert(start) {
-            continue;
-        }
-        count += 1;
-        let mut stack = vec![start];
-        while let Some((x, y, z)) = stack.pop() {
-            for d in 0..27 {
-                let n = (x + d % 3 - 1, y + d / 3 % 3 - 1, z + d / 9 - 1);
-                if set.contains(&n) && seen.insert(n) {
-                    stack.push(n);
-                }
-            }
-        }
+    let mut v = brickmap::VoxelSet::new();
+    for &(x, y, z) in set {
+        v.insert(glam::IVec3::new(x, y, z));
     }
-    count
+    v.components()
 }
 
 fn voxel_of(line: &str) -> (i32, i32, i32) {
@@ -370,24 +364,10 @@ fn voxel_of(line: &str) -> (i32, i32, i32) {
 fn a_drag_faster_than_the_frames_is_one_connected_stroke_reaching_the_release_point() {
     let Some(x) = tools_ready() else { return };
     let dir = scratch("fast-drag");
-    let work = dir.join("work.ron");
-    new_terrain(&work, "64x32x64");
-    let session = dir.join("session.ron");
-    let Some(mut s) = Session::start(
-        &x,
-        &dir,
-        &dir.join("config"),
-        &[
-            work.to_str().unwrap(),
-            "--record",
-            session.to_str().unwrap(),
-            "--window",
-            "960x540",
-        ],
-    ) else {
+    let (work, session) = (dir.join("work.ron"), dir.join("session.ron"));
+    let Some(mut s) = Session::recorded(&x, &dir, "960x540") else {
         return;
     };
-    s.report.wait("the file", |l| l.starts_with("loaded "));
     // The thinnest brush: the voxel, one voxel per point.
     s.key("v", "KeyV", "input key Code(KeyV) down");
     let (x0, y) = (420, 300);

@@ -4,15 +4,10 @@
 //! failing prefix as a replay script that `voxbrick replay` runs headlessly. Without a Vulkan
 //! driver the GPU half skips, saying so, unless VOXBRICK_REQUIRE_GPU=1 makes that a failure.
 
+mod window;
+
 use app::soak::{SoakOptions, soak};
 use std::process::Command;
-
-fn out_dir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("voxbrick-soak-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 #[test]
 fn a_short_soak_with_viewport_frames_is_clean() {
@@ -20,7 +15,7 @@ fn a_short_soak_with_viewport_frames_is_clean() {
         seed: 26,
         events: 2000,
         check_every: 500,
-        out_dir: out_dir("short"),
+        out_dir: window::scratch("soak-short"),
         ..SoakOptions::default()
     };
     match soak(&opts) {
@@ -61,7 +56,7 @@ fn a_short_soak_with_viewport_frames_is_clean() {
 
 #[test]
 fn a_failure_names_the_seed_and_its_shortest_failing_prefix_as_a_replay_script() {
-    let dir = out_dir("failing");
+    let dir = window::scratch("soak-failing");
     let opts = SoakOptions {
         seed: 7,
         events: 400,

@@ -90,6 +90,44 @@ impl VoxelSet {
             .map(|(&(x, y, z), m)| (UVec3::new(x, y, z), m))
     }
 
+    /// Every voxel of the set, brick by brick.
+    pub fn voxels(&self) -> impl Iterator<Item = IVec3> + '_ {
+        self.iter().flat_map(|(b, m)| {
+            let base = b.as_ivec3() * 8;
+            m.ones().map(move |bit| {
+                base + IVec3::new((bit % 8) as i32, (bit / 8 % 8) as i32, (bit / 64) as i32)
+            })
+        })
+    }
+
+    /// Adds one voxel (outside the largest grid's range: ignored).
+    pub fn insert(&mut self, v: IVec3) {
+        self.apply_box(v, v, v + 1, false);
+    }
+
+    /// How many pieces the set is in, voxels touching by a face, edge or corner (26-connected)
+    /// belonging to the same piece.
+    pub fn components(&self) -> usize {
+        let mut seen = std::collections::HashSet::new();
+        let mut count = 0;
+        for start in self.voxels() {
+            if !seen.insert(start) {
+                continue;
+            }
+            count += 1;
+            let mut stack = vec![start];
+            while let Some(v) = stack.pop() {
+                for d in 0..27 {
+                    let n = v + IVec3::new(d % 3 - 1, d / 3 % 3 - 1, d / 9 - 1);
+                    if self.contains(n) && seen.insert(n) {
+                        stack.push(n);
+                    }
+                }
+            }
+        }
+        count
+    }
+
     /// Replaces the mask of brick `b` (an empty mask removes it).
     pub fn set_brick(&mut self, b: UVec3, mask: Mask) {
         self.bounds = Default::default();
@@ -157,6 +195,27 @@ impl VoxelSet {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn components_count_pieces_touching_by_corners_across_bricks() {
+        let mut s = VoxelSet::new();
+        assert_eq!(s.components(), 0);
+        // A diagonal run across a brick corner: corner contacts join it.
+        for k in 5..12 {
+            s.insert(IVec3::splat(k));
+        }
+        assert_eq!(s.components(), 1);
+        assert_eq!(s.voxels().count(), 7);
+        // A gap of one voxel makes a second piece; filling it joins them.
+        s.insert(IVec3::new(13, 12, 13));
+        assert_eq!(s.components(), 2);
+        s.insert(IVec3::new(12, 12, 12));
+        assert_eq!(s.components(), 1);
+        let mut all: Vec<IVec3> = s.voxels().collect();
+        all.sort_by_key(|v| (v.x, v.y, v.z));
+        assert_eq!(all[0], IVec3::splat(5));
+        assert_eq!(all[all.len() - 1], IVec3::new(13, 12, 13));
+    }
 
     #[test]
     fn box_masks_match_the_voxel_test() {

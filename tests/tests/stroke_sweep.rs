@@ -11,7 +11,7 @@ use app::editor::history::History;
 use app::scene::Scene;
 use brickmap::{GridDims, Shape};
 use glam::{DVec3, IVec3, UVec3};
-use std::collections::{BTreeSet, HashSet};
+use std::collections::BTreeSet;
 
 const SIZE: UVec3 = UVec3::new(104, 32, 48);
 const MATERIAL: u8 = 2;
@@ -113,30 +113,13 @@ fn swept(shape: BrushShape, size: f64, axis: DVec3, a: DVec3, b: DVec3, v: IVec3
     }
 }
 
-/// The 26-connected components of a voxel set.
+/// The 26-connected pieces of a voxel set.
 fn components(set: &BTreeSet<(i32, i32, i32)>) -> usize {
-    let mut seen: HashSet<(i32, i32, i32)> = HashSet::new();
-    let mut count = 0;
-    for &start in set {
-        if !seen.insert(start) {
-            continue;
-        }
-        count += 1;
-        let mut stack = vec![start];
-        while let Some((x, y, z)) = stack.pop() {
-            for dx in -1..=1 {
-                for dy in -1..=1 {
-                    for dz in -1..=1 {
-                        let n = (x + dx, y + dy, z + dz);
-                        if set.contains(&n) && seen.insert(n) {
-                            stack.push(n);
-                        }
-                    }
-                }
-            }
-        }
+    let mut v = brickmap::VoxelSet::new();
+    for &(x, y, z) in set {
+        v.insert(IVec3::new(x, y, z));
     }
-    count
+    v.components()
 }
 
 fn reflect(p: DVec3, m: &Mirror, combo: usize) -> DVec3 {
