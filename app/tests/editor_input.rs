@@ -303,18 +303,7 @@ fn strokes_drawn_with_the_mouse_replay_headlessly_to_the_same_scene() {
     );
     // The same actions replayed headlessly give the scene the window saved.
     let replayed = dir.join("replayed");
-    let replay = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
-        .arg("replay")
-        .arg(&session)
-        .arg("--out-dir")
-        .arg(&replayed)
-        .output()
-        .unwrap();
-    assert!(
-        replay.status.success(),
-        "{}",
-        String::from_utf8_lossy(&replay.stderr)
-    );
+    window::replay(env!("CARGO_BIN_EXE_voxbrick"), &session, &replayed);
     let saved = hash(&work);
     assert_ne!(
         saved,

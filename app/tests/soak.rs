@@ -7,7 +7,6 @@
 mod window;
 
 use app::soak::{SoakOptions, soak};
-use std::process::Command;
 
 #[test]
 fn a_short_soak_with_viewport_frames_is_clean() {
@@ -73,16 +72,9 @@ fn a_failure_names_the_seed_and_its_shortest_failing_prefix_as_a_replay_script()
     let script = f.script.expect("the shortest failing session is written");
     assert!(script.starts_with(&dir));
     // The prefix replays headlessly.
-    let replay = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
-        .arg("replay")
-        .arg(&script)
-        .arg("--out-dir")
-        .arg(dir.join("replayed"))
-        .output()
-        .unwrap();
-    assert!(
-        replay.status.success(),
-        "{}",
-        String::from_utf8_lossy(&replay.stderr)
+    window::replay(
+        env!("CARGO_BIN_EXE_voxbrick"),
+        &script,
+        &dir.join("replayed"),
     );
 }

@@ -132,6 +132,24 @@ pub fn xdotool(display: &str, args: &[&str]) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
+/// Replays a script headlessly with the `voxbrick` binary at `bin`, its files into `out`;
+/// fails the test with the replay's errors.
+pub fn replay(bin: &str, script: &Path, out: &Path) {
+    let run = Command::new(bin)
+        .arg("replay")
+        .arg(script)
+        .arg("--out-dir")
+        .arg(out)
+        .output()
+        .expect("voxbrick runs");
+    assert!(
+        run.status.success(),
+        "replaying {}: {}",
+        script.display(),
+        String::from_utf8_lossy(&run.stderr)
+    );
+}
+
 /// The editor's handshake log, read as it grows.
 pub struct Report {
     path: PathBuf,
