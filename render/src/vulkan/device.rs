@@ -77,8 +77,6 @@ pub struct GpuContext {
     /// The limits every buffer, binding and dispatch stays within (lowered by the caps of
     /// [`super::limits`]).
     pub limits: super::DeviceLimits,
-    /// `minStorageBufferOffsetAlignment`: storage bindings start at multiples of it.
-    pub storage_alignment: u64,
     /// VK_KHR_pipeline_executable_properties, when the driver has it.
     pub pipeline_stats: Option<ash::khr::pipeline_executable_properties::Device>,
     /// Float atomic adds on storage buffers (VK_EXT_shader_atomic_float): what the path
@@ -326,7 +324,6 @@ impl GpuContext {
             shadow_queue,
             timestamp_period,
             limits: device_limits,
-            storage_alignment: limits.min_storage_buffer_offset_alignment.max(4),
             pipeline_stats,
             presentation,
             ui_rendering,

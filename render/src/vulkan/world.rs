@@ -254,7 +254,7 @@ impl GpuWorld {
     }
 
     fn flush(&mut self, ctx: &GpuContext) -> Result<UploadReport, GpuError> {
-        let buffers: Vec<vk::Buffer> = self.buffers.iter().map(|b| b.raw).collect();
+        let buffers: [vk::Buffer; N] = std::array::from_fn(|i| self.buffers[i].raw);
         let flushed = self.ring.flush(ctx, &mut self.queue, |r| (buffers[r], 0))?;
         Ok(UploadReport {
             uploaded_bytes: flushed.bytes,
