@@ -143,9 +143,10 @@ enum Command {
     /// Render a scene offscreen to an image.
     Render(RenderArgs),
     /// The soak test: a long seeded random session (strokes of every mode and shape, selections,
-    /// clipboard, palette, terrain, undo / redo bursts, camera, saves and re-opens, viewport
-    /// frames at changing sizes) through the editor's edit thread, checked after every event;
-    /// on a failure, the seed and the shortest failing prefix as a replay script.
+    /// clipboard, palette, terrain, undo / redo bursts, camera, panels, resizes, saves and
+    /// re-opens) fed to a headless editor as window input events, or to its edit thread,
+    /// checked after every input; on a failure, the seed and the shortest failing prefix as a
+    /// replay script.
     Soak(cli::soak::SoakArgs),
     /// Replay an edit script headlessly, reporting each step; exits non-zero at the first
     /// failed step.
@@ -449,6 +450,7 @@ fn run(cli: Cli) -> Result<()> {
             device: e.device,
             validation: e.validation,
             record: e.record,
+            config: None,
         });
     };
     match command {

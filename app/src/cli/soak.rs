@@ -1,10 +1,11 @@
 //! `voxbrick soak`: the soak test ([`app::soak`]) from the command line — a seeded random
-//! session of edits, undo / redo bursts, saves and re-opens and viewport frames, checked after
-//! every event; prints events per second and exits non-zero with the seed and the shortest
-//! failing prefix (a replay script) on a failure.
+//! session fed to a headless editor as window input events (`--through editor`, the default)
+//! or to the edit thread as edits (`--through edits`), checked after every input; prints
+//! events per second and exits non-zero with the seed and the shortest failing prefix (a
+//! replay script) on a failure.
 
 use anyhow::{Result, bail};
-use app::soak::{SoakOptions, soak};
+use app::soak::{SoakOptions, Through, soak};
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -14,6 +15,13 @@ pub(crate) struct SoakArgs {
     /// The session's seed.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// What the session feeds: "editor" (window input events into a headless editor: egui,
+    /// the key map, picking, the tools) or "edits" (edits into the edit thread).
+    #[arg(long, default_value = "editor")]
+    through: String,
+    /// The headless editor's window size, as WxH (--through editor).
+    #[arg(long, default_value = "480x300")]
+    window: String,
     /// Run this many minutes (then stop at the next event).
     #[arg(long)]
     minutes: Option<f64>,
@@ -26,13 +34,14 @@ pub(crate) struct SoakArgs {
     /// The viewport's largest size, as WxH (resizes pick sizes up to it).
     #[arg(long, default_value = "96x64")]
     view: String,
-    /// Vulkan device for the viewport's frames ("gpu": the best), or "none": no frames.
+    /// Vulkan device for the viewport's frames ("gpu": the best), or "none": no frames
+    /// (--through edits only: the editor always draws).
     #[arg(long, default_value = "gpu")]
     device: String,
     /// Events between whole-history checks.
     #[arg(long, default_value_t = 1000)]
     check_every: u64,
-    /// Events between viewport frames.
+    /// Events (--through edits) or inputs (--through editor) between viewport frames.
     #[arg(long, default_value_t = 8)]
     frame_every: u64,
     /// Folder for saves and a failure's replay script.
@@ -55,6 +64,15 @@ fn numbers(text: &str, n: usize) -> Result<Vec<u32>> {
 pub(crate) fn soak_command(a: SoakArgs, workers: usize) -> Result<()> {
     let size = numbers(&a.size, 3)?;
     let view = numbers(&a.view, 2)?;
+    let window = numbers(&a.window, 2)?;
+    let through = match a.through.as_str() {
+        "editor" => Through::Editor,
+        "edits" => Through::Edits,
+        other => bail!("--through {other:?}: say \"editor\" or \"edits\""),
+    };
+    if through == Through::Editor && a.device == "none" {
+        bail!("--through editor draws every frame: it needs a --device (or use --through edits)");
+    }
     if let Some(m) = a.minutes
         && !(m > 0.0 && m.is_finite())
     {
@@ -63,6 +81,8 @@ pub(crate) fn soak_command(a: SoakArgs, workers: usize) -> Result<()> {
     std::fs::create_dir_all(&a.out)?;
     let opts = SoakOptions {
         seed: a.seed,
+        through,
+        window: (window[0], window[1]),
         events: a
             .events
             .unwrap_or(if a.minutes.is_some() { 0 } else { 10_000 }),

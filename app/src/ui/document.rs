@@ -129,9 +129,8 @@ impl Editor {
             let _ = self.config.add_recent(p);
             self.panels.recent = self.config.recent();
         }
-        // A recording covers the file it starts from: the first document only.
-        if self.options.record.is_some() && self.generation == 0 {
-            doc.recorder = Some(crate::editor::script::Recorder::default());
+        if self.options.record.is_some() {
+            doc.recorder = self.carry_recording(path.as_deref());
         }
         doc.path = path.filter(|_| is_project);
         self.view = scene_view(&doc.scene);
@@ -139,6 +138,51 @@ impl Editor {
         self.doc = Arc::new(RwLock::new(doc));
         self.generation += 1;
         self.refresh_stats();
+    }
+
+    /// The recording for the next document: new for the first (it starts from the file the
+    /// recording was asked for); for a file opened later, the session's recording goes on
+    /// with an `Open` step of a copy made beside it now (later saves may overwrite the
+    /// file); a built scene has no step that replays it, so the recording ends there (and is
+    /// what is written at exit).
+    fn carry_recording(&mut self, path: Option<&Path>) -> Option<script::Recorder> {
+        if self.generation == 0 {
+            return Some(script::Recorder::default());
+        }
+        let mut recorder = self
+            .doc
+            .write()
+            .unwrap_or_else(|p| p.into_inner())
+            .recorder
+            .take()?;
+        let (Some(path), Some(out)) = (path, self.options.record.clone()) else {
+            self.ended_recording = Some(recorder);
+            return None;
+        };
+        self.recorded_opens += 1;
+        let copy = recording_copy(&out, path, &format!("open-{}", self.recorded_opens));
+        if let Err(e) = std::fs::copy(path, &copy) {
+            self.panels.errors.push(format!(
+                "--record: copying {} to {}: {e}; the recording ends here",
+                path.display(),
+                copy.display()
+            ));
+            self.ended_recording = Some(recorder);
+            return None;
+        }
+        let name = copy.file_name().map(|n| n.to_string_lossy().into_owned());
+        recorder.record(script::Step::Open(name.unwrap_or_default()));
+        Some(recorder)
+    }
+
+    /// The session's recording so far (the document's, or the one a built scene ended).
+    pub(super) fn recording_text(&self) -> Option<String> {
+        let (out, file) = (self.options.record.as_ref()?, self.options.file.as_ref()?);
+        let doc = self.read();
+        let recorder = doc.recorder.as_ref().or(self.ended_recording.as_ref())?;
+        let start = recording_copy(out, file, "start");
+        let name = start.file_name().map(|n| n.to_string_lossy().into_owned());
+        Some(recorder.to_ron(script::Start::File(name.unwrap_or_default()), None))
     }
 
     /// Runs `then` now, or asks about unsaved changes first.
@@ -233,9 +277,13 @@ impl Editor {
                 .push(format!("writing {}: {e:#}", path.display())),
             Done::Picked(_, Ok(None)) => self.save_then = None,
             Done::Picked(Purpose::SaveAs, Err(e)) => {
-                // Nothing is lost for want of a dialog: save beside the home folder.
-                let home =
-                    std::env::var_os("HOME").map_or_else(|| PathBuf::from("."), PathBuf::from);
+                // Nothing is lost for want of a dialog: save beside the home folder (a
+                // headless editor's: its configuration folder).
+                let home = if self.headless {
+                    self.config.0.clone()
+                } else {
+                    std::env::var_os("HOME").map_or_else(|| PathBuf::from("."), PathBuf::from)
+                };
                 let path = files::fallback_path(&home, "voxbrick-untitled", "ron");
                 self.panels
                     .errors
@@ -328,7 +376,7 @@ impl Editor {
     /// A GPU error mid-session: say so; unsaved work goes to the recovery file at once
     /// (offered on the next start), then a dialog offers to save it as a project too (not
     /// in a script run: nobody is there to answer).
-    pub(super) fn gpu_failed(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
+    pub(super) fn gpu_failed(&mut self, e: anyhow::Error) {
         // The message itself is the run's error, printed once at exit.
         let message = format!("{e:#}");
         self.gfx = None;
@@ -344,10 +392,10 @@ impl Editor {
                 ),
                 Err(e) => eprintln!("voxbrick: writing {} failed: {e:#}", recovery.display()),
             }
-            if self.script.is_none() {
+            if self.script.is_none() && !self.headless {
                 self.offer_save(&message);
             }
-        } else if self.script.is_none() {
+        } else if self.script.is_none() && !self.headless {
             rfd::MessageDialog::new()
                 .set_level(rfd::MessageLevel::Error)
                 .set_title("voxbrick: the GPU failed")
@@ -356,7 +404,7 @@ impl Editor {
                 .show();
         }
         self.outcome = Err(anyhow!("the GPU failed: {message}"));
-        event_loop.exit();
+        self.exit = true;
     }
 
     /// After a GPU failure: "save the scene?", to its file or one the user picks.
@@ -387,21 +435,16 @@ impl Editor {
 
     /// With `--record`: the session's script, starting from the file opened (atomic write).
     pub(super) fn write_recording(&mut self) -> Result<()> {
-        let (Some(out), Some(file)) = (&self.options.record, &self.options.file) else {
+        let Some(out) = self.options.record.clone() else {
             return Ok(());
         };
-        let doc = self.read();
-        let Some(recorder) = &doc.recorder else {
+        if self.options.file.is_none() {
+            return Ok(());
+        }
+        let Some(text) = self.recording_text() else {
             anyhow::bail!("--record: the file was not opened, so nothing was recorded");
         };
-        // The copy of the file made at start-up, beside the script (relative to it).
-        let start = super::recording_start(out, file);
-        let name = start.file_name().map(|n| n.to_string_lossy().into_owned());
-        let text = recorder.to_ron(
-            crate::editor::script::Start::File(name.unwrap_or_default()),
-            None,
-        );
-        crate::atomic::write_atomic(out, |w| w.write_all(text.as_bytes()))
+        crate::atomic::write_atomic(&out, |w| w.write_all(text.as_bytes()))
             .with_context(|| format!("writing the recording {}", out.display()))
     }
 }

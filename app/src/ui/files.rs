@@ -189,6 +189,9 @@ pub struct FileWorker {
     pub done: Receiver<Done>,
     /// Jobs running (for the progress indicator).
     pub running: Vec<String>,
+    /// Whether native dialogs may be shown (false: a pick answers at once that no dialog
+    /// can be shown, as on a machine without a portal).
+    pub dialogs: bool,
     wake: Arc<dyn Fn() + Send + Sync>,
 }
 
@@ -200,6 +203,7 @@ impl FileWorker {
             done_tx,
             done,
             running: Vec::new(),
+            dialogs: true,
             wake,
         }
     }
@@ -216,6 +220,12 @@ impl FileWorker {
     /// A native file dialog on its own thread (the frame loop never waits for it).
     pub fn pick(&mut self, purpose: Purpose, folder: Option<PathBuf>, name: Option<String>) {
         let label = format!("{purpose:?} dialog");
+        if !self.dialogs {
+            self.spawn(label, move || {
+                Done::Picked(purpose, Err(NO_DIALOG.to_string()))
+            });
+            return;
+        }
         self.spawn(label, move || {
             let mut d = rfd::FileDialog::new();
             d = match purpose {

@@ -30,53 +30,78 @@ impl Editor {
         .context("no Vulkan device can draw this window")?;
         let ctx = Arc::new(ctx);
         let size = window.inner_size();
-        self.window_size = (size.width, size.height);
         let presenter = Presenter::new(ctx.clone(), (size.width, size.height))?;
-        let viewport = {
-            let doc = self.read();
-            let view = doc.scene.world.read();
-            Viewport::new(ctx, &view)?
-        };
-        self.gpu_generation = self.generation;
-        let egui_state = egui_winit::State::new(
+        let egui_state = Box::new(egui_winit::State::new(
             self.egui.clone(),
             egui::ViewportId::ROOT,
             &window,
             Some(window.scale_factor() as f32),
             None,
             None,
-        );
+        ));
+        self.attach(
+            ctx,
+            presenter,
+            Host::Window { egui_state, window },
+            (size.width, size.height),
+        )
+    }
+
+    /// The GPU session for the window (or its headless stand-in) of `size`.
+    pub(super) fn attach(
+        &mut self,
+        ctx: Arc<GpuContext>,
+        presenter: Presenter,
+        host: Host,
+        size: (u32, u32),
+    ) -> Result<()> {
+        self.window_size = size;
+        let viewport = {
+            let doc = self.read();
+            let view = doc.scene.world.read();
+            Viewport::new(ctx, &view)?
+        };
+        self.gpu_generation = self.generation;
         self.gfx = Some(Gfx {
             presenter,
             viewport,
-            egui_state,
-            window,
+            host,
         });
         self.refresh_stats();
         Ok(())
     }
 
-    pub(super) fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
-        self.outcome = Err(e);
-        event_loop.exit();
-    }
-
     /// One frame: script step, file results, egui, trace, present. Skipped (not waited
     /// for) while a command runs on the worker; its completion wakes the loop.
-    pub(super) fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+    pub(super) fn redraw(&mut self) -> Result<()> {
         let gate = self.edits.gate.clone();
         let Ok(_frame) = gate.try_lock() else {
             // No frame can be drawn while an edit holds the document; a long one (terrain)
             // shows its progress in the title, refreshed by `about_to_wait`'s timer.
-            if let (Some(f), Some(g)) = (self.progress.fraction(), &self.gfx) {
+            if let (Some(f), Some(g)) = (self.progress.fraction(), &mut self.gfx) {
                 let title = format!("voxbrick — generating terrain {:.0} %", f * 100.0);
                 if title != self.title {
-                    g.window.set_title(&title);
+                    g.host.set_title(&title);
                     self.title = title;
                 }
             }
             return Ok(());
         };
+        self.take_results();
+        self.tick_fly();
+        self.step_script();
+        self.autosave();
+        let Some(mut gfx) = self.gfx.take() else {
+            return Ok(());
+        };
+        let result = self.draw(&mut gfx);
+        self.gfx = Some(gfx);
+        result
+    }
+
+    /// What finished since the last frame (files, edits, saves; the backlog's input), the
+    /// frame gate held.
+    pub(super) fn take_results(&mut self) {
         while let Ok(done) = self.files.done.try_recv() {
             self.file_done(done);
         }
@@ -89,21 +114,12 @@ impl Editor {
             }
         }
         self.mark_saved();
-        for event in std::mem::take(&mut self.backlog) {
-            self.handle_window_event(event_loop, event);
+        for (input, consumed) in std::mem::take(&mut self.backlog) {
+            self.handle_logged(input, consumed);
         }
-        self.tick_fly();
-        self.step_script();
-        self.autosave();
-        let Some(mut gfx) = self.gfx.take() else {
-            return Ok(());
-        };
-        let result = self.draw(&mut gfx, event_loop);
-        self.gfx = Some(gfx);
-        result
     }
 
-    pub(super) fn draw(&mut self, gfx: &mut Gfx, event_loop: &ActiveEventLoop) -> Result<()> {
+    pub(super) fn draw(&mut self, gfx: &mut Gfx) -> Result<()> {
         self.frames += 1;
         if self.fail_at_frame == Some(self.frames) {
             return Err(render::vulkan::GpuError::Vk {
@@ -133,10 +149,8 @@ impl Editor {
         self.panels.busy.extend(self.edits.pending.iter().cloned());
         let samples = gfx.viewport.samples();
         let gpu_ms = gfx.viewport.last_gpu_seconds().map_or(0.0, |s| s * 1e3);
-        let size = gfx.window.inner_size();
-        let internal = gfx
-            .viewport
-            .fit_internal(self.internal_size((size.width, size.height)));
+        let size = gfx.host.inner_size();
+        let internal = gfx.viewport.fit_internal(self.internal_size(size));
         let paths = internal.0 as f64 * internal.1 as f64 * self.last_added as f64;
         self.panels.status = format!(
             "{samples}/{} spp · GPU {gpu_ms:.2} ms/frame · {:.1} Mpaths/s · internal {}x{}{} · {}{}",
@@ -162,10 +176,10 @@ impl Editor {
         // The title only when it changes (each set is a round trip to the window system).
         let title = files::title(&self.read());
         if title != self.title {
-            gfx.window.set_title(&title);
+            gfx.host.set_title(&title);
             self.title = title;
         }
-        let raw = gfx.egui_state.take_egui_input(&gfx.window);
+        let raw = gfx.host.take_egui_input();
         let egui_ctx = self.egui.clone();
         let mut events = Vec::new();
         let output = {
@@ -217,8 +231,7 @@ impl Editor {
             pixels_per_point,
             viewport_output,
         } = output;
-        gfx.egui_state
-            .handle_platform_output(&gfx.window, platform_output);
+        gfx.host.handle_platform_output(platform_output);
         // Texture changes wait here until a frame with the UI applies them.
         self.pending_textures.append(textures_delta);
         let primitives = egui_ctx.tessellate(shapes, pixels_per_point);
@@ -227,7 +240,7 @@ impl Editor {
         let moving = Instant::now() < self.moving_until || self.drawing.is_some();
         let internal = if moving {
             scaled(
-                (size.width, size.height),
+                size,
                 self.settings.moving_scale.min(self.settings.internal_scale),
             )
         } else {
@@ -240,7 +253,7 @@ impl Editor {
         let request = FrameRequest {
             params: &params,
             internal,
-            output: (size.width, size.height),
+            output: size,
             spp: self.spp_per_frame,
             target_spp: self.settings.target_spp,
             exposure: doc.scene.params.settings.exposure + self.settings.exposure,
@@ -277,7 +290,7 @@ impl Editor {
                 }
                 self.adapt_samples(gfx.viewport.last_gpu_seconds());
             }
-            Presented::NotReady | Presented::Recreated => gfx.window.request_redraw(),
+            Presented::NotReady | Presented::Recreated => gfx.host.request_redraw(),
         }
         if let Some(c) = captured {
             self.finish_capture(gfx, c)?;
@@ -290,10 +303,10 @@ impl Editor {
             if errors > 0 {
                 anyhow::bail!("{errors} Vulkan validation errors");
             }
-            event_loop.exit();
+            self.exit = true;
         }
         if self.quitting {
-            event_loop.exit();
+            self.exit = true;
         }
         // Keep drawing while refining, moving, running a script or waiting for files.
         let busy = gfx.viewport.samples() < self.settings.target_spp
@@ -306,7 +319,7 @@ impl Editor {
             || !self.saved.is_empty()
             || viewport_output.values().any(|v| v.repaint_delay.is_zero());
         if busy {
-            gfx.window.request_redraw();
+            gfx.host.request_redraw();
         }
         Ok(())
     }

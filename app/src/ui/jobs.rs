@@ -131,6 +131,12 @@ impl EditQueue {
         }
     }
 
+    /// Whether the edit thread is running (it ends only when the queue is dropped, or by a
+    /// panic).
+    pub fn alive(&self) -> bool {
+        self.thread.as_ref().is_some_and(|t| !t.is_finished())
+    }
+
     /// Marks the oldest edit reported (the caller got its result).
     pub fn finished(&mut self) {
         self.pending.pop_front();

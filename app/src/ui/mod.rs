@@ -7,8 +7,12 @@
 pub mod camera;
 mod document;
 mod editing;
+pub mod event;
 pub mod files;
 mod frame;
+mod handle;
+mod headless;
+mod host;
 pub mod input;
 pub mod jobs;
 pub mod keymap;
@@ -26,8 +30,10 @@ use crate::editor::script::{self, ReplayOptions, Script, ScriptRun};
 use crate::selection::SelectOp;
 use anyhow::{Context, Result, anyhow};
 use camera::ViewCamera;
+pub use event::Input;
 use files::{ConfigDir, Done, FileWorker, Purpose, SharedDocument};
 use glam::DVec3;
+use host::Host;
 use input::{Action, Drag, Mods};
 use jobs::{Edit, EditQueue, Edited};
 use panels::{PanelState, UiEvent, UnsavedAnswer, ViewSettings};
@@ -41,9 +47,9 @@ use std::sync::{Arc, RwLock};
 use std::time::{Duration, Instant};
 use tools::Tool;
 use winit::application::ApplicationHandler;
-use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
-use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
-use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::event::{MouseButton, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::KeyCode;
 use winit::window::{Window, WindowId};
 
 /// How the editor starts.
@@ -67,9 +73,12 @@ pub struct EditorOptions {
     pub device: String,
     /// Enable the validation layer (the editor exits non-zero on any validation error).
     pub validation: bool,
-    /// Record the first document's edits as a replay script starting from `file`, written
-    /// here on exit.
+    /// Record the session's edits as a replay script starting from `file`, written here on
+    /// exit (each file opened later is copied beside it and opened by an `Open` step).
     pub record: Option<PathBuf>,
+    /// The configuration folder (settings, key map, recent files, recovery); None: from the
+    /// environment (`ConfigDir::from_env`).
+    pub config: Option<PathBuf>,
 }
 
 /// Wakes the event loop from other threads (file work finished).
@@ -82,9 +91,22 @@ pub fn run(options: EditorOptions) -> Result<()> {
         anyhow!("cannot open a window: {e} (no display? set DISPLAY or WAYLAND_DISPLAY)")
     })?;
     let proxy = event_loop.create_proxy();
+    copy_recording_start(&options)?;
+    let wake: Arc<dyn Fn() + Send + Sync> = Arc::new(move || {
+        let _ = proxy.send_event(Wake);
+    });
+    let mut editor = Editor::new(options, wake, false)?;
+    event_loop
+        .run_app(&mut editor)
+        .map_err(|e| anyhow!("event loop: {e}"))?;
+    std::mem::replace(&mut editor.outcome, Ok(()))
+}
+
+/// With `--record`: the recording starts from the file as it is now (a save may overwrite
+/// it), so it is copied beside the recording first.
+fn copy_recording_start(options: &EditorOptions) -> Result<()> {
     if let (Some(record), Some(file)) = (&options.record, &options.file) {
-        // The recording starts from the file as it is now (a save may overwrite it).
-        let start = recording_start(record, file);
+        let start = recording_copy(record, file, "start");
         std::fs::copy(file, &start).with_context(|| {
             format!(
                 "--record: copying {} to {}",
@@ -93,30 +115,27 @@ pub fn run(options: EditorOptions) -> Result<()> {
             )
         })?;
     }
-    let mut editor = Editor::new(options, proxy)?;
-    event_loop
-        .run_app(&mut editor)
-        .map_err(|e| anyhow!("event loop: {e}"))?;
-    std::mem::replace(&mut editor.outcome, Ok(()))
+    Ok(())
 }
 
-/// Where `--record OUT` keeps the opened file as it was: beside OUT, named after it.
-fn recording_start(record: &Path, file: &Path) -> PathBuf {
+/// Where `--record OUT` keeps a file the session opened, as it was: beside OUT, named after
+/// it and `what` (`start`, `open-2`, …).
+fn recording_copy(record: &Path, file: &Path, what: &str) -> PathBuf {
     let ext = file.extension().and_then(|e| e.to_str()).unwrap_or("ron");
     let stem = record
         .file_stem()
         .and_then(|s| s.to_str())
         .unwrap_or("session");
-    record.with_file_name(format!("{stem}-start.{ext}"))
+    record.with_file_name(format!("{stem}-{what}.{ext}"))
 }
 
-/// What the GPU and the window are, once the window exists. Field order is drop order:
-/// the presenter and the session go before the window their surface belongs to.
+/// What the GPU and the window are, once the window exists (or its headless stand-in).
+/// Field order is drop order: the presenter and the session go before the window their
+/// surface belongs to.
 struct Gfx {
     presenter: Presenter,
     viewport: Viewport,
-    egui_state: egui_winit::State,
-    window: Arc<Window>,
+    host: Host,
 }
 
 /// A script run through the live editor.
@@ -162,9 +181,9 @@ pub struct Editor {
     gpu_generation: u64,
     files: FileWorker,
     edits: EditQueue,
-    /// Input that arrived while an edit held the frame gate, handled (in order) once it is
-    /// free: a keystroke during a long undo is late, never lost.
-    backlog: Vec<WindowEvent>,
+    /// Input that arrived while an edit held the frame gate (and whether egui kept it),
+    /// handled in order once it is free: a keystroke during a long undo is late, never lost.
+    backlog: Vec<(Input, bool)>,
     /// Saves asked for while edits were queued: they start once those are applied.
     saves_waiting: Vec<(PathBuf, bool)>,
     /// Finished saves (file, revision written) whose bookkeeping is not yet on the document.
@@ -218,18 +237,31 @@ pub struct Editor {
     /// Tests only: the frame that fails as if the device were lost
     /// (`VOXBRICK_TEST_GPU_FAILURE_AT_FRAME`), to check nothing is lost when the GPU fails.
     fail_at_frame: Option<u64>,
+    /// No window: frames are drawn offscreen, no native dialog is shown, fly keys move the
+    /// camera a fixed 1/60 s per frame (a headless session is a function of its input).
+    headless: bool,
+    /// The editor asked to stop (the window loop exits; a headless driver is told).
+    exit: bool,
+    /// Files opened since the recording started (each copied beside it).
+    recorded_opens: u32,
+    /// The recording, once a built scene ended it (written at exit).
+    ended_recording: Option<script::Recorder>,
 }
 
 impl Editor {
-    fn new(options: EditorOptions, proxy: EventLoopProxy<Wake>) -> Result<Self> {
-        let wake_proxy = proxy.clone();
-        let wake: Arc<dyn Fn() + Send + Sync> = Arc::new(move || {
-            let _ = wake_proxy.send_event(Wake);
-        });
-        let files = FileWorker::new(wake.clone());
+    fn new(
+        options: EditorOptions,
+        wake: Arc<dyn Fn() + Send + Sync>,
+        headless: bool,
+    ) -> Result<Self> {
+        let mut files = FileWorker::new(wake.clone());
+        files.dialogs = !headless;
         let wake_preview = wake.clone();
         let edits = EditQueue::new(wake);
-        let config = ConfigDir::from_env();
+        let config = options
+            .config
+            .clone()
+            .map_or_else(ConfigDir::from_env, ConfigDir);
         // Until the first real scene arrives the editor shows an empty one-brick grid.
         let placeholder = Scene::empty(brickmap::GridDims::new(1, 1, 1)?, 1)?;
         let mut doc = Document::new(placeholder, History::with_budget(DEFAULT_BUDGET));
@@ -323,6 +355,10 @@ impl Editor {
                 .and_then(|v| v.parse().ok()),
             script: script_run,
             options,
+            headless,
+            exit: false,
+            recorded_opens: 0,
+            ended_recording: None,
         };
         editor.panels.errors.extend(settings_error);
         if editor.script.is_none() {
@@ -496,8 +532,12 @@ impl Editor {
     fn moved(&mut self) {
         self.moving_until = Instant::now() + Duration::from_millis(150);
         self.move_event.get_or_insert_with(Instant::now);
-        if let Some(g) = &self.gfx {
-            g.window.request_redraw();
+        self.request_redraw();
+    }
+
+    fn request_redraw(&mut self) {
+        if let Some(g) = &mut self.gfx {
+            g.host.request_redraw();
         }
     }
 
@@ -519,144 +559,6 @@ impl Editor {
     fn cursor_ray(&self) -> (DVec3, DVec3) {
         let (u, v) = self.cursor_ndc();
         self.view.ray(u, v, self.aspect())
-    }
-
-    /// Left button down: a paste being placed goes down, the eyedropper (Alt), the selection
-    /// tool, or a new stroke under the cursor.
-    fn press(&mut self) {
-        if self.pasting {
-            self.paste_press();
-            return;
-        }
-        if self.settings.brush.tool == Tool::Select && !self.mods.alt {
-            self.select_press();
-            return;
-        }
-        let (origin, dir) = self.cursor_ray();
-        let doc = self.doc.clone();
-        let doc = doc.read().unwrap_or_else(|p| p.into_inner());
-        let view = doc.scene.world.read();
-        if self.mods.alt {
-            if let Some((_, material)) = tools::pick(&view, origin, dir) {
-                self.settings.brush.material = material;
-            }
-            return;
-        }
-        if self.mods.shift && self.settings.brush.mode == crate::editor::command::BrushMode::Paint {
-            // Flood fill: the connected surface of the clicked voxel's material.
-            if let Some((hit, _)) = tools::pick(&view, origin, dir) {
-                let material = self.settings.brush.material;
-                drop(view);
-                drop(doc);
-                self.execute(Command::FloodFill {
-                    start: hit.voxel,
-                    material,
-                });
-            }
-            return;
-        }
-        let brush = &self.settings.brush;
-        let Some((v, layer)) = tools::start(&view, brush.mode, origin, dir) else {
-            return;
-        };
-        let stroke = brush.stroke(vec![tools::centre(v)], view.dims().voxels());
-        drop(view);
-        drop(doc);
-        self.report.line(format_args!(
-            "stroke begin {} {} voxel {} {} {}",
-            self.cursor.0, self.cursor.1, v.x, v.y, v.z
-        ));
-        self.drawing = Some(Drawing {
-            layer,
-            first: v,
-            last: v,
-        });
-        self.edits.submit(&self.doc, Edit::StrokeBegin(stroke));
-    }
-
-    /// While drawing: the stroke's next point, when the cursor reached another voxel.
-    fn stroke_to_cursor(&mut self) {
-        let Some(d) = &self.drawing else { return };
-        let (origin, dir) = self.cursor_ray();
-        let next = {
-            let doc = self.read();
-            let view = doc.scene.world.read();
-            tools::next(&view, &self.settings.brush, d.layer, origin, dir)
-        };
-        if let Some(v) = next
-            && v != d.last
-        {
-            if let Some(d) = &mut self.drawing {
-                d.last = v;
-            }
-            self.report.line(format_args!(
-                "stroke point {} {} voxel {} {} {}",
-                self.cursor.0, self.cursor.1, v.x, v.y, v.z
-            ));
-            self.edits
-                .submit(&self.doc, Edit::StrokeExtend(vec![tools::centre(v)]));
-        }
-    }
-
-    /// The stroke a click would make now (the preview's), or a box being dragged.
-    fn previewed_stroke(
-        &self,
-        view: &brickmap::WorldView<'_>,
-    ) -> Option<crate::editor::command::Stroke> {
-        let brush = &self.settings.brush;
-        let dims = view.dims().voxels();
-        if brush.tool == Tool::Select || self.pasting {
-            return None;
-        }
-        match &self.drawing {
-            Some(d) if brush.shape == crate::editor::command::BrushShape::Box => {
-                Some(brush.stroke(vec![tools::centre(d.first), tools::centre(d.last)], dims))
-            }
-            Some(_) => None,
-            None => {
-                if self.egui.egui_wants_pointer_input() || self.egui.is_pointer_over_egui() {
-                    return None;
-                }
-                let (origin, dir) = self.cursor_ray();
-                let (v, _) = tools::start(view, brush.mode, origin, dir)?;
-                Some(brush.stroke(vec![tools::centre(v)], dims))
-            }
-        }
-    }
-
-    fn zoom(&mut self, steps: f64) {
-        let aspect = self.aspect();
-        let (u, v) = self.cursor_ndc();
-        let (origin, dir) = self.view.ray(u, v, aspect);
-        let ray = brickmap::Ray { origin, dir };
-        // The surface under the cursor (exact CPU cast), else the pivot plane.
-        let hit = self
-            .read()
-            .scene
-            .world
-            .read()
-            .ray_cast(&ray, f64::INFINITY)
-            .ok()
-            .flatten();
-        let target = match hit {
-            Some((h, _)) => ray.origin + dir * h.t,
-            None => self.view.pivot_plane_point(u, v, aspect),
-        };
-        self.view.zoom_towards(target, 0.85f64.powf(steps));
-        self.moved();
-    }
-
-    fn tick_fly(&mut self) {
-        let now = Instant::now();
-        let dt = (now - self.last_tick).as_secs_f64().min(0.1);
-        self.last_tick = now;
-        if self.flying.is_empty() {
-            return;
-        }
-        let dir: DVec3 = self.flying.iter().filter_map(|k| input::fly_axis(*k)).sum();
-        let speed = self.view.distance.max(8.0) * if self.mods.shift { 2.0 } else { 0.5 };
-        self.view.fly(dir * speed * dt);
-        self.moved();
     }
 }
 
@@ -680,51 +582,61 @@ impl ApplicationHandler<Wake> for Editor {
         if self.gfx.is_none()
             && let Err(e) = self.create_gfx(event_loop)
         {
-            self.fail(event_loop, e);
+            self.outcome = Err(e);
+            event_loop.exit();
             return;
         }
-        if let Some(g) = &self.gfx {
-            g.window.request_redraw();
-        }
+        self.request_redraw();
     }
 
     fn user_event(&mut self, _event_loop: &ActiveEventLoop, _event: Wake) {
-        if let Some(g) = &self.gfx {
-            g.window.request_redraw();
-        }
+        self.request_redraw();
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
-        // While an edit holds the frame gate, input (which may read the document) waits in
-        // the backlog, in order, for the next frame; redraws skip themselves (see `redraw`).
-        let gate = self.edits.gate.clone();
-        let _between_frames = match &event {
-            WindowEvent::RedrawRequested | WindowEvent::Resized(_) => None,
-            _ => match gate.try_lock() {
-                Ok(g) => Some(g),
-                Err(_) => {
-                    self.backlog.push(event);
-                    return;
+        match &event {
+            WindowEvent::RedrawRequested => {
+                if let Err(e) = self.redraw() {
+                    self.gpu_failed(e);
                 }
-            },
-        };
-        if _between_frames.is_some() {
-            for earlier in std::mem::take(&mut self.backlog) {
-                self.handle_window_event(event_loop, earlier);
+            }
+            WindowEvent::ScaleFactorChanged { .. } => self.request_redraw(),
+            _ => {
+                let consumed = match &mut self.gfx {
+                    Some(Gfx {
+                        host: Host::Window { egui_state, window },
+                        ..
+                    }) => {
+                        let response = egui_state.on_window_event(window, &event);
+                        if response.repaint {
+                            window.request_redraw();
+                        }
+                        response.consumed
+                    }
+                    _ => false,
+                };
+                if let Some(input) = Input::from_window_event(&event) {
+                    self.input_with(input, consumed);
+                }
             }
         }
-        self.handle_window_event(event_loop, event);
+        if self.exit {
+            event_loop.exit();
+        }
     }
+
     fn new_events(&mut self, _event_loop: &ActiveEventLoop, cause: winit::event::StartCause) {
         if matches!(cause, winit::event::StartCause::ResumeTimeReached { .. })
             && self.progress.fraction().is_some()
-            && let Some(g) = &self.gfx
         {
-            g.window.request_redraw();
+            self.request_redraw();
         }
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        if self.exit {
+            event_loop.exit();
+        }
         event_loop.set_control_flow(ControlFlow::Wait);
         if self.edits.busy() || self.progress.fraction().is_some() {
             // An edit is running: look at a long one's progress ten times a second.
@@ -741,13 +653,20 @@ impl ApplicationHandler<Wake> for Editor {
     }
 
     fn exiting(&mut self, _event_loop: &ActiveEventLoop) {
+        self.finish();
+    }
+}
+
+impl Editor {
+    /// The session ends: validation errors become the outcome, the GPU objects go before
+    /// the window, the recording is written.
+    fn finish(&mut self) {
         if let Some(g) = &self.gfx {
             let errors = g.viewport.ctx().validation_errors();
             if errors > 0 && self.outcome.is_ok() {
                 self.outcome = Err(anyhow!("{errors} Vulkan validation errors"));
             }
         }
-        // Drop the GPU objects before the window goes.
         self.gfx = None;
         if let Err(e) = self.write_recording() {
             eprintln!("voxbrick: {e:#}");
@@ -758,188 +677,9 @@ impl ApplicationHandler<Wake> for Editor {
     }
 }
 
-impl Editor {
-    /// One window event, the frame gate held (or not needed: redraw, resize); reported once
-    /// handled.
-    fn handle_window_event(&mut self, event_loop: &ActiveEventLoop, event: WindowEvent) {
-        let line = self.report.on().then(|| report_line(&event)).flatten();
-        self.handle_event(event_loop, event);
-        if let Some(line) = line {
-            self.report.line(format_args!("input {line}"));
-        }
-    }
-
-    fn handle_event(&mut self, event_loop: &ActiveEventLoop, event: WindowEvent) {
-        let Some(gfx) = &mut self.gfx else { return };
-        let response = gfx.egui_state.on_window_event(&gfx.window, &event);
-        // egui-winit asks to repaint after every RedrawRequested too; honouring that would
-        // keep a converged editor drawing forever.
-        if response.repaint && !matches!(event, WindowEvent::RedrawRequested) {
-            gfx.window.request_redraw();
-        }
-        let consumed = response.consumed;
-        match event {
-            WindowEvent::CloseRequested => self.action(Action::Quit),
-            WindowEvent::Resized(size) => {
-                self.window_size = (size.width, size.height);
-                gfx.presenter.resize((size.width, size.height));
-                gfx.window.request_redraw();
-            }
-            WindowEvent::ScaleFactorChanged { .. } => gfx.window.request_redraw(),
-            WindowEvent::RedrawRequested => {
-                if let Err(e) = self.redraw(event_loop) {
-                    self.gpu_failed(event_loop, e);
-                }
-            }
-            WindowEvent::DroppedFile(path) => {
-                if path
-                    .extension()
-                    .is_some_and(|e| e.eq_ignore_ascii_case("vox") || e.eq_ignore_ascii_case("ron"))
-                {
-                    self.guard_unsaved(Pending::Open(Some(path)));
-                } else {
-                    self.panels
-                        .errors
-                        .push(format!("{} is not a .ron or .vox file", path.display()));
-                }
-            }
-            WindowEvent::ModifiersChanged(m) => {
-                let s = m.state();
-                self.mods = Mods {
-                    ctrl: s.control_key() || s.super_key(),
-                    shift: s.shift_key(),
-                    alt: s.alt_key(),
-                };
-            }
-            WindowEvent::KeyboardInput { event, .. } => {
-                let PhysicalKey::Code(code) = event.physical_key else {
-                    return;
-                };
-                let pressed = event.state == ElementState::Pressed;
-                if !pressed {
-                    self.flying.remove(&code);
-                    return;
-                }
-                if consumed || self.egui.egui_wants_keyboard_input() {
-                    return;
-                }
-                if code == KeyCode::Escape && self.drawing.take().is_some() {
-                    self.edits.submit(&self.doc, Edit::StrokeAbort);
-                    return;
-                }
-                if code == KeyCode::Escape && (self.pasting || self.selecting.is_some()) {
-                    self.pasting = false;
-                    self.selecting = None;
-                    return;
-                }
-                if let Some(a) = self.keymap.action(code, self.mods) {
-                    if !event.repeat {
-                        self.action(a);
-                    }
-                } else if !self.mods.ctrl && input::fly_axis(code).is_some() {
-                    self.last_tick = Instant::now();
-                    self.flying.insert(code);
-                    self.moved();
-                }
-            }
-            WindowEvent::MouseInput { state, button, .. } => {
-                gfx.window.request_redraw();
-                // A click that closes an open menu only closes it (egui closes the menu when
-                // it sees the click in its next pass; the menu is still open now).
-                let menu_open = egui::Popup::is_any_open(&self.egui);
-                let free = !consumed && !self.egui.egui_wants_pointer_input() && !menu_open;
-                match (state, button) {
-                    (ElementState::Pressed, MouseButton::Left) if free => self.press(),
-                    (ElementState::Released, MouseButton::Left) if self.drawing.is_some() => {
-                        // The release position was the last move's, already taken (taking it
-                        // again would dig an erase stroke deeper where the cursor stopped).
-                        if let Some(d) = &self.drawing {
-                            self.report.line(format_args!(
-                                "stroke release {} {} voxel {} {} {}",
-                                self.cursor.0, self.cursor.1, d.last.x, d.last.y, d.last.z
-                            ));
-                        }
-                        self.drawing = None;
-                        self.edits.submit(&self.doc, Edit::StrokeEnd);
-                        // Back to the full internal size shortly after, as after a move.
-                        self.moving_until = Instant::now() + Duration::from_millis(150);
-                    }
-                    (ElementState::Released, MouseButton::Left) if self.selecting.is_some() => {
-                        self.select_release()
-                    }
-                    (ElementState::Pressed, _) if free => {
-                        self.drag =
-                            input::drag_for_button(button, self.mods).map(|d| (d, self.cursor));
-                    }
-                    (ElementState::Released, _) => self.drag = None,
-                    _ => {}
-                }
-            }
-            WindowEvent::CursorMoved { position, .. } => {
-                let previous = self.cursor;
-                self.cursor = (position.x, position.y);
-                // The preview follows the cursor.
-                gfx.window.request_redraw();
-                if let Some((drag, _)) = self.drag {
-                    let h = gfx.window.inner_size().height.max(1) as f64;
-                    let (dx, dy) = (self.cursor.0 - previous.0, self.cursor.1 - previous.1);
-                    match drag {
-                        Drag::Orbit => self.view.orbit(-dx * 0.3, -dy * 0.3),
-                        Drag::Pan => {
-                            let aspect = self.aspect();
-                            self.view.pan(dx / h, -dy / h, aspect)
-                        }
-                    }
-                    self.moved();
-                }
-                self.stroke_to_cursor();
-                self.select_to_cursor();
-            }
-            WindowEvent::MouseWheel { delta, .. } => {
-                if consumed || self.egui.egui_wants_pointer_input() {
-                    return;
-                }
-                let steps = match delta {
-                    MouseScrollDelta::LineDelta(_, y) => y as f64,
-                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
-                };
-                self.zoom(steps);
-            }
-            _ => {}
-        }
-    }
-}
-
 impl Drop for Editor {
     fn drop(&mut self) {
         self.gfx = None;
         self.pending_textures.clear();
     }
-}
-
-/// How an input event appears in the report (None: not an input event).
-fn report_line(event: &WindowEvent) -> Option<String> {
-    Some(match event {
-        WindowEvent::CursorMoved { position, .. } => format!("move {} {}", position.x, position.y),
-        WindowEvent::MouseInput { state, button, .. } => format!(
-            "{} {button:?}",
-            if state.is_pressed() {
-                "press"
-            } else {
-                "release"
-            }
-        ),
-        WindowEvent::KeyboardInput { event, .. } => format!(
-            "key {:?} {}",
-            event.physical_key,
-            if event.state.is_pressed() {
-                "down"
-            } else {
-                "up"
-            }
-        ),
-        WindowEvent::MouseWheel { .. } => "wheel".into(),
-        WindowEvent::Resized(size) => format!("resized {} {}", size.width, size.height),
-        _ => return None,
-    })
 }

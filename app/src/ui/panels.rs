@@ -165,6 +165,8 @@ pub struct PanelState {
     pub editing: super::editing::EditingState,
     /// The key map's bindings (chord, action) for the shortcut list.
     pub keys: Vec<(String, String)>,
+    /// The window's area between the menu bar and the status line, in points (last frame).
+    pub between_bars: Option<egui::Rect>,
 }
 
 /// Draws the panels; returns what the user asked for.
@@ -295,6 +297,7 @@ pub fn draw(
     // Windows stay between the menu bar and the status line (in a small window egui would
     // otherwise push a tall one up over the menus).
     let area = root.available_rect_before_wrap();
+    state.between_bars = Some(area);
     super::editing::draw(
         ctx,
         area,

@@ -11,40 +11,60 @@ use std::io::Write;
 /// Environment variable naming the report file.
 pub const REPORT_ENV: &str = "VOXBRICK_REPORT";
 
-/// The log (None: off).
+/// The log.
 #[derive(Default)]
-pub struct Report(Option<File>);
+pub enum Report {
+    /// Nothing written.
+    #[default]
+    Off,
+    /// Lines appended to a file, each flushed.
+    File(File),
+    /// Lines kept for a driver in the same process (a headless editor), taken with `take`.
+    Memory(Vec<String>),
+}
 
 impl Report {
     /// The log named by [`REPORT_ENV`], created afresh; off when unset or when the file cannot
     /// be created (said once on stderr).
     pub fn from_env() -> Self {
         let Some(path) = std::env::var_os(REPORT_ENV) else {
-            return Self(None);
+            return Self::Off;
         };
         match File::create(&path) {
-            Ok(f) => Self(Some(f)),
+            Ok(f) => Self::File(f),
             Err(e) => {
                 eprintln!(
                     "voxbrick: {REPORT_ENV}={}: {e}; no report is written",
                     std::path::Path::new(&path).display()
                 );
-                Self(None)
+                Self::Off
             }
         }
     }
 
     /// Whether lines are written.
     pub fn on(&self) -> bool {
-        self.0.is_some()
+        !matches!(self, Self::Off)
     }
 
     /// Appends a line (a failed write turns the log off rather than stopping the editor).
     pub fn line(&mut self, text: std::fmt::Arguments<'_>) {
-        if let Some(f) = &mut self.0
-            && writeln!(f, "{text}").and_then(|()| f.flush()).is_err()
-        {
-            self.0 = None;
+        match self {
+            Self::Off => {}
+            Self::File(f) => {
+                if writeln!(f, "{text}").and_then(|()| f.flush()).is_err() {
+                    *self = Self::Off;
+                }
+            }
+            Self::Memory(lines) => lines.push(text.to_string()),
+        }
+    }
+
+    /// The lines kept since the last call (a memory log's; none otherwise).
+    pub fn take(&mut self) -> Vec<String> {
+        match self {
+            Self::Memory(lines) => std::mem::take(lines),
+            _ => Vec::new(),
         }
     }
 }

@@ -1,24 +1,12 @@
-//! The soak test: a long seeded random session through the editor's edit path — the same
-//! edit thread ([`EditQueue`]) and document operations the window's handlers submit to:
-//! strokes of every mode and shape begun, extended point by point, ended or cancelled;
-//! selections and their operations, copy / cut / paste, palette and material edits, flood
-//! fills, terrain generation, bursts of undo and redo, camera, sun, sky and settings, saves
-//! and re-opens — with the live viewport's frames (the GPU session, validation on) at sizes
-//! that change as a resized window's would.
-//!
-//! After every event: the edit thread is alive (no panic), the validation layer has said
-//! nothing, and an edit that failed left the content and the history as they were. At every
-//! check (every `check_every` events and at the end): undo of the whole history gives the
-//! opening content hash and redo the latest, a save and reload gives the same hash, and the
-//! history's memory stays within its bound (the process's memory within the bound plus the
-//! world's, with room for the allocator).
-//!
-//! The session is a function of the seed: a failure is re-run with fewer events to find the
-//! shortest failing prefix, whose recorded session is written as a replay script.
-//!
-//! What it does not reach: the window's own event handling (egui, the key map, picking the
-//! cursor's voxel); the xdotool tests in `app/tests/editor_input.rs` drive those.
+//! The soak through the edit thread: seeded random edits submitted to an [`EditQueue`] — the
+//! queue and document operations the window's handlers submit to — strokes of every mode and
+//! shape begun, extended point by point, ended or cancelled; selections and their operations,
+//! copy / cut / paste, palette and material edits with random parameters, flood fills,
+//! terrain generation, bursts of undo and redo, camera, sun, sky and settings, saves and
+//! re-opens — with a bare viewport's frames (validation on) at sizes that change as a resized
+//! window's would. Each edit is waited for, so each event's invariants are checked on its own.
 
+use super::{Rng, SoakOptions, SoakReport, rss};
 use crate::Scene;
 use crate::editor::Document;
 use crate::editor::command::{
@@ -29,148 +17,15 @@ use crate::editor::script::{Recorder, Start, Step};
 use crate::selection::SelectOp;
 use crate::ui::jobs::{Edit, EditQueue, Edited};
 use anyhow::{Context, Result, anyhow, bail, ensure};
-use glam::{DVec3, IVec3, UVec3};
+use glam::{DVec3, IVec3};
 use render::viewport::{FrameRequest, Viewport};
-use std::collections::BTreeMap;
-use std::path::PathBuf;
 use std::sync::{Arc, RwLock};
-use std::time::{Duration, Instant};
-
-/// What a soak runs.
-#[derive(Clone, Debug)]
-pub struct SoakOptions {
-    /// The session's seed.
-    pub seed: u64,
-    /// Stop after this many events (0: only the duration stops it).
-    pub events: u64,
-    /// Stop after this long (None: only the event count stops it).
-    pub duration: Option<Duration>,
-    /// World size in voxels.
-    pub size: UVec3,
-    /// The viewport's largest size in pixels (resizes pick sizes up to it).
-    pub view: (u32, u32),
-    /// Vulkan device for the viewport's frames ("gpu" or part of a name); None: no frames.
-    pub device: Option<String>,
-    /// Events between checks.
-    pub check_every: u64,
-    /// Events between frames.
-    pub frame_every: u64,
-    /// World worker threads.
-    pub workers: usize,
-    /// Where saves and the failure's script go.
-    pub out_dir: PathBuf,
-    /// History bound in bytes.
-    pub history_budget: usize,
-    /// Tests of the soak itself: event number `n` fails on purpose (the shortest failing
-    /// prefix is then exactly `n` events).
-    pub fail_at: Option<u64>,
-}
-
-impl Default for SoakOptions {
-    fn default() -> Self {
-        Self {
-            seed: 1,
-            events: 10_000,
-            duration: None,
-            size: UVec3::new(64, 32, 64),
-            view: (96, 64),
-            device: Some("gpu".into()),
-            check_every: 1000,
-            frame_every: 8,
-            workers: 2,
-            out_dir: std::env::temp_dir(),
-            history_budget: crate::editor::history::DEFAULT_BUDGET,
-            fail_at: None,
-        }
-    }
-}
-
-/// What a clean soak did.
-#[derive(Clone, Debug, Default)]
-pub struct SoakReport {
-    /// Events fed: user actions (a whole stroke, an undo / redo burst, a command, a resize, a
-    /// save).
-    pub events: u64,
-    /// Inputs those events are made of: each stroke point, undo, redo, command, resize and
-    /// frame, as the window's handlers would pass them on.
-    pub inputs: u64,
-    /// Wall time.
-    pub elapsed: Duration,
-    /// Viewport frames drawn.
-    pub frames: u64,
-    /// Whole-history checks passed.
-    pub checks: u64,
-    /// Events by kind.
-    pub kinds: BTreeMap<&'static str, u64>,
-    /// Edits refused (bad input by chance: each left the document as it was).
-    pub refused: u64,
-    /// Largest history memory seen, bytes.
-    pub peak_history: usize,
-    /// Largest resident memory seen, bytes (0 where /proc is missing).
-    pub peak_rss: u64,
-}
-
-/// A failed soak: where, why, and the shortest failing prefix as a replay script.
-#[derive(Debug)]
-pub struct SoakFailure {
-    /// The seed.
-    pub seed: u64,
-    /// The event (1-based) at which the first run failed.
-    pub event: u64,
-    /// The shortest failing prefix, in events.
-    pub shortest: u64,
-    /// What went wrong.
-    pub message: String,
-    /// The recorded session of the shortest failing run (replay with `voxbrick replay`).
-    pub script: Option<PathBuf>,
-}
-
-impl std::fmt::Display for SoakFailure {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "soak seed {} failed at event {} (shortest failing prefix: {} events): {}",
-            self.seed, self.event, self.shortest, self.message
-        )?;
-        if let Some(s) = &self.script {
-            write!(f, "; its session: {} (voxbrick replay)", s.display())?;
-        }
-        Ok(())
-    }
-}
-
-/// SplitMix64: small, fast, and the same sequence everywhere.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n.max(1)
-    }
-    fn range(&mut self, lo: i64, hi: i64) -> i64 {
-        lo + self.below((hi - lo + 1) as u64) as i64
-    }
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn chance(&mut self, p: f64) -> bool {
-        self.unit() < p
-    }
-    fn pick<T: Copy>(&mut self, items: &[T]) -> T {
-        items[self.below(items.len() as u64) as usize]
-    }
-}
+use std::time::Duration;
 
 type Shared = Arc<RwLock<Document>>;
 
 /// One soak session.
-struct Session {
+pub(super) struct Session {
     opts: SoakOptions,
     rng: Rng,
     doc: Shared,
@@ -184,14 +39,6 @@ struct Session {
     start: Start,
 }
 
-/// The process's resident memory in bytes (0 where /proc is missing).
-fn rss() -> u64 {
-    std::fs::read_to_string("/proc/self/statm")
-        .ok()
-        .and_then(|s| s.split_whitespace().nth(1)?.parse::<u64>().ok())
-        .map_or(0, |pages| pages * 4096)
-}
-
 fn hash(doc: &Shared) -> u64 {
     doc.read()
         .unwrap_or_else(|p| p.into_inner())
@@ -203,31 +50,8 @@ fn hash(doc: &Shared) -> u64 {
 
 impl Session {
     fn new(opts: &SoakOptions) -> Result<Self> {
-        let start = Start::New {
-            size: (opts.size.x, opts.size.y, opts.size.z),
-            terrain: Some(TerrainSpec {
-                seed: opts.seed as u32,
-                scale: 40.0,
-                octaves: 4,
-                height_range: (2, opts.size.y * 2 / 3),
-                water_level: opts.size.y / 4,
-                noise: Default::default(),
-                bands: Default::default(),
-            }),
-        };
-        let dims = brickmap::GridDims::from_voxels(opts.size).context("soak world size")?;
-        let mut doc = Document::new(
-            Scene::empty(dims, opts.workers)?,
-            History::with_budget(opts.history_budget),
-        );
-        if let Start::New {
-            terrain: Some(t), ..
-        } = &start
-        {
-            Command::GenerateTerrain(t.clone())
-                .apply(&mut doc.scene, &opts.out_dir)
-                .context("soak terrain")?;
-        }
+        let (scene, start) = super::start_scene(opts)?;
+        let mut doc = Document::new(scene, History::with_budget(opts.history_budget));
         doc.folder = opts.out_dir.clone();
         doc.recorder = Some(Recorder::default());
         let viewport = match &opts.device {
@@ -729,56 +553,6 @@ impl Session {
         Ok(())
     }
 
-    /// Runs until the options say stop or something fails (the event number and why).
-    fn run(&mut self, limit: u64) -> std::result::Result<(), (u64, String)> {
-        let started = Instant::now();
-        let mut n = 0;
-        loop {
-            let over_time = self.opts.duration.is_some_and(|d| started.elapsed() >= d);
-            if (limit > 0 && n >= limit) || over_time {
-                break;
-            }
-            n += 1;
-            self.report.events = n;
-            let step = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                self.event()?;
-                if self.opts.fail_at == Some(n) {
-                    bail!("failing on purpose at event {n} (a test of the soak)");
-                }
-                if n % self.opts.frame_every.max(1) == 0 {
-                    self.frame()?;
-                }
-                if n % self.opts.check_every.max(1) == 0 {
-                    self.check()?;
-                }
-                Ok::<(), anyhow::Error>(())
-            }));
-            match step {
-                Ok(Ok(())) => {}
-                Ok(Err(e)) => return Err((n, format!("{e:#}"))),
-                Err(panic) => {
-                    let what = panic
-                        .downcast_ref::<String>()
-                        .cloned()
-                        .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
-                        .unwrap_or_default();
-                    return Err((n, format!("panic: {what}")));
-                }
-            }
-        }
-        let last = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| self.check()));
-        match last {
-            Ok(Ok(())) => {}
-            Ok(Err(e)) => return Err((n, format!("final check: {e:#}"))),
-            Err(_) => return Err((n, "panic in the final check".into())),
-        }
-        self.report.elapsed = started.elapsed();
-        if let Some(vp) = &mut self.viewport {
-            let _ = vp.wait_idle();
-        }
-        Ok(())
-    }
-
     /// The recorded session as a replay script.
     fn script(&self) -> String {
         let d = self.doc.read().unwrap_or_else(|p| p.into_inner());
@@ -789,67 +563,35 @@ impl Session {
     }
 }
 
-/// Runs a soak. On failure the same seed is re-run with fewer events (a binary search) for
-/// the shortest failing prefix, whose session is written to `out_dir` as a replay script.
-pub fn soak(opts: &SoakOptions) -> std::result::Result<SoakReport, SoakFailure> {
-    let fail = |event, shortest, message: String, script| SoakFailure {
-        seed: opts.seed,
-        event,
-        shortest,
-        message,
-        script,
-    };
-    let mut session = Session::new(opts).map_err(|e| fail(0, 0, format!("{e:#}"), None))?;
-    let limit = opts.events;
-    let (event, message) = match session.run(limit) {
-        Ok(()) => return Ok(session.report),
-        Err(f) => f,
-    };
-    drop(session);
-    // The shortest prefix that still fails (a session is a function of its seed).
-    let (mut lo, mut hi) = (0u64, event);
-    let mut failing: Option<String> = None;
-    while lo + 1 < hi {
-        let mid = lo + (hi - lo) / 2;
-        let probe = SoakOptions {
-            events: mid,
-            duration: None,
-            ..opts.clone()
-        };
-        let Ok(mut s) = Session::new(&probe) else {
-            break;
-        };
-        match s.run(mid) {
-            Err(_) => {
-                hi = mid;
-                failing = Some(s.script());
-            }
-            Ok(()) => lo = mid,
-        }
+impl super::Driver for Session {
+    fn start(opts: &SoakOptions) -> Result<Self> {
+        Self::new(opts)
     }
-    let script = match failing {
-        Some(text) => Some(text),
-        None => {
-            let probe = SoakOptions {
-                events: hi,
-                duration: None,
-                ..opts.clone()
-            };
-            Session::new(&probe).ok().map(|mut s| {
-                let _ = s.run(hi);
-                s.script()
-            })
+
+    fn event(&mut self, n: u64) -> Result<()> {
+        self.event()?;
+        if n.is_multiple_of(self.opts.frame_every.max(1)) {
+            self.frame()?;
         }
-    };
-    let path = script.and_then(|text| {
-        let p = opts
-            .out_dir
-            .join(format!("soak-failure-seed-{}.ron", opts.seed));
-        crate::atomic::write_atomic(&p, |w: &mut dyn std::io::Write| {
-            w.write_all(text.as_bytes())
-        })
-        .ok()
-        .map(|()| p)
-    });
-    Err(fail(event, hi, message, path))
+        Ok(())
+    }
+
+    fn check(&mut self) -> Result<()> {
+        self.check()
+    }
+
+    fn report(&mut self) -> &mut SoakReport {
+        &mut self.report
+    }
+
+    fn script(&self) -> String {
+        self.script()
+    }
+
+    fn finish(&mut self) -> Result<()> {
+        if let Some(vp) = &mut self.viewport {
+            vp.wait_idle()?;
+        }
+        Ok(())
+    }
 }

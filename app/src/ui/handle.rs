@@ -1,0 +1,300 @@
+//! Input → the editor: each [`Input`] (from the window's events, or from a headless driver)
+//! passes the frame gate or waits in the backlog, in order; egui's share is left to egui;
+//! keys go through the key map (Esc cancels what is being dragged), buttons start strokes,
+//! selections, pastes, the eyedropper, flood fills or view drags, moves extend them, the
+//! wheel zooms to the cursor, held movement keys fly.
+
+use super::*;
+
+impl Editor {
+    /// One input, with whether egui kept it: handled now, or after the edit that holds the
+    /// frame gate (the backlog keeps the order); reported once handled.
+    pub(super) fn input_with(&mut self, input: Input, consumed: bool) {
+        if !input.gated() {
+            self.handle_logged(input, consumed);
+            return;
+        }
+        let gate = self.edits.gate.clone();
+        let Ok(_between_frames) = gate.try_lock() else {
+            self.backlog.push((input, consumed));
+            return;
+        };
+        for (earlier, c) in std::mem::take(&mut self.backlog) {
+            self.handle_logged(earlier, c);
+        }
+        self.handle_logged(input, consumed);
+    }
+
+    /// An input, the frame gate held (or not needed: a resize), then its report line.
+    pub(super) fn handle_logged(&mut self, input: Input, consumed: bool) {
+        let line = self.report.on().then(|| input.report_line()).flatten();
+        self.handle_input(input, consumed);
+        if let Some(line) = line {
+            self.report.line(format_args!("input {line}"));
+        }
+    }
+
+    fn handle_input(&mut self, input: Input, consumed: bool) {
+        if self.gfx.is_none() {
+            return;
+        }
+        match input {
+            Input::Close => self.action(Action::Quit),
+            Input::Resized(w, h) => {
+                self.window_size = (w, h);
+                if let Some(gfx) = &mut self.gfx {
+                    gfx.presenter.resize((w, h));
+                    gfx.host.request_redraw();
+                }
+            }
+            Input::Dropped(path) => {
+                if path
+                    .extension()
+                    .is_some_and(|e| e.eq_ignore_ascii_case("vox") || e.eq_ignore_ascii_case("ron"))
+                {
+                    self.guard_unsaved(Pending::Open(Some(path)));
+                } else {
+                    self.panels
+                        .errors
+                        .push(format!("{} is not a .ron or .vox file", path.display()));
+                }
+            }
+            Input::Modifiers(m) => self.mods = m,
+            Input::Key {
+                code,
+                pressed,
+                repeat,
+            } => self.key(code, pressed, repeat, consumed),
+            Input::Button { button, pressed } => self.button(button, pressed, consumed),
+            Input::Moved { x, y } => self.cursor_moved(x, y),
+            Input::Wheel(steps) => {
+                if consumed || self.egui.egui_wants_pointer_input() {
+                    return;
+                }
+                self.zoom(steps);
+            }
+        }
+    }
+
+    fn key(&mut self, code: KeyCode, pressed: bool, repeat: bool, consumed: bool) {
+        if !pressed {
+            self.flying.remove(&code);
+            return;
+        }
+        if consumed || self.egui.egui_wants_keyboard_input() {
+            return;
+        }
+        if code == KeyCode::Escape && self.drawing.take().is_some() {
+            self.edits.submit(&self.doc, Edit::StrokeAbort);
+            return;
+        }
+        if code == KeyCode::Escape && (self.pasting || self.selecting.is_some()) {
+            self.pasting = false;
+            self.selecting = None;
+            return;
+        }
+        if let Some(a) = self.keymap.action(code, self.mods) {
+            if !repeat {
+                self.action(a);
+            }
+        } else if !self.mods.ctrl && input::fly_axis(code).is_some() {
+            self.last_tick = Instant::now();
+            self.flying.insert(code);
+            self.moved();
+        }
+    }
+
+    fn button(&mut self, button: MouseButton, pressed: bool, consumed: bool) {
+        self.request_redraw();
+        // A click that closes an open menu only closes it (egui closes the menu when it sees
+        // the click in its next pass; the menu is still open now).
+        let menu_open = egui::Popup::is_any_open(&self.egui);
+        let free = !consumed && !self.egui.egui_wants_pointer_input() && !menu_open;
+        match (pressed, button) {
+            (true, MouseButton::Left) if free => self.press(),
+            (false, MouseButton::Left) if self.drawing.is_some() => {
+                // The release position was the last move's, already taken (taking it again
+                // would dig an erase stroke deeper where the cursor stopped).
+                if let Some(d) = &self.drawing {
+                    self.report.line(format_args!(
+                        "stroke release {} {} voxel {} {} {}",
+                        self.cursor.0, self.cursor.1, d.last.x, d.last.y, d.last.z
+                    ));
+                }
+                self.drawing = None;
+                self.edits.submit(&self.doc, Edit::StrokeEnd);
+                // Back to the full internal size shortly after, as after a move.
+                self.moving_until = Instant::now() + Duration::from_millis(150);
+            }
+            (false, MouseButton::Left) if self.selecting.is_some() => self.select_release(),
+            (true, _) if free => {
+                self.drag = input::drag_for_button(button, self.mods).map(|d| (d, self.cursor));
+            }
+            (false, _) => self.drag = None,
+            _ => {}
+        }
+    }
+
+    fn cursor_moved(&mut self, x: f64, y: f64) {
+        let previous = self.cursor;
+        self.cursor = (x, y);
+        // The preview follows the cursor.
+        self.request_redraw();
+        if let Some((drag, _)) = self.drag {
+            let h = self.window_size.1.max(1) as f64;
+            let (dx, dy) = (self.cursor.0 - previous.0, self.cursor.1 - previous.1);
+            match drag {
+                Drag::Orbit => self.view.orbit(-dx * 0.3, -dy * 0.3),
+                Drag::Pan => {
+                    let aspect = self.aspect();
+                    self.view.pan(dx / h, -dy / h, aspect)
+                }
+            }
+            self.moved();
+        }
+        self.stroke_to_cursor();
+        self.select_to_cursor();
+    }
+
+    /// Left button down: a paste being placed goes down, the eyedropper (Alt), the selection
+    /// tool, or a new stroke under the cursor.
+    pub(super) fn press(&mut self) {
+        if self.pasting {
+            self.paste_press();
+            return;
+        }
+        if self.settings.brush.tool == Tool::Select && !self.mods.alt {
+            self.select_press();
+            return;
+        }
+        let (origin, dir) = self.cursor_ray();
+        let doc = self.doc.clone();
+        let doc = doc.read().unwrap_or_else(|p| p.into_inner());
+        let view = doc.scene.world.read();
+        if self.mods.alt {
+            if let Some((_, material)) = tools::pick(&view, origin, dir) {
+                self.settings.brush.material = material;
+            }
+            return;
+        }
+        if self.mods.shift && self.settings.brush.mode == crate::editor::command::BrushMode::Paint {
+            // Flood fill: the connected surface of the clicked voxel's material.
+            if let Some((hit, _)) = tools::pick(&view, origin, dir) {
+                let material = self.settings.brush.material;
+                drop(view);
+                drop(doc);
+                self.execute(Command::FloodFill {
+                    start: hit.voxel,
+                    material,
+                });
+            }
+            return;
+        }
+        let brush = &self.settings.brush;
+        let Some((v, layer)) = tools::start(&view, brush.mode, origin, dir) else {
+            return;
+        };
+        let stroke = brush.stroke(vec![tools::centre(v)], view.dims().voxels());
+        drop(view);
+        drop(doc);
+        self.report.line(format_args!(
+            "stroke begin {} {} voxel {} {} {}",
+            self.cursor.0, self.cursor.1, v.x, v.y, v.z
+        ));
+        self.drawing = Some(Drawing {
+            layer,
+            first: v,
+            last: v,
+        });
+        self.edits.submit(&self.doc, Edit::StrokeBegin(stroke));
+    }
+
+    /// While drawing: the stroke's next point, when the cursor reached another voxel.
+    pub(super) fn stroke_to_cursor(&mut self) {
+        let Some(d) = &self.drawing else { return };
+        let (origin, dir) = self.cursor_ray();
+        let next = {
+            let doc = self.read();
+            let view = doc.scene.world.read();
+            tools::next(&view, &self.settings.brush, d.layer, origin, dir)
+        };
+        if let Some(v) = next
+            && v != d.last
+        {
+            if let Some(d) = &mut self.drawing {
+                d.last = v;
+            }
+            self.report.line(format_args!(
+                "stroke point {} {} voxel {} {} {}",
+                self.cursor.0, self.cursor.1, v.x, v.y, v.z
+            ));
+            self.edits
+                .submit(&self.doc, Edit::StrokeExtend(vec![tools::centre(v)]));
+        }
+    }
+
+    /// The stroke a click would make now (the preview's), or a box being dragged.
+    pub(super) fn previewed_stroke(
+        &self,
+        view: &brickmap::WorldView<'_>,
+    ) -> Option<crate::editor::command::Stroke> {
+        let brush = &self.settings.brush;
+        let dims = view.dims().voxels();
+        if brush.tool == Tool::Select || self.pasting {
+            return None;
+        }
+        match &self.drawing {
+            Some(d) if brush.shape == crate::editor::command::BrushShape::Box => {
+                Some(brush.stroke(vec![tools::centre(d.first), tools::centre(d.last)], dims))
+            }
+            Some(_) => None,
+            None => {
+                if self.egui.egui_wants_pointer_input() || self.egui.is_pointer_over_egui() {
+                    return None;
+                }
+                let (origin, dir) = self.cursor_ray();
+                let (v, _) = tools::start(view, brush.mode, origin, dir)?;
+                Some(brush.stroke(vec![tools::centre(v)], dims))
+            }
+        }
+    }
+
+    pub(super) fn zoom(&mut self, steps: f64) {
+        let aspect = self.aspect();
+        let (u, v) = self.cursor_ndc();
+        let (origin, dir) = self.view.ray(u, v, aspect);
+        let ray = brickmap::Ray { origin, dir };
+        // The surface under the cursor (exact CPU cast), else the pivot plane.
+        let hit = self
+            .read()
+            .scene
+            .world
+            .read()
+            .ray_cast(&ray, f64::INFINITY)
+            .ok()
+            .flatten();
+        let target = match hit {
+            Some((h, _)) => ray.origin + dir * h.t,
+            None => self.view.pivot_plane_point(u, v, aspect),
+        };
+        self.view.zoom_towards(target, 0.85f64.powf(steps));
+        self.moved();
+    }
+
+    pub(super) fn tick_fly(&mut self) {
+        let now = Instant::now();
+        let dt = if self.headless {
+            1.0 / 60.0
+        } else {
+            (now - self.last_tick).as_secs_f64().min(0.1)
+        };
+        self.last_tick = now;
+        if self.flying.is_empty() {
+            return;
+        }
+        let dir: DVec3 = self.flying.iter().filter_map(|k| input::fly_axis(*k)).sum();
+        let speed = self.view.distance.max(8.0) * if self.mods.shift { 2.0 } else { 0.5 };
+        self.view.fly(dir * speed * dt);
+        self.moved();
+    }
+}

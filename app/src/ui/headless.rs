@@ -1,0 +1,167 @@
+//! The editor without a window: the same [`Editor`], its frames drawn offscreen by the same
+//! presenter (egui included), its input given as [`Input`] events through the same handlers a
+//! window's events reach (egui gets its share first, as egui-winit gives it). The soak test
+//! drives it so; nothing here is a second implementation of the editor.
+
+use super::host::Headless;
+use super::*;
+
+impl Editor {
+    /// An editor of `size` pixels on the device `options.device`, without a window: no native
+    /// dialog is ever shown (a pick answers that none can be), the handshake log is kept in
+    /// memory ([`Editor::take_report`]), fly keys move a fixed 1/60 s per frame. Opens
+    /// `options.file` (or builds the default scene) like the window does.
+    pub fn headless(options: EditorOptions, size: (u32, u32)) -> Result<Self> {
+        copy_recording_start(&options)?;
+        let validation = options.validation;
+        let device = options.device.clone();
+        let mut editor = Self::new(options, Arc::new(|| {}), true)?;
+        editor.report = report::Report::Memory(Vec::new());
+        let ctx = GpuContext::new(&ContextOptions {
+            device: crate::gpu::device_choice(&device),
+            validation,
+            draw_ui: true,
+            ..Default::default()
+        })
+        .context("no usable Vulkan device")?;
+        let ctx = Arc::new(ctx);
+        let size = (size.0.max(1), size.1.max(1));
+        let presenter = Presenter::offscreen(ctx.clone(), size)?;
+        editor.attach(ctx, presenter, Host::Headless(Headless::new(size)), size)?;
+        Ok(editor)
+    }
+
+    /// One input event, as a window would pass it on: egui sees it first and may keep it.
+    pub fn input(&mut self, input: Input) {
+        let mods = match &input {
+            Input::Modifiers(m) => *m,
+            _ => self.mods,
+        };
+        if let Some(Gfx {
+            host: Host::Headless(h),
+            ..
+        }) = &mut self.gfx
+        {
+            h.push(&input, mods);
+        }
+        let consumed = input.consumed_by(&self.egui);
+        self.input_with(input, consumed);
+    }
+
+    /// One frame, as a redraw of the window: finished edits and files, the backlog, a script
+    /// step, egui, trace and present (skipped while an edit holds the document). A GPU error
+    /// is handled as in the window (unsaved work to the recovery file) and returned.
+    pub fn frame(&mut self) -> Result<()> {
+        if let Err(e) = self.redraw() {
+            let message = format!("{e:#}");
+            self.gpu_failed(e);
+            anyhow::bail!("{message}");
+        }
+        Ok(())
+    }
+
+    /// Takes what finished (edits, files, saves, the backlog) without drawing, when no edit
+    /// holds the frame gate.
+    pub fn pump(&mut self) {
+        let gate = self.edits.gate.clone();
+        if let Ok(_frame) = gate.try_lock() {
+            self.take_results();
+        }
+    }
+
+    /// Whether the edit thread is alive (it never ends while the editor runs: a panic did).
+    pub fn edit_thread_alive(&self) -> bool {
+        self.edits.alive()
+    }
+
+    /// Bumped whenever the document is replaced (open, new, recovery).
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
+    /// Whether everything asked for is done: no edit queued or running, no file job, no save
+    /// waiting or unrecorded, no input in the backlog.
+    pub fn settled(&self) -> bool {
+        !self.edits.busy()
+            && self.files.running.is_empty()
+            && self.saves_waiting.is_empty()
+            && self.saved.is_empty()
+            && self.backlog.is_empty()
+    }
+
+    /// The document (shared with the edit thread and the file worker).
+    pub fn document(&self) -> SharedDocument {
+        self.doc.clone()
+    }
+
+    /// The handshake log's lines since the last call (a headless editor keeps them).
+    pub fn take_report(&mut self) -> Vec<String> {
+        self.report.take()
+    }
+
+    /// Errors the panels would show, taken (they are shown no longer).
+    pub fn take_errors(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.panels.errors)
+    }
+
+    /// Whether the editor asked to stop (quit, a failed script, a GPU failure).
+    pub fn wants_exit(&self) -> bool {
+        self.exit
+    }
+
+    /// The editor is kept running after it asked to stop (a driver's "started again": the
+    /// settings were saved and the recovery file removed as on a real quit).
+    pub fn keep_running(&mut self) {
+        self.exit = false;
+        self.quitting = false;
+    }
+
+    /// Validation messages so far (0 without the layer).
+    pub fn validation_errors(&self) -> u64 {
+        self.gfx
+            .as_ref()
+            .map_or(0, |g| g.viewport.ctx().validation_errors() as u64)
+    }
+
+    /// The window's size in physical pixels.
+    pub fn size(&self) -> (u32, u32) {
+        self.window_size
+    }
+
+    /// The session's recording so far, as a replay script (with `options.record`).
+    pub fn recording(&self) -> Option<String> {
+        self.recording_text()
+    }
+
+    /// Where the world point `p` shows in the window, in pixels — None when it is behind the
+    /// eye, outside the window, or under a menu, a status line or a window (as drawn in the
+    /// last frame): the places a user would aim at to reach it.
+    pub fn aim(&self, p: DVec3) -> Option<(f64, f64)> {
+        let (u, v) = self.view.project(p, self.aspect())?;
+        let (w, h) = self.window_size;
+        let x = (u + 1.0) * 0.5 * f64::from(w);
+        let y = (1.0 - v) * 0.5 * f64::from(h);
+        let inside =
+            (1.0..f64::from(w) - 1.0).contains(&x) && (1.0..f64::from(h) - 1.0).contains(&y);
+        let ppp = f64::from(self.egui.pixels_per_point());
+        let pos = egui::pos2((x / ppp) as f32, (y / ppp) as f32);
+        let covered = self
+            .egui
+            .layer_id_at(pos)
+            .is_some_and(|l| l.order != egui::Order::Background);
+        let free = self.panels.between_bars.is_some_and(|r| r.contains(pos)) && !covered;
+        (inside && free).then_some((x, y))
+    }
+
+    /// The brush's settings as the Tools window shows them.
+    pub fn brush(&self) -> &tools::Brush {
+        &self.settings.brush
+    }
+
+    /// Ends the session as the window's exit does, and returns its outcome (validation errors
+    /// count; the recording is written).
+    pub fn close(mut self) -> Result<()> {
+        self.finish();
+        std::mem::replace(&mut self.outcome, Ok(()))
+    }
+}

@@ -1,0 +1,113 @@
+//! Where the editor's frames go and its egui input comes from: a winit window (egui-winit
+//! turns its events into egui's), or a headless stand-in of a given size that takes the
+//! editor's own [`Input`] events (the soak test drives the editor so, through the same
+//! handlers as a window's events, with frames drawn offscreen).
+
+use super::event::{Input, egui_modifiers};
+use super::input::Mods;
+use std::sync::Arc;
+use winit::window::Window;
+
+/// The editor's window, or none.
+pub(super) enum Host {
+    /// A real window.
+    Window {
+        egui_state: Box<egui_winit::State>,
+        window: Arc<Window>,
+    },
+    /// No window: a size, egui's pending events, and whether a frame was asked for.
+    Headless(Headless),
+}
+
+/// The headless stand-in for a window.
+pub(super) struct Headless {
+    pub size: (u32, u32),
+    events: Vec<egui::Event>,
+    cursor: (f64, f64),
+    /// A frame was asked for since the last one (what `request_redraw` would do).
+    pub redraw: bool,
+    pub title: String,
+    /// Frames drawn: egui's clock runs at 60 per second of them, so a headless session is a
+    /// function of its input, not of the machine's speed.
+    frames: u64,
+}
+
+impl Headless {
+    pub fn new(size: (u32, u32)) -> Self {
+        Self {
+            size,
+            events: Vec::new(),
+            cursor: (0.0, 0.0),
+            redraw: true,
+            title: String::new(),
+            frames: 0,
+        }
+    }
+
+    /// An input event for egui's next frame.
+    pub fn push(&mut self, input: &Input, mods: Mods) {
+        match input {
+            Input::Moved { x, y } => self.cursor = (*x, *y),
+            Input::Modifiers(m) => self
+                .events
+                .push(egui::Event::ModifiersChanged(egui_modifiers(*m))),
+            Input::Resized(w, h) => self.size = (*w, *h),
+            _ => {}
+        }
+        self.events.extend(input.to_egui(self.cursor, mods));
+    }
+}
+
+impl Host {
+    pub fn request_redraw(&mut self) {
+        match self {
+            Host::Window { window, .. } => window.request_redraw(),
+            Host::Headless(h) => h.redraw = true,
+        }
+    }
+
+    pub fn set_title(&mut self, title: &str) {
+        match self {
+            Host::Window { window, .. } => window.set_title(title),
+            Host::Headless(h) => h.title = title.to_string(),
+        }
+    }
+
+    /// The inner size in physical pixels.
+    pub fn inner_size(&self) -> (u32, u32) {
+        match self {
+            Host::Window { window, .. } => {
+                let s = window.inner_size();
+                (s.width, s.height)
+            }
+            Host::Headless(h) => h.size,
+        }
+    }
+
+    /// egui's input for the next frame.
+    pub fn take_egui_input(&mut self) -> egui::RawInput {
+        match self {
+            Host::Window { egui_state, window } => egui_state.take_egui_input(window),
+            Host::Headless(h) => {
+                h.frames += 1;
+                egui::RawInput {
+                    screen_rect: Some(egui::Rect::from_min_size(
+                        egui::Pos2::ZERO,
+                        egui::vec2(h.size.0 as f32, h.size.1 as f32),
+                    )),
+                    time: Some(h.frames as f64 / 60.0),
+                    events: std::mem::take(&mut h.events),
+                    focused: true,
+                    ..Default::default()
+                }
+            }
+        }
+    }
+
+    /// What egui asks of the platform (cursor icon, clipboard, links): a window's only.
+    pub fn handle_platform_output(&mut self, output: egui::PlatformOutput) {
+        if let Host::Window { egui_state, window } = self {
+            egui_state.handle_platform_output(window, output);
+        }
+    }
+}
