@@ -42,7 +42,11 @@ impl Editor {
         self.attach(
             ctx,
             presenter,
-            Host::Window { egui_state, window },
+            Host::Window {
+                egui_state,
+                window,
+                clock: super::host::InputClock::new(),
+            },
             (size.width, size.height),
         )
     }

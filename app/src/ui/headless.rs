@@ -153,6 +153,11 @@ impl Editor {
         (inside && free).then_some((x, y))
     }
 
+    /// Whether a menu or another popup is open (as of the last frame).
+    pub fn popup_open(&self) -> bool {
+        egui::Popup::is_any_open(&self.egui)
+    }
+
     /// The brush's settings as the Tools window shows them.
     pub fn brush(&self) -> &tools::Brush {
         &self.settings.brush

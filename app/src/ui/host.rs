@@ -6,6 +6,7 @@
 use super::event::{Input, egui_modifiers};
 use super::input::Mods;
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 use winit::window::Window;
 
 /// The editor's window, or none.
@@ -14,9 +15,49 @@ pub(super) enum Host {
     Window {
         egui_state: Box<egui_winit::State>,
         window: Arc<Window>,
+        clock: InputClock,
     },
     /// No window: a size, egui's pending events, and whether a frame was asked for.
     Headless(Headless),
+}
+
+/// egui's clock for a window: wall time that stops while a frame blocks the event loop
+/// for longer than [`FRAME_ALLOWANCE`]. egui tells a click from a held press by the time
+/// between the passes that see the press and the release; on wall time, a quick click whose
+/// press and release were read after two slow frames (the path tracer at 1–3 s a frame on a
+/// CPU driver) read as a held press and did nothing — a menu that did not open, a swatch that
+/// needed two clicks. Input queued while the loop was blocked is dated, on this clock, to
+/// when the loop stopped reading: what the user did in a frozen window counts as done at once.
+pub(super) struct InputClock {
+    start: Instant,
+    /// Time the clock stood still (the blocked part of slow frames).
+    stood: Duration,
+    last: f64,
+}
+
+/// How long a frame may block the loop before the clock stops for the rest of it.
+const FRAME_ALLOWANCE: Duration = Duration::from_millis(50);
+
+impl InputClock {
+    pub fn new() -> Self {
+        Self {
+            start: Instant::now(),
+            stood: Duration::ZERO,
+            last: 0.0,
+        }
+    }
+
+    /// A frame ran from `began` until now.
+    pub fn frame_ran(&mut self, began: Instant) {
+        self.stood += began.elapsed().saturating_sub(FRAME_ALLOWANCE);
+    }
+
+    /// The next pass's time in seconds (never earlier than the last).
+    fn pass_time(&mut self) -> f64 {
+        let t = self.start.elapsed().saturating_sub(self.stood);
+        self.last = t.as_secs_f64().max(self.last);
+        self.last
+    }
 }
 
 /// The headless stand-in for a window.
@@ -87,7 +128,15 @@ impl Host {
     /// egui's input for the next frame.
     pub fn take_egui_input(&mut self) -> egui::RawInput {
         match self {
-            Host::Window { egui_state, window } => egui_state.take_egui_input(window),
+            Host::Window {
+                egui_state,
+                window,
+                clock,
+            } => {
+                let mut raw = egui_state.take_egui_input(window);
+                raw.time = Some(clock.pass_time());
+                raw
+            }
             Host::Headless(h) => {
                 h.frames += 1;
                 egui::RawInput {
@@ -106,8 +155,39 @@ impl Host {
 
     /// What egui asks of the platform (cursor icon, clipboard, links): a window's only.
     pub fn handle_platform_output(&mut self, output: egui::PlatformOutput) {
-        if let Host::Window { egui_state, window } = self {
+        if let Host::Window {
+            egui_state, window, ..
+        } = self
+        {
             egui_state.handle_platform_output(window, output);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_clock_stands_still_while_a_slow_frame_blocks_the_loop() {
+        let mut clock = InputClock::new();
+        let press_pass = clock.pass_time();
+        // A slow frame (1 s) runs; the release, queued meanwhile, is seen by the next pass.
+        let began = Instant::now();
+        std::thread::sleep(Duration::from_millis(1000));
+        clock.frame_ran(began);
+        let release_pass = clock.pass_time();
+        assert!(
+            release_pass - press_pass < 0.8,
+            "press at {press_pass} s, release at {release_pass} s: egui would not see a click"
+        );
+        assert!(release_pass - press_pass >= 0.049, "the allowance counts");
+        // Between frames the clock runs; it never goes back.
+        std::thread::sleep(Duration::from_millis(40));
+        let later = clock.pass_time();
+        assert!(later >= release_pass + 0.039, "{later} s");
+        let fast = Instant::now();
+        clock.frame_ran(fast);
+        assert!(clock.pass_time() >= later);
     }
 }

@@ -596,15 +596,27 @@ impl ApplicationHandler<Wake> for Editor {
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
         match &event {
             WindowEvent::RedrawRequested => {
+                let began = Instant::now();
                 if let Err(e) = self.redraw() {
                     self.gpu_failed(e);
+                }
+                if let Some(Gfx {
+                    host: Host::Window { clock, .. },
+                    ..
+                }) = &mut self.gfx
+                {
+                    clock.frame_ran(began);
                 }
             }
             WindowEvent::ScaleFactorChanged { .. } => self.request_redraw(),
             _ => {
+                let input = Input::from_window_event(&event);
                 let consumed = match &mut self.gfx {
                     Some(Gfx {
-                        host: Host::Window { egui_state, window },
+                        host:
+                            Host::Window {
+                                egui_state, window, ..
+                            },
                         ..
                     }) => {
                         let response = egui_state.on_window_event(window, &event);
@@ -615,7 +627,7 @@ impl ApplicationHandler<Wake> for Editor {
                     }
                     _ => false,
                 };
-                if let Some(input) = Input::from_window_event(&event) {
+                if let Some(input) = input {
                     self.input_with(input, consumed);
                 }
             }
