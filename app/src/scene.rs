@@ -176,7 +176,8 @@ pub fn thesis_terrain(materials: terrain::TerrainMaterials, height: u32) -> terr
 }
 
 /// Adds the terrain palette to a world: grass, dirt, rock with colour variants, sand, snow,
-/// and water (a blue-tinted dielectric, IOR 1.333).
+/// and water (a blue-tinted dielectric, IOR 1.333). A material already in the table with the
+/// same kind, parameter and colour is reused, so generating terrain again adds nothing.
 pub fn terrain_materials(world: &World) -> brickmap::Result<terrain::TerrainMaterials> {
     // Colours are taken from the top of the table down; a fresh table's placeholder
     // material 0 is replaced by the first terrain material.
@@ -186,6 +187,17 @@ pub fn terrain_materials(world: &World) -> brickmap::Result<terrain::TerrainMate
     let mut add = |rgb: [u8; 3], kind: MaterialKind, param: u8| -> brickmap::Result<u8> {
         let colour = next_colour;
         next_colour -= 1;
+        if !first {
+            let table = world.materials();
+            let equal = (0..table.len()).find(|&k| {
+                table.get(k as u8).is_ok_and(|m| {
+                    m.kind == kind && m.param == param && table.colour(m.colour) == rgb
+                })
+            });
+            if let Some(k) = equal {
+                return Ok(k as u8);
+            }
+        }
         world.set_colour(colour, rgb);
         let m = Material {
             kind,
@@ -269,4 +281,23 @@ fn place_statue(world: &World) -> Result<()> {
     formats::vox::import_into(world, STATUE_VOX, &options, Some(gold))
         .map_err(anyhow::Error::msg)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn terrain_generated_twice_reuses_its_materials() {
+        let scene = Scene::empty(GridDims::new(2, 2, 2).unwrap(), 1).unwrap();
+        let first = terrain_materials(&scene.world).unwrap();
+        let count = scene.world.materials().len();
+        assert_eq!(count, 10, "grass 3, dirt 2, rock 2, sand, snow, water");
+        let second = terrain_materials(&scene.world).unwrap();
+        assert_eq!(scene.world.materials().len(), count, "no duplicates");
+        assert_eq!(
+            (second.grass, second.rock, second.water),
+            (first.grass, first.rock, first.water)
+        );
+    }
 }

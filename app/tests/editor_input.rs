@@ -228,7 +228,8 @@ fn strokes_drawn_with_the_mouse_replay_headlessly_to_the_same_scene() {
     let Some(x) = tools_ready() else { return };
     let dir = scratch("strokes");
     let (work, session) = (dir.join("work.ron"), dir.join("session.ron"));
-    let Some(mut s) = Session::recorded(&x, &dir, "640x400") else {
+    // Big enough that the viewport between the docks holds every point below.
+    let Some(mut s) = Session::recorded(&x, &dir, "960x540") else {
         return;
     };
     // A click that closes a menu draws nothing.
@@ -259,7 +260,8 @@ fn strokes_drawn_with_the_mouse_replay_headlessly_to_the_same_scene() {
     s.key("ctrl+c", "KeyC", "edited command Copy");
     s.key("Right", "ArrowRight", "edited command");
     s.key("ctrl+v", "KeyV", "input key Code(KeyV) down");
-    s.mouse_to((520, 200));
+    // Low on the terrain: a paste on a column that reaches the ceiling would be outside.
+    s.mouse_to((450, 440));
     s.press();
     // The paste lands at the press; its line may come before or after the release's.
     let mark = s.report.position();
@@ -359,7 +361,8 @@ fn a_drag_faster_than_the_frames_is_one_connected_stroke_reaching_the_release_po
     };
     // The thinnest brush: the voxel, one voxel per point.
     s.key("v", "KeyV", "input key Code(KeyV) down");
-    let (x0, y) = (420, 300);
+    // From the viewport's left part (x 236 to 724 between the docks) across 340 px.
+    let (x0, y) = (260, 300);
     s.mouse_to((x0, y));
     s.press();
     // 30 moves across 300 px in one xdotool call (far faster than lavapipe's frames), the
@@ -469,7 +472,7 @@ fn a_killed_editor_offers_its_autosave_and_recovering_gives_its_content() {
         &x,
         &dir,
         &config,
-        &[work.to_str().unwrap(), "--window", "640x400"],
+        &[work.to_str().unwrap(), "--window", "960x540"],
     ) else {
         return;
     };
@@ -487,7 +490,7 @@ fn a_killed_editor_offers_its_autosave_and_recovering_gives_its_content() {
     assert_ne!(autosaved, hash(&work), "the autosave holds the stroke");
 
     // The next start offers it; Enter recovers it.
-    let Some(mut s) = Session::start(&x, &dir, &config, &["--window", "640x400"]) else {
+    let Some(mut s) = Session::start(&x, &dir, &config, &["--window", "960x540"]) else {
         return;
     };
     let lines = s.report.lines();

@@ -136,14 +136,28 @@ impl Camera {
     /// from the eye to that centre. The editor's "frame the scene" and a `.vox` import's
     /// camera.
     pub fn framing(&self, min: DVec3, max: DVec3) -> (Camera, f64) {
+        self.framing_in(min, max, 1.0)
+    }
+
+    /// [`Camera::framing`] for an image of `aspect` (width / height): the sphere fits the
+    /// narrower of the two fields of view (the vertical one for an image at least as wide
+    /// as tall, as in `framing`).
+    pub fn framing_in(&self, min: DVec3, max: DVec3, aspect: f64) -> (Camera, f64) {
         let centre = (min + max) * 0.5;
         let radius = ((max - min).length() * 0.5).max(1.0);
-        let half = (self.fov_y_deg.to_radians() * 0.5).sin().max(1e-3);
+        let aspect = if aspect.is_finite() {
+            aspect.clamp(1e-3, 1.0)
+        } else {
+            1.0
+        };
+        let half_v = self.fov_y_deg.to_radians() * 0.5;
+        let half_h = (half_v.tan() * aspect).atan();
+        let half = half_h.sin().max(1e-3);
         let distance = radius / half;
         let projection = match self.projection {
             Projection::Perspective => Projection::Perspective,
             Projection::Orthographic { .. } => Projection::Orthographic {
-                height: 2.0 * radius,
+                height: 2.0 * radius / aspect,
             },
         };
         let camera = Camera {

@@ -141,13 +141,16 @@ impl Presenter {
         Ok(())
     }
 
-    /// Draws one frame: the viewport's trace and display, egui on top, presented. With
-    /// `capture`, waits for the frame and returns the presented pixels.
+    /// Draws one frame: the viewport's trace and display in `area` (x, y, width, height in
+    /// pixels, clamped to the image; None: the whole image) with the rest cleared to the
+    /// panels' grey, egui on top, presented. With `capture`, waits for the frame and returns
+    /// the presented pixels.
     pub fn frame(
         &mut self,
         viewport: &mut Viewport,
         world: &World,
         req: &FrameRequest<'_>,
+        area: Option<(u32, u32, u32, u32)>,
         ui: Option<EguiFrame<'_>>,
         capture: bool,
     ) -> Result<(Presented, Option<Capture>), GpuError> {
@@ -188,11 +191,13 @@ impl Presenter {
             }
         }
         let (extent, format) = (target.extent(), target.format());
+        let area = clamp_area(area, extent);
         let req = FrameRequest {
-            output: (extent.width, extent.height),
+            output: (area.extent.width, area.extent.height),
             bgra: is_bgra(format),
             ..*req
         };
+        let whole = area.extent == extent;
         let status = viewport.trace_frame(&frame, world, &req)?;
         let (image, view) = target.image(index);
         let cmd = frame.cmd;
@@ -223,12 +228,45 @@ impl Presenter {
                     vk::AccessFlags::TRANSFER_WRITE,
                 ),
             );
+            if !whole {
+                // Around the viewport's area: the panels' grey (egui's dark panel fill).
+                let grey = 27.0 / 255.0;
+                d.cmd_clear_color_image(
+                    cmd,
+                    image,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &vk::ClearColorValue {
+                        float32: [grey, grey, grey, 1.0],
+                    },
+                    &[vk::ImageSubresourceRange {
+                        aspect_mask: vk::ImageAspectFlags::COLOR,
+                        base_mip_level: 0,
+                        level_count: 1,
+                        base_array_layer: 0,
+                        layer_count: 1,
+                    }],
+                );
+                crate::vulkan::barrier::barrier(
+                    &ctx,
+                    cmd,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                    vk::PipelineStageFlags::TRANSFER,
+                    vk::AccessFlags::TRANSFER_WRITE,
+                );
+            }
+            let mut copy = whole_image(area.extent);
+            copy.image_offset = vk::Offset3D {
+                x: area.offset.x,
+                y: area.offset.y,
+                z: 0,
+            };
             d.cmd_copy_buffer_to_image(
                 cmd,
                 viewport.output(&frame),
                 image,
                 vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &[whole_image(extent)],
+                &[copy],
             );
             image_barrier(
                 d,
@@ -385,6 +423,23 @@ impl Presenter {
 }
 
 /// A tightly packed copy of a whole image of `extent`.
+/// The viewport's area inside an image of `extent`: at least one pixel, never past its edges.
+fn clamp_area(area: Option<(u32, u32, u32, u32)>, extent: vk::Extent2D) -> vk::Rect2D {
+    let (x, y, w, h) = area.unwrap_or((0, 0, extent.width, extent.height));
+    let x = x.min(extent.width.saturating_sub(1));
+    let y = y.min(extent.height.saturating_sub(1));
+    vk::Rect2D {
+        offset: vk::Offset2D {
+            x: x as i32,
+            y: y as i32,
+        },
+        extent: vk::Extent2D {
+            width: w.clamp(1, extent.width - x),
+            height: h.clamp(1, extent.height - y),
+        },
+    }
+}
+
 fn whole_image(extent: vk::Extent2D) -> vk::BufferImageCopy {
     vk::BufferImageCopy {
         buffer_offset: 0,

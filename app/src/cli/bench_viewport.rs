@@ -180,7 +180,7 @@ fn run_case_ui(
                 textures: &pending,
             };
             let r = FrameRequest { params: &p, ..req };
-            let (shown, _) = presenter.frame(vp, world, &r, Some(ui), false)?;
+            let (shown, _) = presenter.frame(vp, world, &r, None, Some(ui), false)?;
             if !matches!(shown, Presented::Shown(_)) {
                 std::thread::yield_now();
                 continue;

@@ -359,13 +359,13 @@ impl Command {
             }
             Command::Copy => {
                 let clip = Clip::copy(&world.read(), selected(scene)?)
-                    .ok_or_else(|| super::error::invalid("nothing is selected"))?;
+                    .ok_or(super::error::EditError::NothingToDo("nothing is selected"))?;
                 scene.clipboard = Some(std::sync::Arc::new(clip));
                 unchanged(Inverse::Compound(Vec::new()))
             }
             Command::Cut => {
                 let clip = Clip::copy(&world.read(), selected(scene)?)
-                    .ok_or_else(|| super::error::invalid("nothing is selected"))?;
+                    .ok_or(super::error::EditError::NothingToDo("nothing is selected"))?;
                 let applied = selection_edit(scene, Mode::Remove)?;
                 scene.clipboard = Some(std::sync::Arc::new(clip));
                 applied
@@ -374,7 +374,9 @@ impl Command {
                 let clip = scene
                     .clipboard
                     .clone()
-                    .ok_or_else(|| super::error::invalid("the clipboard is empty"))?;
+                    .ok_or(super::error::EditError::NothingToDo(
+                        "the clipboard is empty",
+                    ))?;
                 let voxels = world.dims().voxels();
                 let edit = selection::paste_edit(&clip, *at, voxels);
                 let pasted = Selection::new(clip.region.translated(*at), voxels);
@@ -518,7 +520,7 @@ fn selected(scene: &Scene) -> Result<&Selection> {
     scene
         .selection
         .as_ref()
-        .ok_or_else(|| super::error::invalid("nothing is selected"))
+        .ok_or(super::error::EditError::NothingToDo("nothing is selected"))
 }
 
 /// A mode applied to exactly the selected voxels.
@@ -557,7 +559,9 @@ fn remove_unused_materials(scene: &Scene) -> Result<Applied> {
             }
         });
         if (0..before.len()).all(|i| used[i]) {
-            return Err(super::error::invalid("every material is in use"));
+            return Err(super::error::EditError::NothingToDo(
+                "every material is in use",
+            ));
         }
         if !used.iter().any(|u| *u) {
             // An empty scene keeps its first material (brushes need one).

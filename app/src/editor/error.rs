@@ -27,6 +27,21 @@ pub enum EditError {
     /// Redo with an empty redo list.
     #[error("nothing to redo")]
     NothingToRedo,
+    /// Nothing for the command to act on (no selection, an empty clipboard, no unused
+    /// material): harmless, said in passing rather than shown as a failure.
+    #[error("{0}")]
+    NothingToDo(&'static str),
+}
+
+impl EditError {
+    /// Whether the edit had nothing to act on (an undo with nothing to undo, a copy without
+    /// a selection): a no-op, not a failure.
+    pub fn is_no_op(&self) -> bool {
+        matches!(
+            self,
+            Self::NothingToUndo | Self::NothingToRedo | Self::NothingToDo(_)
+        )
+    }
 }
 
 /// The engine's result.

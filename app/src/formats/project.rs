@@ -200,8 +200,14 @@ pub fn load(path: &Path, workers: usize) -> Result<Scene, FormatError> {
 pub fn from_bytes(text: &[u8], path: &Path, workers: usize) -> Result<Scene, FormatError> {
     let invalid = |m: String| FormatError::invalid(path, m);
     let text = std::str::from_utf8(text).map_err(|e| invalid(format!("not UTF-8 text: {e}")))?;
-    let probe: Probe =
-        ron::from_str(text).map_err(|e| invalid(format!("not a voxbrick project: {e}")))?;
+    // The probe's own name never reaches the user: the file is not a project, and where.
+    let probe: Probe = ron::from_str(text).map_err(|e| {
+        invalid(format!(
+            "not a voxbrick project (a project begins with `(format_version: {FORMAT_VERSION},`; \
+             this file does not, line {} column {})",
+            e.span.start.line, e.span.start.col
+        ))
+    })?;
     match probe.format_version {
         v if v > FORMAT_VERSION => {
             return Err(FormatError::NewerVersion {

@@ -143,10 +143,11 @@ impl ViewCamera {
         self.camera.position += right * local.x + DVec3::Y * local.y + f * local.z;
     }
 
-    /// Frames a box: keeps the orientation, pivots on its centre and backs off until its
-    /// bounding sphere fits the vertical field of view (orthographic: the view's height).
-    pub fn frame(&mut self, min: DVec3, max: DVec3) {
-        let (camera, distance) = self.camera.framing(min, max);
+    /// Frames a box in a view of `aspect` (width / height): keeps the orientation, pivots
+    /// on its centre and backs off until its bounding sphere fits the narrower field of view
+    /// (orthographic: the view's narrower side).
+    pub fn frame(&mut self, min: DVec3, max: DVec3, aspect: f64) {
+        let (camera, distance) = self.camera.framing_in(min, max, aspect);
         *self = Self::from_camera(camera, distance);
     }
 
@@ -254,7 +255,7 @@ mod tests {
     fn framing_puts_the_box_in_view() {
         let mut v = view();
         let (min, max) = (DVec3::ZERO, DVec3::new(96.0, 48.0, 96.0));
-        v.frame(min, max);
+        v.frame(min, max, 1.6);
         assert!(close(v.pivot(), (min + max) * 0.5, 1e-9));
         for corner in 0..8 {
             let p = DVec3::new(
@@ -380,7 +381,7 @@ mod tests {
     fn orthographic_framing_puts_the_box_in_view_in_front_of_the_plane() {
         let mut v = ortho();
         let (min, max) = (DVec3::new(10.0, 0.0, 20.0), DVec3::new(40.0, 30.0, 50.0));
-        v.frame(min, max);
+        v.frame(min, max, 1.6);
         assert!(v.camera.is_orthographic());
         for corner in 0..8 {
             let p = DVec3::new(

@@ -52,20 +52,14 @@ impl Editor {
                 };
                 self.report
                     .line(format_args!("edited command {label}: {outcome}"));
-                if let Err(e) = result {
-                    self.panels.errors.push(format!("{label}: {e}"));
+                match result {
+                    Err(e) if e.is_no_op() => self.panels.notify(format!("{label}: {e}")),
+                    Err(e) => self.panels.errors.push(format!("{label}: {e}")),
+                    Ok(_) => {}
                 }
             }
-            Edited::Undo(result) | Edited::Redo(result) => {
-                let outcome = match &result {
-                    Ok(label) => format!("ok {label}"),
-                    Err(e) => format!("error {e}"),
-                };
-                self.report.line(format_args!("edited history: {outcome}"));
-                if let Err(e) = result {
-                    self.panels.errors.push(e.to_string());
-                }
-            }
+            Edited::Undo(result) => self.history_done("Undid", result),
+            Edited::Redo(result) => self.history_done("Redid", result),
             // A segment: the statistics (a walk over every cell) wait for the stroke's end.
             Edited::Stroke(Ok(None)) => {
                 self.report.line(format_args!("edited stroke segment: ok"));
@@ -104,6 +98,20 @@ impl Editor {
             }
         }
         self.refresh_stats();
+    }
+
+    /// An undo or a redo done: said on the status line, as is one with nothing to do.
+    fn history_done(&mut self, what: &str, result: Result<String, crate::editor::EditError>) {
+        let outcome = match &result {
+            Ok(label) => format!("ok {label}"),
+            Err(e) => format!("error {e}"),
+        };
+        self.report.line(format_args!("edited history: {outcome}"));
+        match result {
+            Ok(label) => self.panels.notify(format!("{what} {label}")),
+            Err(e) if e.is_no_op() => self.panels.notify(capitalized(&e.to_string())),
+            Err(e) => self.panels.errors.push(e.to_string()),
+        }
     }
 
     pub(super) fn refresh_stats(&mut self) {
@@ -238,36 +246,41 @@ impl Editor {
         self.quitting = true;
     }
 
+    /// A path the user chose (in a native dialog or the in-app browser) for `purpose`.
+    pub(super) fn picked(&mut self, purpose: Purpose, path: PathBuf) {
+        match purpose {
+            Purpose::Open => self.files.load(path, self.options.workers),
+            Purpose::SaveAs | Purpose::Export => {
+                let path = if purpose == Purpose::SaveAs && path.extension().is_none() {
+                    path.with_extension("ron")
+                } else {
+                    path
+                };
+                self.save_to(path, false)
+            }
+            // Asks for the offset first (the import dialog), then `ImportVox`.
+            Purpose::Import => self.panels.import = Some((path, [0, 0, 0])),
+            Purpose::LoadPalette => self.files.load_palette(path),
+            Purpose::SavePalette => {
+                let path = if path.extension().is_none() {
+                    path.with_extension("png")
+                } else {
+                    path
+                };
+                let colours = {
+                    let doc = self.read();
+                    let table = doc.scene.world.materials();
+                    (0..=255u8).map(|i| table.colour(i)).collect()
+                };
+                self.files.save_palette(colours, path);
+            }
+        }
+    }
+
     pub(super) fn file_done(&mut self, done: Done) {
         self.files.finished();
         match done {
-            Done::Picked(purpose, Ok(Some(path))) => match purpose {
-                Purpose::Open => self.files.load(path, self.options.workers),
-                Purpose::SaveAs | Purpose::Export => {
-                    let path = if purpose == Purpose::SaveAs && path.extension().is_none() {
-                        path.with_extension("ron")
-                    } else {
-                        path
-                    };
-                    self.save_to(path, false)
-                }
-                // Asks for the offset first (the import dialog), then `ImportVox`.
-                Purpose::Import => self.panels.import = Some((path, [0, 0, 0])),
-                Purpose::LoadPalette => self.files.load_palette(path),
-                Purpose::SavePalette => {
-                    let path = if path.extension().is_none() {
-                        path.with_extension("png")
-                    } else {
-                        path
-                    };
-                    let colours = {
-                        let doc = self.read();
-                        let table = doc.scene.world.materials();
-                        (0..=255u8).map(|i| table.colour(i)).collect()
-                    };
-                    self.files.save_palette(colours, path);
-                }
-            },
+            Done::Picked(purpose, Some(path)) => self.picked(purpose, path),
             Done::Palette(Ok(colours)) => self.execute(Command::SetPalette(colours)),
             Done::Palette(Err(e)) => self.panels.errors.push(format!("{e:#}")),
             Done::PaletteSaved(_, Ok(())) => {}
@@ -275,26 +288,24 @@ impl Editor {
                 .panels
                 .errors
                 .push(format!("writing {}: {e:#}", path.display())),
-            Done::Picked(_, Ok(None)) => self.save_then = None,
-            Done::Picked(Purpose::SaveAs, Err(e)) => {
-                // Nothing is lost for want of a dialog: save beside the home folder (a
-                // headless editor's: its configuration folder).
-                let home = if self.headless {
-                    self.config.0.clone()
-                } else {
-                    std::env::var_os("HOME").map_or_else(|| PathBuf::from("."), PathBuf::from)
+            Done::Picked(_, None) => self.save_then = None,
+            // No native dialog: the in-app browser asks (nothing is written meanwhile).
+            Done::NoDialog {
+                purpose,
+                folder,
+                name,
+            } => {
+                let places = {
+                    let doc = self.read();
+                    let folder = doc
+                        .path
+                        .as_ref()
+                        .and_then(|p| p.parent())
+                        .map(Path::to_path_buf);
+                    super::browser::places(folder.as_deref(), &self.panels.recent)
                 };
-                let path = files::fallback_path(&home, "voxbrick-untitled", "ron");
-                self.panels
-                    .errors
-                    .push(format!("{e}; saving to {} instead", path.display()));
-                self.save_to(path, false);
-            }
-            Done::Picked(_, Err(e)) => {
-                self.save_then = None;
-                self.panels.errors.push(format!(
-                    "{e}; open a file by dropping it onto the window or naming it on the command line"
-                ));
+                let browser = super::browser::Browser::new(purpose, folder, name);
+                self.panels.browser = Some((browser, places));
             }
             Done::Loaded(path, loaded) => match *loaded {
                 Ok(scene) => {
@@ -342,6 +353,7 @@ impl Editor {
                 }
                 Ok(()) => {
                     self.report.line(format_args!("saved {}", path.display()));
+                    self.panels.notify(format!("Saved {}", path.display()));
                     self.saved.push((path.clone(), revision));
                     self.mark_saved();
                     let _ = self.config.add_recent(&path);
@@ -486,4 +498,11 @@ pub(super) fn scene_statistics(doc: &Document) -> String {
         doc.history.dropped()
     );
     s
+}
+
+/// `text` with its first letter a capital (an error's text as a sentence).
+fn capitalized(text: &str) -> String {
+    let mut c = text.chars();
+    c.next()
+        .map_or_else(String::new, |f| f.to_uppercase().chain(c).collect())
 }

@@ -19,12 +19,15 @@ use brickmap::{MaterialKind, MaterialTable};
 pub struct EditingState {
     /// The tools window is hidden (shown by default).
     pub tools_hidden: bool,
-    /// The palette and materials window.
-    pub palette_open: bool,
-    /// The history window.
+    /// The palette dock is collapsed (shown by default).
+    pub palette_hidden: bool,
+    /// The history section of the palette dock is open.
     pub history_open: bool,
     /// The colour selected in the palette grid.
     pub colour: u8,
+    /// Where the palette's 16 × 16 grid of colours was drawn (points, last frame; None
+    /// while its dock is collapsed).
+    pub palette_grid: Option<egui::Rect>,
     /// The terrain window, with its parameters.
     pub terrain: Option<TerrainSpec>,
 }
@@ -58,10 +61,14 @@ fn kind_name(k: MaterialKind) -> &'static str {
     }
 }
 
-/// Draws the editing windows.
-pub fn draw(
-    ctx: &egui::Context,
-    area: egui::Rect,
+/// The docks' width in points: the palette's 16 columns of swatches and the tools' rows.
+const DOCK_WIDTH: f32 = 236.0;
+
+/// The docked panels, at the window's sides: Tools on the left; the 256 colours, the
+/// current material and the history on the right. Each collapses to a strip with the button
+/// that brings it back; the viewport is what they leave.
+pub fn docks(
+    root: &mut egui::Ui,
     state: &mut EditingState,
     doc: &Document,
     brush: &mut Brush,
@@ -71,22 +78,72 @@ pub fn draw(
     // The table can shrink (an undone addition, unused materials removed): the current
     // material stays an entry of it.
     brush.material = brush.material.min((table.len() - 1) as u8);
-    if !state.tools_hidden {
-        let mut open = true;
-        window(area, "Tools")
-            .open(&mut open)
-            .default_pos(egui::pos2(8.0, 40.0))
+    let strip = |root: &mut egui::Ui, id: &str, left: bool, label: &str| {
+        let panel = if left {
+            egui::Panel::left(id.to_string())
+        } else {
+            egui::Panel::right(id.to_string())
+        };
+        panel
             .resizable(false)
-            .show(ctx, |ui| tools(ui, brush, &table, doc, out));
-        state.tools_hidden = !open;
+            .exact_size(24.0)
+            .show(root, |ui| {
+                ui.button(if left { "⏵" } else { "⏴" })
+                    .on_hover_text(label)
+                    .clicked()
+            })
+            .inner
+    };
+    if state.tools_hidden {
+        state.tools_hidden = !strip(root, "tools strip", true, "Show the tools");
+    } else {
+        egui::Panel::left("tools")
+            .resizable(false)
+            .exact_size(DOCK_WIDTH)
+            .show(root, |ui| {
+                ui.horizontal(|ui| {
+                    ui.strong("Tools");
+                    ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+                        state.tools_hidden = ui.small_button("⏴").on_hover_text("Hide").clicked();
+                    });
+                });
+                egui::ScrollArea::vertical().show(ui, |ui| tools(ui, brush, &table, doc, out));
+            });
     }
-    if state.palette_open {
-        let mut open = true;
-        window(area, "Palette and materials")
-            .open(&mut open)
-            .show(ctx, |ui| palette(ui, state, brush, &table, out));
-        state.palette_open = open;
+    if state.palette_hidden {
+        state.palette_grid = None;
+        state.palette_hidden = !strip(root, "palette strip", false, "Show the palette");
+    } else {
+        egui::Panel::right("palette")
+            .resizable(false)
+            .exact_size(DOCK_WIDTH)
+            .show(root, |ui| {
+                ui.horizontal(|ui| {
+                    state.palette_hidden = ui.small_button("⏵").on_hover_text("Hide").clicked();
+                    ui.strong("Palette and materials");
+                });
+                egui::ScrollArea::vertical().show(ui, |ui| {
+                    palette(ui, state, brush, &table, out);
+                    ui.separator();
+                    let header = egui::CollapsingHeader::new("History")
+                        .open(Some(state.history_open))
+                        .show(ui, |ui| history(ui, doc, out));
+                    if header.header_response.clicked() {
+                        state.history_open = !state.history_open;
+                    }
+                });
+            });
     }
+}
+
+/// Draws the editing windows that float over the viewport (terrain).
+pub fn draw(
+    ctx: &egui::Context,
+    area: egui::Rect,
+    state: &mut EditingState,
+    doc: &Document,
+    out: &mut Vec<UiEvent>,
+) {
     if let Some(spec) = &mut state.terrain {
         let mut open = true;
         let height = doc.scene.world.dims().voxels().y as u32;
@@ -97,13 +154,6 @@ pub fn draw(
             state.terrain = None;
         }
     }
-    if state.history_open {
-        let mut open = true;
-        window(area, "History")
-            .open(&mut open)
-            .show(ctx, |ui| history(ui, doc, out));
-        state.history_open = open;
-    }
 }
 
 fn tools(
@@ -113,7 +163,7 @@ fn tools(
     doc: &Document,
     out: &mut Vec<UiEvent>,
 ) {
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         for (m, name) in [
             (BrushMode::Attach, "Attach  T"),
             (BrushMode::Erase, "Erase  X"),
@@ -145,14 +195,14 @@ fn tools(
             .text("size  [ ]"),
     );
     if brush.shape == BrushShape::Cylinder {
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             ui.label("cylinder axis");
             for (a, name) in [(Axis::X, "X"), (Axis::Y, "Y"), (Axis::Z, "Z")] {
                 ui.selectable_value(&mut brush.axis, a, name);
             }
         });
     }
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("mirror");
         ui.checkbox(&mut brush.mirror[0], "X");
         ui.checkbox(&mut brush.mirror[1], "Y");
@@ -161,7 +211,7 @@ fn tools(
     if brush.mirror.iter().any(|m| *m) {
         let dims = doc.scene.world.dims().voxels();
         let mut c = brush.centre(dims);
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             ui.label("centre");
             let mut changed = false;
             for k in 0..3 {
@@ -246,7 +296,7 @@ fn selection(ui: &mut egui::Ui, brush: &mut Brush, doc: &Document, out: &mut Vec
         button(ui, has_copy, "Paste", "Ctrl+V, then click", Action::Paste);
     });
     ui.add_enabled_ui(has, |ui| {
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             ui.label("move");
             for (name, n) in [
                 ("left", Nudge::Left),
@@ -275,21 +325,28 @@ fn palette(
     table: &MaterialTable,
     out: &mut Vec<UiEvent>,
 ) {
-    ui.label("colours (click one, then edit it)");
-    egui::Grid::new("palette")
+    ui.label("click: paint with a colour · right-click: edit it");
+    let current = table.get(brush.material).map(|m| m.colour).ok();
+    let grid = egui::Grid::new("palette")
         .spacing(egui::vec2(1.0, 1.0))
+        .min_col_width(12.5)
         .show(ui, |ui| {
             for row in 0..16u8 {
                 for col in 0..16u8 {
                     let i = row * 16 + col;
-                    if swatch(ui, rgb(table, i), state.colour == i, 12.0).clicked() {
+                    let r = swatch(ui, rgb(table, i), current == Some(i), 12.5);
+                    if r.clicked() {
+                        paint_with_colour(i, state, brush, table, out);
+                    }
+                    if r.secondary_clicked() {
                         state.colour = i;
                     }
                 }
                 ui.end_row();
             }
         });
-    ui.horizontal(|ui| {
+    state.palette_grid = Some(grid.response.rect);
+    ui.horizontal_wrapped(|ui| {
         if ui
             .button("Load palette…")
             .on_hover_text("a 256 × 1 PNG strip or a .vox file")
@@ -301,7 +358,7 @@ fn palette(
             out.push(UiEvent::PaletteFile { save: true });
         }
     });
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         let mut c = table.colour(state.colour);
         ui.label(format!("colour {}", state.colour));
         if ui.color_edit_button_srgb(&mut c).changed() {
@@ -353,7 +410,7 @@ fn palette(
             });
         }
     }
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         swatch(ui, rgb(table, m.colour), false, 16.0);
         ui.label(format!("colour {}", m.colour));
         if m.colour != state.colour && ui.button("use the selected colour").clicked() {
@@ -366,7 +423,7 @@ fn palette(
             material: spec,
         });
     }
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         if table.len() < 256 && ui.button("duplicate as a new material").clicked() {
             out.push(UiEvent::AddMaterial(spec));
             brush.material = table.len() as u8;
@@ -380,6 +437,38 @@ fn palette(
             out.push(UiEvent::Action(Action::RemoveUnusedMaterials));
         }
     });
+}
+
+/// A palette click: the brush paints with colour `i` — the first material of that colour
+/// (a lambertian one first), else a new lambertian material of it.
+fn paint_with_colour(
+    i: u8,
+    state: &mut EditingState,
+    brush: &mut Brush,
+    table: &MaterialTable,
+    out: &mut Vec<UiEvent>,
+) {
+    state.colour = i;
+    brush.tool = Tool::Brush;
+    let of_colour = |lambertian: bool| {
+        (0..table.len()).find(|&k| {
+            table
+                .get(k as u8)
+                .is_ok_and(|m| m.colour == i && (!lambertian || m.kind == MaterialKind::Lambertian))
+        })
+    };
+    match of_colour(true).or_else(|| of_colour(false)) {
+        Some(k) => brush.material = k as u8,
+        None if table.len() < 256 => {
+            out.push(UiEvent::AddMaterial(MaterialSpec {
+                kind: KindSpec::Lambertian,
+                param: 0,
+                colour: i,
+            }));
+            brush.material = table.len() as u8;
+        }
+        None => {}
+    }
 }
 
 fn history(ui: &mut egui::Ui, doc: &Document, out: &mut Vec<UiEvent>) {

@@ -37,6 +37,8 @@ pub enum Input {
     },
     /// The modifier keys held changed.
     Modifiers(Mods),
+    /// Text typed (egui's alone: a window's egui-winit takes it from the key events itself).
+    Text(String),
     /// The wheel turned, in lines (up positive).
     Wheel(f64),
     /// The window's inner size changed, in physical pixels.
@@ -158,6 +160,7 @@ impl Input {
                 phase: egui::TouchPhase::Move,
                 modifiers,
             }],
+            Self::Text(text) => vec![egui::Event::Text(text.clone())],
             Self::Modifiers(_) | Self::Resized(..) | Self::Dropped(_) | Self::Close => Vec::new(),
         }
     }

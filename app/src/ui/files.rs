@@ -11,9 +11,6 @@ use crossbeam_channel::{Receiver, Sender};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, RwLock};
 
-/// What a dialog that could not open reports.
-pub const NO_DIALOG: &str = "no file dialog could be shown (is xdg-desktop-portal running?)";
-
 /// Recent files kept.
 const RECENT: usize = 10;
 
@@ -143,7 +140,7 @@ impl ConfigDir {
 pub type SharedDocument = Arc<RwLock<Document>>;
 
 /// Why a file was asked for.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Purpose {
     /// Replace the document.
     Open,
@@ -161,8 +158,18 @@ pub enum Purpose {
 
 /// A finished piece of background work.
 pub enum Done {
-    /// A file dialog closed (None: cancelled or no dialog available, with the reason).
-    Picked(Purpose, Result<Option<PathBuf>, String>),
+    /// A file dialog closed (None: cancelled).
+    Picked(Purpose, Option<PathBuf>),
+    /// No native dialog could be shown: the in-app browser asks instead, starting in
+    /// `folder` with `name` filled in.
+    NoDialog {
+        /// What the path is for.
+        purpose: Purpose,
+        /// Where to start.
+        folder: Option<PathBuf>,
+        /// The suggested file name.
+        name: Option<String>,
+    },
     /// A scene was loaded (or failed to) from a path, or built (the default scene: None).
     Loaded(Option<PathBuf>, Box<Result<Scene>>),
     /// A palette was read (or failed to).
@@ -220,47 +227,47 @@ impl FileWorker {
     /// A native file dialog on its own thread (the frame loop never waits for it).
     pub fn pick(&mut self, purpose: Purpose, folder: Option<PathBuf>, name: Option<String>) {
         let label = format!("{purpose:?} dialog");
-        if !self.dialogs {
-            self.spawn(label, move || {
-                Done::Picked(purpose, Err(NO_DIALOG.to_string()))
-            });
-            return;
-        }
+        let dialogs = self.dialogs;
         self.spawn(label, move || {
-            let mut d = rfd::FileDialog::new();
-            d = match purpose {
-                Purpose::Open => d.add_filter("Scenes", &["ron", "vox"]),
-                Purpose::Import => d.add_filter("MagicaVoxel", &["vox"]),
-                Purpose::SaveAs => d.add_filter("voxbrick project", &["ron"]),
-                Purpose::Export => d.add_filter("MagicaVoxel", &["vox"]),
-                Purpose::LoadPalette => d.add_filter("Palette", &["png", "vox"]),
-                Purpose::SavePalette => d.add_filter("PNG palette strip", &["png"]),
+            let no_dialog = |folder, name| Done::NoDialog {
+                purpose,
+                folder,
+                name,
             };
-            if let Some(f) = folder {
+            if !dialogs {
+                return no_dialog(folder, name);
+            }
+            let (what, exts) = super::browser::filter(purpose);
+            let mut d = rfd::FileDialog::new().add_filter(what, exts);
+            if let Some(f) = &folder {
                 d = d.set_directory(f);
             }
-            if let Some(n) = name {
+            if let Some(n) = &name {
                 d = d.set_file_name(n);
             }
             let started = std::time::Instant::now();
-            let picked = match purpose {
-                Purpose::Open | Purpose::Import | Purpose::LoadPalette => d.pick_file(),
-                Purpose::SaveAs | Purpose::Export | Purpose::SavePalette => d.save_file(),
-            };
+            let saves = super::browser::saves(purpose);
+            let picked = if saves { d.save_file() } else { d.pick_file() };
             // rfd answers "cancelled" at once when no dialog can be shown (no
-            // xdg-desktop-portal); nobody cancels a dialog that fast.
+            // xdg-desktop-portal); nobody cancels a dialog that fast. Then zenity or
+            // kdialog where one is installed, else the in-app browser.
             if picked.is_none() && started.elapsed() < std::time::Duration::from_millis(150) {
-                return Done::Picked(purpose, Err(NO_DIALOG.to_string()));
+                return match super::dialog_tools::pick(purpose, folder.as_deref(), name.as_deref())
+                {
+                    Some(picked) => Done::Picked(purpose, picked),
+                    None => no_dialog(folder, name),
+                };
             }
-            Done::Picked(purpose, Ok(picked))
+            Done::Picked(purpose, picked)
         });
     }
 
     /// Loads a scene (.ron or .vox) on a worker thread.
     pub fn load(&mut self, path: PathBuf, workers: usize) {
         self.spawn(format!("opening {}", path.display()), move || {
+            // The format's error names the file already.
             let scene =
-                Scene::load(&path, workers).with_context(|| format!("opening {}", path.display()));
+                Scene::load(&path, workers).map_err(|e| anyhow::anyhow!("Could not open {e}"));
             Done::Loaded(Some(path), Box::new(scene))
         });
     }
@@ -340,26 +347,14 @@ pub fn new_scene(size: (u32, u32, u32), terrain: bool, workers: usize) -> Result
     Ok(scene)
 }
 
-/// Where a save goes when no dialog can ask: `name` in `folder`, numbered so nothing is
-/// overwritten.
-pub fn fallback_path(folder: &Path, name: &str, extension: &str) -> PathBuf {
-    let first = folder.join(format!("{name}.{extension}"));
-    if !first.exists() {
-        return first;
-    }
-    (2..)
-        .map(|n| folder.join(format!("{name}-{n}.{extension}")))
-        .find(|p| !p.exists())
-        .expect("some number is free")
-}
-
 fn save_scene(scene: &Scene, path: &Path, autosave: bool) -> Result<()> {
     if autosave && let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
+    // The format's error names the file already.
     scene
         .save(path)
-        .with_context(|| format!("saving {}", path.display()))
+        .map_err(|e| anyhow::anyhow!("Could not save {e}; pick another place with Save As"))
 }
 
 /// The window title: file name (or "untitled"), an unsaved-changes mark, the program.
@@ -440,18 +435,6 @@ mod tests {
         assert_eq!(
             (partial.exposure, partial.target_spp),
             (1.5, ViewSettings::default().target_spp)
-        );
-    }
-
-    #[test]
-    fn a_save_without_a_dialog_never_overwrites() {
-        let dir = temp("fallback");
-        let first = fallback_path(&dir, "untitled", "ron");
-        assert_eq!(first, dir.join("untitled.ron"));
-        std::fs::write(&first, b"x").unwrap();
-        assert_eq!(
-            fallback_path(&dir, "untitled", "ron"),
-            dir.join("untitled-2.ron")
         );
     }
 

@@ -60,6 +60,7 @@ impl Editor {
         size: (u32, u32),
     ) -> Result<()> {
         self.window_size = size;
+        self.view_area = (0, 0, size.0, size.1);
         let viewport = {
             let doc = self.read();
             let view = doc.scene.world.read();
@@ -154,7 +155,8 @@ impl Editor {
         let samples = gfx.viewport.samples();
         let gpu_ms = gfx.viewport.last_gpu_seconds().map_or(0.0, |s| s * 1e3);
         let size = gfx.host.inner_size();
-        let internal = gfx.viewport.fit_internal(self.internal_size(size));
+        let shown = (self.view_area.2, self.view_area.3);
+        let internal = gfx.viewport.fit_internal(self.internal_size(shown));
         let paths = internal.0 as f64 * internal.1 as f64 * self.last_added as f64;
         self.panels.status = format!(
             "{samples}/{} spp · GPU {gpu_ms:.2} ms/frame · {:.1} Mpaths/s · internal {}x{}{} · {}{}",
@@ -228,6 +230,14 @@ impl Editor {
         for e in events {
             self.ui_event(e);
         }
+        // The viewport is what the bars and docks left this frame (a script run's capture
+        // is compared with whole-window renders: the whole window, the panels over it).
+        self.view_area = match self.panels.viewport {
+            Some(r) if self.script.is_none() => pixel_area(r, self.egui.pixels_per_point(), size),
+            _ => (0, 0, size.0, size.1),
+        };
+        let shown = (self.view_area.2, self.view_area.3);
+        let internal = gfx.viewport.fit_internal(self.internal_size(shown));
         let egui::FullOutput {
             platform_output,
             textures_delta,
@@ -244,7 +254,7 @@ impl Editor {
         let moving = Instant::now() < self.moving_until || self.drawing.is_some();
         let internal = if moving {
             scaled(
-                size,
+                shown,
                 self.settings.moving_scale.min(self.settings.internal_scale),
             )
         } else {
@@ -257,7 +267,7 @@ impl Editor {
         let request = FrameRequest {
             params: &params,
             internal,
-            output: size,
+            output: shown,
             spp: self.spp_per_frame,
             target_spp: self.settings.target_spp,
             exposure: doc.scene.params.settings.exposure + self.settings.exposure,
@@ -274,6 +284,7 @@ impl Editor {
             &mut gfx.viewport,
             &doc.scene.world,
             &request,
+            Some(self.view_area),
             ui,
             capture_now,
         )?;
@@ -387,5 +398,18 @@ pub(super) fn scaled((w, h): (u32, u32), f: f32) -> (u32, u32) {
     (
         ((w as f64 * f).ceil() as u32).max(1),
         ((h as f64 * f).ceil() as u32).max(1),
+    )
+}
+
+/// A rectangle in points as whole pixels inside a window of `size`: at least one pixel.
+fn pixel_area(r: egui::Rect, ppp: f32, size: (u32, u32)) -> (u32, u32, u32, u32) {
+    let px = |v: f32, max: u32| ((v * ppp).round().max(0.0) as u32).min(max);
+    let (x0, y0) = (px(r.min.x, size.0), px(r.min.y, size.1));
+    let (x1, y1) = (px(r.max.x, size.0), px(r.max.y, size.1));
+    (
+        x0.min(size.0.saturating_sub(1)),
+        y0.min(size.1.saturating_sub(1)),
+        x1.saturating_sub(x0).max(1),
+        y1.saturating_sub(y0).max(1),
     )
 }

@@ -60,15 +60,19 @@ impl Editor {
                 }
             }
             Input::Modifiers(m) => self.mods = m,
+            // egui's alone.
+            Input::Text(_) => {}
             Input::Key {
                 code,
                 pressed,
                 repeat,
             } => self.key(code, pressed, repeat, consumed),
-            Input::Button { button, pressed } => self.button(button, pressed, consumed),
+            // Pointer input is judged by where it happens against the UI as last drawn (what
+            // the user saw), not by egui's idea of the pointer, which is a frame behind.
+            Input::Button { button, pressed } => self.button(button, pressed),
             Input::Moved { x, y } => self.cursor_moved(x, y),
             Input::Wheel(steps) => {
-                if consumed || self.egui.egui_wants_pointer_input() {
+                if self.on_ui(self.cursor) {
                     return;
                 }
                 self.zoom(steps);
@@ -78,7 +82,11 @@ impl Editor {
 
     fn key(&mut self, code: KeyCode, pressed: bool, repeat: bool, consumed: bool) {
         if !pressed {
-            self.flying.remove(&code);
+            if self.flying.contains(&code) {
+                // The flight lasts until the release, not until the last frame before it.
+                self.tick_fly();
+                self.flying.remove(&code);
+            }
             return;
         }
         if consumed || self.egui.egui_wants_keyboard_input() {
@@ -98,18 +106,41 @@ impl Editor {
                 self.action(a);
             }
         } else if !self.mods.ctrl && input::fly_axis(code).is_some() {
-            self.last_tick = Instant::now();
+            // Keys already held fly until now in their old direction; a first key starts
+            // the clock.
+            if self.flying.is_empty() {
+                self.last_tick = Instant::now();
+            } else {
+                self.tick_fly();
+            }
             self.flying.insert(code);
             self.moved();
         }
     }
 
-    fn button(&mut self, button: MouseButton, pressed: bool, consumed: bool) {
+    /// Whether the window point `(x, y)` (pixels) is the UI's as the last frame drew it: a
+    /// window, a menu bar or status line over it, or any point while a menu or another popup
+    /// is open (a click then only closes it). A press there belongs to the UI until its
+    /// release; the viewport never sees it.
+    pub(super) fn on_ui(&self, at: (f64, f64)) -> bool {
+        egui::Popup::is_any_open(&self.egui) || self.covered(at)
+    }
+
+    /// Whether a panel, the bars or a window cover the window point `(x, y)` (pixels), as
+    /// drawn in the last frame; outside the viewport's rectangle counts as covered.
+    pub(super) fn covered(&self, (x, y): (f64, f64)) -> bool {
+        let ppp = f64::from(self.egui.pixels_per_point());
+        let pos = egui::pos2((x / ppp) as f32, (y / ppp) as f32);
+        let over_window = self
+            .egui
+            .layer_id_at(pos)
+            .is_some_and(|l| l.order != egui::Order::Background);
+        over_window || !self.panels.viewport.is_some_and(|r| r.contains(pos))
+    }
+
+    fn button(&mut self, button: MouseButton, pressed: bool) {
         self.request_redraw();
-        // A click that closes an open menu only closes it (egui closes the menu when it sees
-        // the click in its next pass; the menu is still open now).
-        let menu_open = egui::Popup::is_any_open(&self.egui);
-        let free = !consumed && !self.egui.egui_wants_pointer_input() && !menu_open;
+        let free = !self.on_ui(self.cursor);
         match (pressed, button) {
             (true, MouseButton::Left) if free => self.press(),
             (false, MouseButton::Left) if self.drawing.is_some() => {
@@ -141,7 +172,7 @@ impl Editor {
         // The preview follows the cursor.
         self.request_redraw();
         if let Some((drag, _)) = self.drag {
-            let h = self.window_size.1.max(1) as f64;
+            let h = self.view_area.3.max(1) as f64;
             let (dx, dy) = (self.cursor.0 - previous.0, self.cursor.1 - previous.1);
             match drag {
                 Drag::Orbit => self.view.orbit(-dx * 0.3, -dy * 0.3),
@@ -249,7 +280,7 @@ impl Editor {
             }
             Some(_) => None,
             None => {
-                if self.egui.egui_wants_pointer_input() || self.egui.is_pointer_over_egui() {
+                if self.on_ui(self.cursor) {
                     return None;
                 }
                 let (origin, dir) = self.cursor_ray();
@@ -281,12 +312,15 @@ impl Editor {
         self.moved();
     }
 
+    /// Held movement keys move the camera by the time since the last tick (a key's press,
+    /// a frame, a release): the same distance per second at any frame rate. A headless
+    /// editor moves 1/60 s per tick, so that its session is a function of its input.
     pub(super) fn tick_fly(&mut self) {
         let now = Instant::now();
-        let dt = if self.headless {
+        let dt = if self.headless && !self.fly_real_time {
             1.0 / 60.0
         } else {
-            (now - self.last_tick).as_secs_f64().min(0.1)
+            (now - self.last_tick).as_secs_f64()
         };
         self.last_tick = now;
         if self.flying.is_empty() {

@@ -123,6 +123,17 @@ impl Editor {
             .map_or(0, |g| g.viewport.ctx().validation_errors() as u64)
     }
 
+    /// Where the viewport shows in the window (x, y, width, height in pixels, as last drawn).
+    pub fn view_area(&self) -> (u32, u32, u32, u32) {
+        self.view_area
+    }
+
+    /// The view's ray through a window point (pixels): what a click there would pick.
+    pub fn ray_at(&self, x: f64, y: f64) -> (DVec3, DVec3) {
+        let (u, v) = self.ndc((x, y));
+        self.view.ray(u, v, self.aspect())
+    }
+
     /// The window's size in physical pixels.
     pub fn size(&self) -> (u32, u32) {
         self.window_size
@@ -138,19 +149,52 @@ impl Editor {
     /// last frame): the places a user would aim at to reach it.
     pub fn aim(&self, p: DVec3) -> Option<(f64, f64)> {
         let (u, v) = self.view.project(p, self.aspect())?;
+        let (x0, y0, w, h) = self.view_area;
+        let x = f64::from(x0) + (u + 1.0) * 0.5 * f64::from(w);
+        let y = f64::from(y0) + (1.0 - v) * 0.5 * f64::from(h);
         let (w, h) = self.window_size;
-        let x = (u + 1.0) * 0.5 * f64::from(w);
-        let y = (1.0 - v) * 0.5 * f64::from(h);
         let inside =
             (1.0..f64::from(w) - 1.0).contains(&x) && (1.0..f64::from(h) - 1.0).contains(&y);
+        (inside && !self.covered((x, y))).then_some((x, y))
+    }
+
+    /// Whether a press at the window point `(x, y)` (pixels) would be the UI's (a panel, a
+    /// bar or a window under it as last drawn, or a popup open) rather than the viewport's.
+    pub fn on_ui_at(&self, x: f64, y: f64) -> bool {
+        self.on_ui((x, y))
+    }
+
+    /// Where the palette's 16 × 16 colours show (x, y, width, height in pixels, as last
+    /// drawn; None while its dock is collapsed).
+    pub fn palette_grid(&self) -> Option<(f64, f64, f64, f64)> {
+        let r = self.panels.editing.palette_grid?;
         let ppp = f64::from(self.egui.pixels_per_point());
-        let pos = egui::pos2((x / ppp) as f32, (y / ppp) as f32);
-        let covered = self
-            .egui
-            .layer_id_at(pos)
-            .is_some_and(|l| l.order != egui::Order::Background);
-        let free = self.panels.between_bars.is_some_and(|r| r.contains(pos)) && !covered;
-        (inside && free).then_some((x, y))
+        Some((
+            f64::from(r.min.x) * ppp,
+            f64::from(r.min.y) * ppp,
+            f64::from(r.width()) * ppp,
+            f64::from(r.height()) * ppp,
+        ))
+    }
+
+    /// Whether the in-app file browser is open.
+    pub fn browser_open(&self) -> bool {
+        self.panels.browser.is_some()
+    }
+
+    /// The status line's passing message, if one shows.
+    pub fn notice(&self) -> Option<&str> {
+        self.panels.notice.as_ref().map(|(t, _)| t.as_str())
+    }
+
+    /// Fly keys move by the time that passed, as in a window (not 1/60 s per tick).
+    pub fn fly_in_real_time(&mut self) {
+        self.fly_real_time = true;
+    }
+
+    /// The view camera.
+    pub fn view(&self) -> &ViewCamera {
+        &self.view
     }
 
     /// Whether a menu or another popup is open (as of the last frame).

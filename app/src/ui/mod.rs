@@ -4,7 +4,10 @@
 //! through the GPU session ([`Viewport`]) and the window's [`Presenter`]. Progressive
 //! refinement adds samples until the target, then the loop waits for events.
 
+mod actions;
+mod browser;
 pub mod camera;
+mod dialog_tools;
 mod document;
 mod editing;
 pub mod event;
@@ -224,6 +227,9 @@ pub struct Editor {
     keymap: keymap::KeyMap,
     /// The window's inner size in physical pixels (cursor positions are in these).
     window_size: (u32, u32),
+    /// Where the viewport shows in the window (x, y, width, height in pixels): what the bars
+    /// and docked panels leave, as last drawn. Framing, picking and the camera's aspect use it.
+    view_area: (u32, u32, u32, u32),
     /// The stroke being drawn with the left button.
     drawing: Option<Drawing>,
     /// What a click would change, under the cursor.
@@ -240,6 +246,8 @@ pub struct Editor {
     /// No window: frames are drawn offscreen, no native dialog is shown, fly keys move the
     /// camera a fixed 1/60 s per frame (a headless session is a function of its input).
     headless: bool,
+    /// Fly keys move by the time that passed even without a window (tests of the fly speed).
+    fly_real_time: bool,
     /// The editor asked to stop (the window loop exits; a headless driver is told).
     exit: bool,
     /// Files opened since the recording started (each copied beside it).
@@ -345,6 +353,7 @@ impl Editor {
             frames: 0,
             keymap: Default::default(),
             window_size: (16, 9),
+            view_area: (0, 0, 16, 9),
             drawing: None,
             preview: preview::Preview::new(wake_preview),
             selecting: None,
@@ -356,6 +365,7 @@ impl Editor {
             script: script_run,
             options,
             headless,
+            fly_real_time: false,
             exit: false,
             recorded_opens: 0,
             ended_recording: None,
@@ -396,139 +406,6 @@ impl Editor {
         Ok(editor)
     }
 
-    fn action(&mut self, action: Action) {
-        match action {
-            Action::Undo => self.edits.submit(&self.doc, Edit::Undo),
-            Action::Redo => self.edits.submit(&self.doc, Edit::Redo),
-            Action::New => self.panels.new_open = true,
-            Action::Open => self.guard_unsaved(Pending::Open(None)),
-            Action::Save => self.save(false),
-            Action::SaveAs => self.save(true),
-            Action::Import => self.files.pick(Purpose::Import, self.folder(), None),
-            Action::Export => {
-                self.files
-                    .pick(Purpose::Export, self.folder(), Some("scene.vox".into()))
-            }
-            Action::Frame => {
-                let (min, max) = content_bounds(&self.read().scene);
-                self.view.frame(min, max);
-                self.moved();
-            }
-            Action::ToggleProjection => {
-                let size = self.read().scene.world.dims().voxels().as_dvec3();
-                self.view.toggle_projection(DVec3::ZERO, size);
-                self.moved();
-            }
-            Action::StoreView(n) => self.slots[n as usize - 1] = Some(self.view.clone()),
-            Action::RecallView(n) => {
-                if let Some(v) = self.slots[n as usize - 1].clone() {
-                    self.view = v;
-                    self.moved();
-                }
-            }
-            Action::BrushSmaller => self.settings.brush.resize(-1.0),
-            Action::BrushLarger => self.settings.brush.resize(1.0),
-            Action::Mode(m) => {
-                self.settings.brush.mode = m;
-                self.settings.brush.tool = Tool::Brush;
-            }
-            Action::Shape(s) => {
-                self.settings.brush.shape = s;
-                self.settings.brush.tool = Tool::Brush;
-            }
-            Action::SelectTool => self.settings.brush.tool = Tool::Select,
-            Action::RemoveUnusedMaterials => self.execute(Command::RemoveUnusedMaterials),
-            Action::SelectAll => self.select(SelectOp::All),
-            Action::SelectNone => self.select(SelectOp::None),
-            Action::DeleteSelection => self.execute(Command::DeleteSelection),
-            Action::FillSelection => {
-                self.execute(Command::FillSelection(self.settings.brush.material))
-            }
-            Action::PaintSelection => {
-                self.execute(Command::PaintSelection(self.settings.brush.material))
-            }
-            Action::Copy => self.execute(Command::Copy),
-            Action::Cut => self.execute(Command::Cut),
-            // The copy is on the document once queued edits (a copy just asked for) ran;
-            // until then the placement shows nothing and a click pastes nothing.
-            Action::Paste => self.pasting = true,
-            Action::Nudge(n) => self.nudge(n),
-            Action::Help => self.panels.help_open = !self.panels.help_open,
-            Action::Quit => self.guard_unsaved(Pending::Quit),
-        }
-    }
-
-    fn ui_event(&mut self, e: UiEvent) {
-        match e {
-            UiEvent::Action(a) => self.action(a),
-            UiEvent::OpenRecent(p) => self.guard_unsaved(Pending::Open(Some(p))),
-            UiEvent::SetSun(s) => self.execute(Command::SetSun(s)),
-            UiEvent::SetSky(s) => self.execute(Command::SetSky(s)),
-            UiEvent::SetSettings(s) => self.execute(Command::SetSettings(s)),
-            // Reading and merging a file can take a while: on the worker.
-            UiEvent::Import { path, offset } => self.execute(Command::ImportVox {
-                path: path.display().to_string(),
-                offset: glam::IVec3::from_array(offset),
-            }),
-            UiEvent::SetColour { index, rgb } => self.execute(Command::SetColour { index, rgb }),
-            UiEvent::SetMaterial { index, material } => {
-                self.execute(Command::SetMaterial { index, material })
-            }
-            UiEvent::AddMaterial(m) => self.execute(Command::AddMaterial(m)),
-            UiEvent::PaletteFile { save: false } => {
-                self.files.pick(Purpose::LoadPalette, self.folder(), None)
-            }
-            UiEvent::PaletteFile { save: true } => self.files.pick(
-                Purpose::SavePalette,
-                self.folder(),
-                Some("palette.png".into()),
-            ),
-            UiEvent::SetParam { kind, index, value } => {
-                self.execute(Command::SetParam { kind, index, value })
-            }
-            UiEvent::Generate(spec) => self.execute(Command::GenerateTerrain(spec)),
-            UiEvent::Jump { undo, redo } => {
-                for _ in 0..undo {
-                    self.edits.submit(&self.doc, Edit::Undo);
-                }
-                for _ in 0..redo {
-                    self.edits.submit(&self.doc, Edit::Redo);
-                }
-            }
-            UiEvent::UseViewAsSceneCamera => {
-                self.execute(Command::SetCamera(self.view.camera.clone()))
-            }
-            UiEvent::NewScene { size, terrain } => {
-                self.guard_unsaved(Pending::New { size, terrain })
-            }
-            UiEvent::Unsaved(answer) => {
-                self.panels.asking_unsaved = false;
-                let Some(then) = self.pending.take() else {
-                    return;
-                };
-                match answer {
-                    UnsavedAnswer::Cancel => {}
-                    UnsavedAnswer::Discard => self.proceed(then),
-                    UnsavedAnswer::Save => {
-                        self.save_then = Some(then);
-                        self.save(false);
-                    }
-                }
-            }
-            UiEvent::Recover(yes) => {
-                if let Some(p) = self.panels.recovery.take() {
-                    if yes {
-                        self.awaiting_built_scene = false;
-                        self.files.load(p, self.options.workers);
-                        self.recovering = true;
-                    } else {
-                        self.config.remove_recovery();
-                    }
-                }
-            }
-        }
-    }
-
     fn moved(&mut self) {
         self.moving_until = Instant::now() + Duration::from_millis(150);
         self.move_event.get_or_insert_with(Instant::now);
@@ -541,17 +418,23 @@ impl Editor {
         }
     }
 
+    /// The viewport's aspect ratio.
     fn aspect(&self) -> f64 {
-        let (w, h) = self.window_size;
+        let (_, _, w, h) = self.view_area;
         w.max(1) as f64 / h.max(1) as f64
     }
 
-    /// Normalized device coordinates of the cursor (v up).
+    /// Normalized device coordinates of the cursor in the viewport (v up).
     fn cursor_ndc(&self) -> (f64, f64) {
-        let (w, h) = self.window_size;
+        self.ndc(self.cursor)
+    }
+
+    /// Normalized device coordinates of a window point in the viewport (v up).
+    fn ndc(&self, (x, y): (f64, f64)) -> (f64, f64) {
+        let (x0, y0, w, h) = self.view_area;
         (
-            2.0 * self.cursor.0 / w.max(1) as f64 - 1.0,
-            1.0 - 2.0 * self.cursor.1 / h.max(1) as f64,
+            2.0 * (x - f64::from(x0)) / w.max(1) as f64 - 1.0,
+            1.0 - 2.0 * (y - f64::from(y0)) / h.max(1) as f64,
         )
     }
 

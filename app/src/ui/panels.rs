@@ -106,6 +106,10 @@ pub enum UiEvent {
     },
     /// The unsaved-changes question was answered.
     Unsaved(UnsavedAnswer),
+    /// The in-app file browser confirmed a path for this purpose.
+    Picked(super::files::Purpose, PathBuf),
+    /// The in-app file browser was closed without a choice.
+    PickCancelled,
     /// The recovery offer was answered (true: recover).
     Recover(bool),
     /// New scene of this size in voxels, terrain or empty.
@@ -157,6 +161,11 @@ pub struct PanelState {
     pub recent: Vec<PathBuf>,
     /// Status line: device, samples, timings.
     pub status: String,
+    /// The in-app file browser (no native dialog could be shown), with its places.
+    pub browser: Option<(super::browser::Browser, Vec<(String, PathBuf)>)>,
+    /// A passing message on the status line (a save done, an undo with nothing to undo)
+    /// and when it was given; shown for [`NOTICE_SECS`].
+    pub notice: Option<(String, std::time::Instant)>,
     /// Scene statistics text (refreshed when the scene changes).
     pub stats: String,
     /// Background jobs running.
@@ -165,8 +174,19 @@ pub struct PanelState {
     pub editing: super::editing::EditingState,
     /// The key map's bindings (chord, action) for the shortcut list.
     pub keys: Vec<(String, String)>,
-    /// The window's area between the menu bar and the status line, in points (last frame).
-    pub between_bars: Option<egui::Rect>,
+    /// The viewport's rectangle: what the menu bar, the status line and the docked panels
+    /// leave of the window, in points (last frame).
+    pub viewport: Option<egui::Rect>,
+}
+
+/// How long a status-line notice stays.
+pub const NOTICE_SECS: f32 = 4.0;
+
+impl PanelState {
+    /// A passing message on the status line (replacing the one before).
+    pub fn notify(&mut self, text: impl Into<String>) {
+        self.notice = Some((text.into(), std::time::Instant::now()));
+    }
 }
 
 /// Draws the panels; returns what the user asked for.
@@ -275,7 +295,9 @@ pub fn draw(
                 let mut tools = !state.editing.tools_hidden;
                 ui.checkbox(&mut tools, "Tools");
                 state.editing.tools_hidden = !tools;
-                ui.checkbox(&mut state.editing.palette_open, "Palette and materials");
+                let mut palette = !state.editing.palette_hidden;
+                ui.checkbox(&mut palette, "Palette and materials");
+                state.editing.palette_hidden = !palette;
                 ui.checkbox(&mut state.editing.history_open, "History");
                 if ui.button("Terrain and water…").clicked() {
                     let d = doc.scene.world.dims().voxels();
@@ -292,20 +314,42 @@ pub fn draw(
         });
     });
     egui::Panel::bottom("status").show(root, |ui| {
-        ui.label(&state.status);
+        ui.horizontal(|ui| {
+            if let Some((text, at)) = &state.notice {
+                let left = NOTICE_SECS - at.elapsed().as_secs_f32();
+                if left > 0.0 {
+                    ui.strong(text);
+                    ui.separator();
+                    ctx.request_repaint_after(std::time::Duration::from_secs_f32(left));
+                } else {
+                    state.notice = None;
+                }
+            }
+            ui.label(&state.status);
+        });
     });
-    // Windows stay between the menu bar and the status line (in a small window egui would
-    // otherwise push a tall one up over the menus).
+    // The file browser may use the whole width between the bars (it asks before anything
+    // else goes on); the other windows stay in the viewport.
+    let between_bars = root.available_rect_before_wrap();
+    super::editing::docks(root, &mut state.editing, doc, &mut view.brush, &mut out);
+    // The viewport is what the bars and the docks leave; windows stay inside it (in a small
+    // window egui would otherwise push a tall one up over the menus).
     let area = root.available_rect_before_wrap();
-    state.between_bars = Some(area);
-    super::editing::draw(
-        ctx,
-        area,
-        &mut state.editing,
-        doc,
-        &mut view.brush,
-        &mut out,
-    );
+    state.viewport = Some(area);
+    super::editing::draw(ctx, area, &mut state.editing, doc, &mut out);
+    if let Some((browser, places)) = &mut state.browser {
+        match browser.draw(ctx, between_bars, places) {
+            super::browser::Answer::Open => {}
+            super::browser::Answer::Cancelled => {
+                state.browser = None;
+                out.push(UiEvent::PickCancelled);
+            }
+            super::browser::Answer::Chosen(path) => {
+                out.push(UiEvent::Picked(browser.purpose, path));
+                state.browser = None;
+            }
+        }
+    }
     if state.render_open {
         let mut open = true;
         window(area, "Render settings")

@@ -1,0 +1,143 @@
+//! What the user asked for → the editor: key-map actions (menus and shortcuts) and the
+//! panels' events, each turned into an edit on the edit thread, a file job, a camera change
+//! or a panel's state.
+
+use super::*;
+
+impl Editor {
+    pub(super) fn action(&mut self, action: Action) {
+        match action {
+            Action::Undo => self.edits.submit(&self.doc, Edit::Undo),
+            Action::Redo => self.edits.submit(&self.doc, Edit::Redo),
+            Action::New => self.panels.new_open = true,
+            Action::Open => self.guard_unsaved(Pending::Open(None)),
+            Action::Save => self.save(false),
+            Action::SaveAs => self.save(true),
+            Action::Import => self.files.pick(Purpose::Import, self.folder(), None),
+            Action::Export => {
+                self.files
+                    .pick(Purpose::Export, self.folder(), Some("scene.vox".into()))
+            }
+            Action::Frame => {
+                let (min, max) = content_bounds(&self.read().scene);
+                let aspect = self.aspect();
+                self.view.frame(min, max, aspect);
+                self.moved();
+            }
+            Action::ToggleProjection => {
+                let size = self.read().scene.world.dims().voxels().as_dvec3();
+                self.view.toggle_projection(DVec3::ZERO, size);
+                self.moved();
+            }
+            Action::StoreView(n) => self.slots[n as usize - 1] = Some(self.view.clone()),
+            Action::RecallView(n) => {
+                if let Some(v) = self.slots[n as usize - 1].clone() {
+                    self.view = v;
+                    self.moved();
+                }
+            }
+            Action::BrushSmaller => self.settings.brush.resize(-1.0),
+            Action::BrushLarger => self.settings.brush.resize(1.0),
+            Action::Mode(m) => {
+                self.settings.brush.mode = m;
+                self.settings.brush.tool = Tool::Brush;
+            }
+            Action::Shape(s) => {
+                self.settings.brush.shape = s;
+                self.settings.brush.tool = Tool::Brush;
+            }
+            Action::SelectTool => self.settings.brush.tool = Tool::Select,
+            Action::RemoveUnusedMaterials => self.execute(Command::RemoveUnusedMaterials),
+            Action::SelectAll => self.select(SelectOp::All),
+            Action::SelectNone => self.select(SelectOp::None),
+            Action::DeleteSelection => self.execute(Command::DeleteSelection),
+            Action::FillSelection => {
+                self.execute(Command::FillSelection(self.settings.brush.material))
+            }
+            Action::PaintSelection => {
+                self.execute(Command::PaintSelection(self.settings.brush.material))
+            }
+            Action::Copy => self.execute(Command::Copy),
+            Action::Cut => self.execute(Command::Cut),
+            // The copy is on the document once queued edits (a copy just asked for) ran;
+            // until then the placement shows nothing and a click pastes nothing.
+            Action::Paste => self.pasting = true,
+            Action::Nudge(n) => self.nudge(n),
+            Action::Help => self.panels.help_open = !self.panels.help_open,
+            Action::Quit => self.guard_unsaved(Pending::Quit),
+        }
+    }
+
+    pub(super) fn ui_event(&mut self, e: UiEvent) {
+        match e {
+            UiEvent::Action(a) => self.action(a),
+            UiEvent::OpenRecent(p) => self.guard_unsaved(Pending::Open(Some(p))),
+            UiEvent::SetSun(s) => self.execute(Command::SetSun(s)),
+            UiEvent::SetSky(s) => self.execute(Command::SetSky(s)),
+            UiEvent::SetSettings(s) => self.execute(Command::SetSettings(s)),
+            // Reading and merging a file can take a while: on the worker.
+            UiEvent::Import { path, offset } => self.execute(Command::ImportVox {
+                path: path.display().to_string(),
+                offset: glam::IVec3::from_array(offset),
+            }),
+            UiEvent::SetColour { index, rgb } => self.execute(Command::SetColour { index, rgb }),
+            UiEvent::SetMaterial { index, material } => {
+                self.execute(Command::SetMaterial { index, material })
+            }
+            UiEvent::AddMaterial(m) => self.execute(Command::AddMaterial(m)),
+            UiEvent::PaletteFile { save: false } => {
+                self.files.pick(Purpose::LoadPalette, self.folder(), None)
+            }
+            UiEvent::PaletteFile { save: true } => self.files.pick(
+                Purpose::SavePalette,
+                self.folder(),
+                Some("palette.png".into()),
+            ),
+            UiEvent::SetParam { kind, index, value } => {
+                self.execute(Command::SetParam { kind, index, value })
+            }
+            UiEvent::Generate(spec) => self.execute(Command::GenerateTerrain(spec)),
+            UiEvent::Jump { undo, redo } => {
+                for _ in 0..undo {
+                    self.edits.submit(&self.doc, Edit::Undo);
+                }
+                for _ in 0..redo {
+                    self.edits.submit(&self.doc, Edit::Redo);
+                }
+            }
+            UiEvent::UseViewAsSceneCamera => {
+                self.execute(Command::SetCamera(self.view.camera.clone()))
+            }
+            UiEvent::NewScene { size, terrain } => {
+                self.guard_unsaved(Pending::New { size, terrain })
+            }
+            UiEvent::Picked(purpose, path) => self.picked(purpose, path),
+            UiEvent::PickCancelled => self.save_then = None,
+            UiEvent::Unsaved(answer) => {
+                self.panels.asking_unsaved = false;
+                let Some(then) = self.pending.take() else {
+                    return;
+                };
+                match answer {
+                    UnsavedAnswer::Cancel => {}
+                    UnsavedAnswer::Discard => self.proceed(then),
+                    UnsavedAnswer::Save => {
+                        self.save_then = Some(then);
+                        self.save(false);
+                    }
+                }
+            }
+            UiEvent::Recover(yes) => {
+                if let Some(p) = self.panels.recovery.take() {
+                    if yes {
+                        self.awaiting_built_scene = false;
+                        self.files.load(p, self.options.workers);
+                        self.recovering = true;
+                    } else {
+                        self.config.remove_recovery();
+                    }
+                }
+            }
+        }
+    }
+}
