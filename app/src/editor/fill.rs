@@ -6,6 +6,16 @@ use brickmap::{VoxelEdit, VoxelOp};
 use glam::IVec3;
 use std::collections::VecDeque;
 
+/// The 6 face neighbours of a voxel.
+const FACES: [IVec3; 6] = [
+    IVec3::X,
+    IVec3::NEG_X,
+    IVec3::Y,
+    IVec3::NEG_Y,
+    IVec3::Z,
+    IVec3::NEG_Z,
+];
+
 /// The 26 neighbours of a voxel.
 const NEIGHBOURS: [IVec3; 26] = {
     let mut n = [IVec3::ZERO; 26];
@@ -33,16 +43,8 @@ pub(super) fn flood_fill(scene: &Scene, start: IVec3, material: u8) -> Result<Ve
     let target = view
         .voxel(start)?
         .ok_or_else(|| invalid(format!("flood fill starts at {start}, which is empty")))?;
-    let faces = [
-        IVec3::X,
-        IVec3::NEG_X,
-        IVec3::Y,
-        IVec3::NEG_Y,
-        IVec3::Z,
-        IVec3::NEG_Z,
-    ];
     let on_surface = |v: IVec3| {
-        faces
+        FACES
             .iter()
             .any(|f| !dims.contains_voxel(v + *f) || view.voxel(v + *f).ok().flatten().is_none())
     };
@@ -130,16 +132,9 @@ mod tests {
         let (scene, sphere) = sphere_on_a_floor();
         let view = scene.world.read();
         let empty_beside = |v: IVec3| {
-            [
-                IVec3::X,
-                IVec3::NEG_X,
-                IVec3::Y,
-                IVec3::NEG_Y,
-                IVec3::Z,
-                IVec3::NEG_Z,
-            ]
-            .iter()
-            .any(|f| view.voxel(v + *f).ok().flatten().is_none())
+            FACES
+                .iter()
+                .any(|f| view.voxel(v + *f).ok().flatten().is_none())
         };
         let surface: HashSet<IVec3> = sphere.into_iter().filter(|v| empty_beside(*v)).collect();
         drop(view);
