@@ -14,7 +14,8 @@ use std::time::{Duration, Instant};
 use winit::event::MouseButton;
 use winit::keyboard::KeyCode;
 
-const SIZE: (u32, u32) = (640, 400);
+/// The window the issue was found at: both docks and a viewport of 488 × 494.
+const SIZE: (u32, u32) = (960, 540);
 
 struct Session {
     ed: Editor,
@@ -423,6 +424,53 @@ fn without_a_dialog_save_as_and_open_ask_in_the_browser(s: &mut Session, dir: &s
     assert!(!s.ed.browser_open(), "Esc closes the browser");
 }
 
+/// Item 14: a new empty scene has a floor to aim at: the first click attaches on it.
+fn the_first_click_on_an_empty_scene_attaches_on_the_floor(s: &mut Session, dir: &std::path::Path) {
+    let empty = dir.join("empty.ron");
+    app::ui::files::new_scene((32, 16, 32), false, 1)
+        .unwrap()
+        .save(&empty)
+        .unwrap();
+    let generation = s.ed.generation();
+    s.ed.input(Input::Dropped(empty));
+    s.quiet();
+    s.settle();
+    s.quiet();
+    assert!(s.ed.generation() > generation, "the empty scene was opened");
+    let (x, y, w, h) = s.ed.view_area();
+    let centre = (f64::from(x + w / 2), f64::from(y + h / 2));
+    s.to(centre);
+    s.quiet();
+    s.left(true);
+    s.left(false);
+    s.quiet();
+    let doc = s.ed.document();
+    let d = doc.read().unwrap();
+    let view = d.scene.world.read();
+    let solid: Vec<IVec3> = (0..32)
+        .flat_map(|x| (0..16).flat_map(move |y| (0..32).map(move |z| IVec3::new(x, y, z))))
+        .filter(|v| matches!(view.voxel(*v), Ok(Some(_))))
+        .collect();
+    assert!(!solid.is_empty(), "the click placed nothing");
+    assert_eq!(solid.iter().map(|v| v.y).min(), Some(0), "on the floor");
+}
+
+/// Item 15: a small window folds the docks so the viewport keeps its room; back at full
+/// size they are as they were.
+fn a_small_window_folds_the_docks_and_a_large_one_brings_them_back(s: &mut Session) {
+    s.quiet();
+    let wide = s.ed.view_area();
+    s.ed.input(Input::Resized(420, 300));
+    s.quiet();
+    let (_, _, w, _) = s.ed.view_area();
+    assert!(w >= 300, "a 420 px window leaves the viewport {w} px");
+    assert!(s.ed.palette_grid().is_none(), "the palette folded");
+    s.ed.input(Input::Resized(SIZE.0, SIZE.1));
+    s.quiet();
+    assert_eq!(s.ed.view_area(), wide, "the docks came back as they were");
+    assert!(s.ed.palette_grid().is_some());
+}
+
 #[test]
 fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     let dir = window::scratch("editor-handlers");
@@ -435,6 +483,8 @@ fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     no_ops_and_saves_are_said_on_the_status_line(&mut s);
     the_docks_leave_the_viewport_framing_fits_it_and_the_palette_paints(&mut s);
     without_a_dialog_save_as_and_open_ask_in_the_browser(&mut s, &dir);
+    the_first_click_on_an_empty_scene_attaches_on_the_floor(&mut s, &dir);
+    a_small_window_folds_the_docks_and_a_large_one_brings_them_back(&mut s);
     assert!(s.ed.take_errors().is_empty());
     s.ed.close().expect("a clean session");
 }

@@ -63,6 +63,8 @@ fn kind_name(k: MaterialKind) -> &'static str {
 
 /// The docks' width in points: the palette's 16 columns of swatches and the tools' rows.
 const DOCK_WIDTH: f32 = 236.0;
+/// The narrowest viewport the docks leave; a narrower window folds them.
+const MIN_VIEWPORT: f32 = 240.0;
 
 /// The docked panels, at the window's sides: Tools on the left; the 256 colours, the
 /// current material and the history on the right. Each collapses to a strip with the button
@@ -94,8 +96,21 @@ pub fn docks(
             })
             .inner
     };
-    if state.tools_hidden {
-        state.tools_hidden = !strip(root, "tools strip", true, "Show the tools");
+    // A narrow window keeps a usable viewport: the palette's dock folds first, then the
+    // tools' (the user's choice comes back when the window is wide again).
+    let width = root.available_rect_before_wrap().width();
+    let show_tools = !state.tools_hidden && width >= DOCK_WIDTH + MIN_VIEWPORT;
+    let docks = if show_tools { 2.0 } else { 1.0 };
+    let show_palette = !state.palette_hidden && width >= docks * DOCK_WIDTH + MIN_VIEWPORT;
+    if !show_tools {
+        if strip(
+            root,
+            "tools strip",
+            true,
+            "Show the tools (a wider window has room)",
+        ) {
+            state.tools_hidden = false;
+        }
     } else {
         egui::Panel::left("tools")
             .resizable(false)
@@ -110,9 +125,16 @@ pub fn docks(
                 egui::ScrollArea::vertical().show(ui, |ui| tools(ui, brush, &table, doc, out));
             });
     }
-    if state.palette_hidden {
+    if !show_palette {
         state.palette_grid = None;
-        state.palette_hidden = !strip(root, "palette strip", false, "Show the palette");
+        if strip(
+            root,
+            "palette strip",
+            false,
+            "Show the palette (a wider window has room)",
+        ) {
+            state.palette_hidden = false;
+        }
     } else {
         egui::Panel::right("palette")
             .resizable(false)

@@ -199,11 +199,19 @@ impl Editor {
                     .update(&self.doc, stroke.as_ref(), doc.revision);
             }
             let paste = self.paste_target(&doc);
+            let view_area = self.view_area;
+            let empty = doc.scene.world.read().solid_count() == 0;
             let dragged = self.dragged_box();
             egui_ctx.run_ui(raw, |ui| {
                 // Under every panel and window, over the viewport image.
                 let painter = ui.ctx().layer_painter(egui::LayerId::background());
-                let rect = ui.ctx().content_rect();
+                // The viewport's rectangle as picking used it (the last layout's).
+                let ppp = ui.ctx().pixels_per_point();
+                let (x, y, w, h) = view_area;
+                let rect = egui::Rect::from_min_size(
+                    egui::pos2(x as f32 / ppp, y as f32 / ppp),
+                    egui::vec2(w as f32 / ppp, h as f32 / ppp),
+                );
                 self.preview.paint(&painter, &self.view, rect);
                 let brush = &self.settings.brush;
                 let dims = doc.scene.world.dims().voxels();
@@ -216,6 +224,9 @@ impl Editor {
                     dragged,
                     paste,
                 );
+                if empty {
+                    preview::paint_floor(&painter, &self.view, rect, dims);
+                }
                 preview::paint_mirror(
                     &painter,
                     &self.view,
@@ -252,11 +263,12 @@ impl Editor {
         // While the camera moves and while a stroke is drawn: the moving scale, so each
         // change shows in the next, cheaper frame.
         let moving = Instant::now() < self.moving_until || self.drawing.is_some();
+        let still = internal;
         let internal = if moving {
-            scaled(
+            self.budgeted(scaled(
                 shown,
                 self.settings.moving_scale.min(self.settings.internal_scale),
-            )
+            ))
         } else {
             internal
         };
@@ -268,7 +280,7 @@ impl Editor {
             params: &params,
             internal,
             output: shown,
-            spp: self.spp_per_frame,
+            spp: self.budget.spp,
             target_spp: self.settings.target_spp,
             exposure: doc.scene.params.settings.exposure + self.settings.exposure,
             bgra: false,
@@ -303,7 +315,11 @@ impl Editor {
                 if let Some(t) = self.move_event.take() {
                     self.latency = Some(t.elapsed());
                 }
-                self.adapt_samples(gfx.viewport.last_gpu_seconds());
+                // The budget reasons about the still image: a moving frame's time is scaled
+                // by the pixels it left out.
+                let ratio = (f64::from(still.0) * f64::from(still.1))
+                    / (f64::from(internal.0) * f64::from(internal.1)).max(1.0);
+                self.adapt_samples(gfx.viewport.last_gpu_seconds().map(|t| t * ratio));
             }
             Presented::NotReady | Presented::Recreated => gfx.host.request_redraw(),
         }
@@ -339,17 +355,25 @@ impl Editor {
         Ok(())
     }
 
+    /// The traced size for a viewport of `size`: the internal scale, then the budget's.
     pub(super) fn internal_size(&self, size: (u32, u32)) -> (u32, u32) {
-        scaled(size, self.settings.internal_scale)
+        self.budgeted(scaled(size, self.settings.internal_scale))
     }
 
-    /// Samples per frame follow the GPU time: about 16 ms of tracing per frame.
+    /// `internal` scaled by the frame budget (not in a script run: its capture is compared
+    /// with renders at the internal scale).
+    fn budgeted(&self, internal: (u32, u32)) -> (u32, u32) {
+        if self.script.is_some() {
+            internal
+        } else {
+            self.budget.apply(internal)
+        }
+    }
+
+    /// Samples per frame and the traced resolution follow the GPU time ([`budget`]).
     pub(super) fn adapt_samples(&mut self, gpu: Option<f64>) {
-        let Some(t) = gpu else { return };
-        if t < 0.008 && self.spp_per_frame < 16 {
-            self.spp_per_frame *= 2;
-        } else if t > 0.033 && self.spp_per_frame > 1 {
-            self.spp_per_frame /= 2;
+        if let Some(t) = gpu {
+            self.budget.update(t);
         }
     }
 

@@ -6,6 +6,7 @@
 
 mod actions;
 mod browser;
+mod budget;
 pub mod camera;
 mod dialog_tools;
 mod document;
@@ -201,7 +202,8 @@ pub struct Editor {
     flying: HashSet<KeyCode>,
     last_tick: Instant,
     moving_until: Instant,
-    spp_per_frame: u32,
+    /// Samples per frame and the traced resolution's scale, from the GPU time per frame.
+    budget: budget::FrameBudget,
     /// Samples per pixel the last shown frame added (0 once converged).
     last_added: u32,
     pending: Option<Pending>,
@@ -337,7 +339,7 @@ impl Editor {
             flying: HashSet::new(),
             last_tick: Instant::now(),
             moving_until: Instant::now(),
-            spp_per_frame: 1,
+            budget: Default::default(),
             last_added: 0,
             pending: None,
             save_then: None,

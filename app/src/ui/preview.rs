@@ -185,6 +185,36 @@ fn screen_point(view: &ViewCamera, rect: egui::Rect, p: DVec3) -> Option<egui::P
     })
 }
 
+/// An empty scene's bounds and floor: the grid's box, and lines on the floor every 8 voxels
+/// (every 32 in a large grid), so there is something to aim at; a click on the floor
+/// attaches there.
+pub fn paint_floor(painter: &egui::Painter, view: &ViewCamera, rect: egui::Rect, dims: IVec3) {
+    let size = dims.as_dvec3();
+    let edge = egui::Stroke::new(
+        1.0,
+        egui::Color32::from_rgba_unmultiplied(220, 220, 220, 140),
+    );
+    paint_box(painter, view, rect, DVec3::ZERO, size, edge);
+    let line = egui::Stroke::new(
+        1.0,
+        egui::Color32::from_rgba_unmultiplied(200, 200, 200, 70),
+    );
+    let step = if dims.x.max(dims.z) > 256 { 32 } else { 8 };
+    let segment = |a: DVec3, b: DVec3| {
+        if let (Some(p), Some(q)) = (screen_point(view, rect, a), screen_point(view, rect, b)) {
+            painter.line_segment([p, q], line);
+        }
+    };
+    for x in (step..dims.x).step_by(step as usize) {
+        let x = f64::from(x);
+        segment(DVec3::new(x, 0.0, 0.0), DVec3::new(x, 0.0, size.z));
+    }
+    for z in (step..dims.z).step_by(step as usize) {
+        let z = f64::from(z);
+        segment(DVec3::new(0.0, 0.0, z), DVec3::new(size.x, 0.0, z));
+    }
+}
+
 /// Draws the enabled mirror planes as their outlines across the grid (x red, y green,
 /// z blue).
 pub fn paint_mirror(
