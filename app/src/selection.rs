@@ -158,6 +158,14 @@ impl std::fmt::Debug for Clip {
 }
 
 impl Clip {
+    /// The copied voxels as bricks of the grid they came from: (brick coordinates, solid
+    /// voxels). A paste at `at` puts them `at - origin` further on.
+    pub fn source_bricks(&self) -> Vec<(IVec3, Mask)> {
+        self.bricks
+            .iter()
+            .map(|(rel, mask, _)| ((self.origin + *rel).div_euclid(IVec3::splat(8)), *mask))
+            .collect()
+    }
     /// Copies the solid voxels of `selection` (None when it selects no voxel).
     pub fn copy(view: &WorldView<'_>, selection: &Selection) -> Option<Clip> {
         let (lo, hi) = selection.voxels.bounds()?;

@@ -471,6 +471,24 @@ fn a_small_window_folds_the_docks_and_a_large_one_brings_them_back(s: &mut Sessi
     assert!(s.ed.palette_grid().is_some());
 }
 
+/// Item 8: a paste being placed shows the voxels it will put down, not only a box.
+fn a_paste_being_placed_shows_its_voxels(s: &mut Session) {
+    s.ctrl(KeyCode::KeyA);
+    s.ctrl(KeyCode::KeyC);
+    s.quiet();
+    assert_eq!(s.ed.paste_preview_faces(), 0, "nothing is being pasted yet");
+    s.ctrl(KeyCode::KeyV);
+    let terrain = s.on_the_terrain();
+    s.to(terrain);
+    s.quiet();
+    let faces = s.ed.paste_preview_faces();
+    assert!(faces > 1000, "the whole terrain's copy shows {faces} faces");
+    s.key(KeyCode::Escape, true);
+    s.key(KeyCode::Escape, false);
+    s.quiet();
+    assert_eq!(s.ed.paste_preview_faces(), 0, "Esc put the paste away");
+}
+
 #[test]
 fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     let dir = window::scratch("editor-handlers");
@@ -481,6 +499,7 @@ fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     a_drag_from_a_window_into_the_viewport_edits_nothing(&mut s);
     a_held_fly_key_moves_by_the_time_held(&mut s);
     no_ops_and_saves_are_said_on_the_status_line(&mut s);
+    a_paste_being_placed_shows_its_voxels(&mut s);
     the_docks_leave_the_viewport_framing_fits_it_and_the_palette_paints(&mut s);
     without_a_dialog_save_as_and_open_ask_in_the_browser(&mut s, &dir);
     the_first_click_on_an_empty_scene_attaches_on_the_floor(&mut s, &dir);

@@ -199,6 +199,8 @@ impl Editor {
                     .update(&self.doc, stroke.as_ref(), doc.revision);
             }
             let paste = self.paste_target(&doc);
+            self.preview
+                .set_paste(doc.scene.clipboard.as_ref().filter(|_| self.pasting));
             let view_area = self.view_area;
             let empty = doc.scene.world.read().solid_count() == 0;
             let dragged = self.dragged_box();
@@ -226,6 +228,10 @@ impl Editor {
                 );
                 if empty {
                     preview::paint_floor(&painter, &self.view, rect, dims);
+                }
+                // The voxels a click pastes, where it pastes them (the box is drawn above).
+                if let Some((at, _)) = paste {
+                    self.preview.paint_paste(&painter, &self.view, rect, at);
                 }
                 preview::paint_mirror(
                     &painter,

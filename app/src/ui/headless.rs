@@ -177,6 +177,15 @@ impl Editor {
         ))
     }
 
+    /// How many voxel faces the paste being placed shows (0: no paste, or too large a clip).
+    pub fn paste_preview_faces(&self) -> usize {
+        if self.pasting {
+            self.preview.paste_faces()
+        } else {
+            0
+        }
+    }
+
     /// Whether the in-app file browser is open.
     pub fn browser_open(&self) -> bool {
         self.panels.browser.is_some()

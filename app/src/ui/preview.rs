@@ -30,8 +30,17 @@ struct Shown {
     mode: Option<BrushMode>,
 }
 
+/// Outer faces of a voxel set: corners and outward normal.
+type Faces = Vec<([DVec3; 4], IVec3)>;
+
+/// The largest clipboard whose voxels a paste shows (larger: its box only).
+const PASTE_PREVIEW_VOXELS: u64 = 200_000;
+
 /// The kept preview and its thread.
 pub struct Preview {
+    /// The clipboard's outer faces where it was copied, for the paste being placed (the
+    /// clip they are of, by address; computed once per clip).
+    paste: Option<(usize, Faces, IVec3)>,
     requests: Option<Sender<(SharedDocument, Key)>>,
     results: Receiver<(Key, Shown)>,
     /// The latest stroke asked for (None: nothing to show).
@@ -67,6 +76,7 @@ impl Preview {
             })
             .expect("spawning the preview thread");
         Self {
+            paste: None,
             requests: Some(requests),
             results,
             wanted: None,
@@ -93,6 +103,45 @@ impl Preview {
         }
     }
 
+    /// Keeps the clipboard's faces for the paste preview (recomputed only for another clip;
+    /// none for a clip over [`PASTE_PREVIEW_VOXELS`]).
+    pub fn set_paste(&mut self, clip: Option<&Arc<crate::selection::Clip>>) {
+        let Some(clip) = clip.filter(|c| c.voxels <= PASTE_PREVIEW_VOXELS) else {
+            self.paste = None;
+            return;
+        };
+        let id = Arc::as_ptr(clip) as usize;
+        if self.paste.as_ref().is_none_or(|(k, _, _)| *k != id) {
+            self.paste = Some((id, outer_faces(&clip.source_bricks()), clip.origin));
+        }
+    }
+
+    /// How many faces the paste preview has (0: none kept).
+    pub fn paste_faces(&self) -> usize {
+        self.paste.as_ref().map_or(0, |(_, f, _)| f.len())
+    }
+
+    /// Paints the kept clipboard's voxels where a paste at `at` puts them, translucent.
+    pub fn paint_paste(
+        &self,
+        painter: &egui::Painter,
+        view: &ViewCamera,
+        rect: egui::Rect,
+        at: IVec3,
+    ) {
+        if let Some((_, faces, origin)) = &self.paste {
+            let colour = egui::Color32::from_rgba_unmultiplied(255, 210, 60, 70);
+            paint_faces(
+                painter,
+                view,
+                rect,
+                faces,
+                (at - *origin).as_dvec3(),
+                colour,
+            );
+        }
+    }
+
     /// Paints the preview for the view's camera into `rect` (the viewport, in points): the
     /// latest computed one, while a stroke is wanted.
     pub fn paint(&self, painter: &egui::Painter, view: &ViewCamera, rect: egui::Rect) {
@@ -105,41 +154,53 @@ impl Preview {
             BrushMode::Erase => egui::Color32::from_rgba_unmultiplied(255, 60, 40, 90),
             BrushMode::Paint => egui::Color32::from_rgba_unmultiplied(80, 200, 255, 80),
         };
-        let to_screen = |p: DVec3| screen_point(view, rect, p);
-        let eye = view.camera.position;
-        let forward = view.camera.forward();
-        let mut mesh = egui::Mesh::default();
-        for (corners, normal) in &shown.faces {
-            let centre = (corners[0] + corners[2]) * 0.5;
-            let towards = if view.camera.is_orthographic() {
-                forward
-            } else {
-                centre - eye
-            };
-            if towards.dot(normal.as_dvec3()) >= 0.0 {
-                continue;
-            }
-            let Some(pts) = corners
-                .iter()
-                .map(|c| to_screen(*c))
-                .collect::<Option<Vec<_>>>()
-            else {
-                continue;
-            };
-            let base = mesh.vertices.len() as u32;
-            for p in pts {
-                mesh.colored_vertex(p, colour);
-            }
-            mesh.add_triangle(base, base + 1, base + 2);
-            mesh.add_triangle(base, base + 2, base + 3);
-        }
-        if !mesh.is_empty() {
-            painter.add(egui::Shape::mesh(mesh));
-        }
+        paint_faces(painter, view, rect, &shown.faces, DVec3::ZERO, colour);
         if let Some((lo, hi)) = shown.bounds {
             let stroke = egui::Stroke::new(1.5, colour.to_opaque());
             paint_box(painter, view, rect, lo, hi, stroke);
         }
+    }
+}
+
+/// Paints the faces turned towards the camera, moved by `offset`, translucent.
+fn paint_faces(
+    painter: &egui::Painter,
+    view: &ViewCamera,
+    rect: egui::Rect,
+    faces: &Faces,
+    offset: DVec3,
+    colour: egui::Color32,
+) {
+    let to_screen = |p: DVec3| screen_point(view, rect, p);
+    let eye = view.camera.position;
+    let forward = view.camera.forward();
+    let mut mesh = egui::Mesh::default();
+    for (corners, normal) in faces {
+        let centre = (corners[0] + corners[2]) * 0.5 + offset;
+        let towards = if view.camera.is_orthographic() {
+            forward
+        } else {
+            centre - eye
+        };
+        if towards.dot(normal.as_dvec3()) >= 0.0 {
+            continue;
+        }
+        let Some(pts) = corners
+            .iter()
+            .map(|c| to_screen(*c + offset))
+            .collect::<Option<Vec<_>>>()
+        else {
+            continue;
+        };
+        let base = mesh.vertices.len() as u32;
+        for p in pts {
+            mesh.colored_vertex(p, colour);
+        }
+        mesh.add_triangle(base, base + 1, base + 2);
+        mesh.add_triangle(base, base + 2, base + 3);
+    }
+    if !mesh.is_empty() {
+        painter.add(egui::Shape::mesh(mesh));
     }
 }
 
