@@ -145,7 +145,8 @@ pub fn docks(
                     ui.strong("Palette and materials");
                 });
                 egui::ScrollArea::vertical().show(ui, |ui| {
-                    palette(ui, state, brush, &table, out);
+                    let selected = doc.scene.selection.is_some();
+                    palette(ui, state, brush, &table, selected, out);
                     ui.separator();
                     let header = egui::CollapsingHeader::new("History")
                         .open(Some(state.history_open))
@@ -345,6 +346,7 @@ fn palette(
     state: &mut EditingState,
     brush: &mut Brush,
     table: &MaterialTable,
+    selected: bool,
     out: &mut Vec<UiEvent>,
 ) {
     ui.label("click: paint with a colour · right-click: edit it");
@@ -399,6 +401,7 @@ fn palette(
         brush.material,
         table.len()
     ));
+    ui.weak("an edit here changes every voxel of this material");
     let mut spec: MaterialSpec = m.into();
     let before = spec;
     egui::ComboBox::from_label("type")
@@ -449,6 +452,19 @@ fn palette(
         if table.len() < 256 && ui.button("duplicate as a new material").clicked() {
             out.push(UiEvent::AddMaterial(spec));
             brush.material = table.len() as u8;
+        }
+        // The selected voxels get a material of their own, to edit apart from the rest.
+        if table.len() < 256
+            && selected
+            && ui
+                .button("make a new one for the selection")
+                .on_hover_text("a copy of this material, painted on the selected voxels (two steps in the history)")
+                .clicked()
+        {
+            // The paint reads the brush's material when the events are applied: the new one.
+            brush.material = table.len() as u8;
+            out.push(UiEvent::AddMaterial(spec));
+            out.push(UiEvent::Action(Action::PaintSelection));
         }
         if table.len() > 1
             && ui
