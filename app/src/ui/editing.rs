@@ -225,6 +225,10 @@ fn tools(
             }
         });
     }
+    if brush.mode == BrushMode::Attach && brush.shape != BrushShape::Box {
+        ui.checkbox(&mut brush.follow_surface, "follow the surface")
+            .on_hover_text("on: each point of a stroke attaches to the face under the cursor; off: the stroke keeps to the first face's layer (shown while drawing)");
+    }
     ui.horizontal_wrapped(|ui| {
         ui.label("mirror");
         ui.checkbox(&mut brush.mirror[0], "X");

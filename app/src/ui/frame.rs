@@ -202,6 +202,15 @@ impl Editor {
             self.preview
                 .set_paste(doc.scene.clipboard.as_ref().filter(|_| self.pasting));
             let view_area = self.view_area;
+            let brush = &self.settings.brush;
+            let keeps_layer = brush.shape == crate::editor::command::BrushShape::Box
+                || (brush.mode == crate::editor::command::BrushMode::Attach
+                    && !brush.follow_surface);
+            let layer = self
+                .drawing
+                .as_ref()
+                .filter(|_| keeps_layer)
+                .map(|d| d.layer);
             let empty = doc.scene.world.read().solid_count() == 0;
             let dragged = self.dragged_box();
             egui_ctx.run_ui(raw, |ui| {
@@ -228,6 +237,9 @@ impl Editor {
                 );
                 if empty {
                     preview::paint_floor(&painter, &self.view, rect, dims);
+                }
+                if let Some(layer) = layer {
+                    preview::paint_layer(&painter, &self.view, rect, layer, dims);
                 }
                 // The voxels a click pastes, where it pastes them (the box is drawn above).
                 if let Some((at, _)) = paste {

@@ -276,6 +276,24 @@ pub fn paint_floor(painter: &egui::Painter, view: &ViewCamera, rect: egui::Rect,
     }
 }
 
+/// The layer a stroke keeps to, while it is drawn: the plane through its voxels' middles,
+/// outlined across the grid (attach strokes that keep to the first face, and boxes, whose
+/// first and last points span a box on it).
+pub fn paint_layer(
+    painter: &egui::Painter,
+    view: &ViewCamera,
+    rect: egui::Rect,
+    layer: super::tools::Layer,
+    dims: IVec3,
+) {
+    let stroke = egui::Stroke::new(
+        1.5,
+        egui::Color32::from_rgba_unmultiplied(255, 255, 255, 150),
+    );
+    let at = f64::from(layer.layer) + 0.5;
+    paint_plane(painter, view, rect, (layer.axis, at), dims, stroke);
+}
+
 /// Draws the enabled mirror planes as their outlines across the grid (x red, y green,
 /// z blue).
 pub fn paint_mirror(
@@ -286,35 +304,47 @@ pub fn paint_mirror(
     centre: DVec3,
     dims: IVec3,
 ) {
-    let size = dims.as_dvec3();
     let colours = [
         egui::Color32::from_rgba_unmultiplied(255, 80, 80, 160),
         egui::Color32::from_rgba_unmultiplied(80, 255, 80, 160),
         egui::Color32::from_rgba_unmultiplied(80, 140, 255, 160),
     ];
     for axis in (0..3).filter(|&a| mirror[a]) {
-        let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
-        let corner = |cu: bool, cw: bool| {
-            let mut p = DVec3::ZERO;
-            p[axis] = centre[axis];
-            p[u] = if cu { size[u] } else { 0.0 };
-            p[w] = if cw { size[w] } else { 0.0 };
-            p
-        };
-        let ring = [
-            corner(false, false),
-            corner(true, false),
-            corner(true, true),
-            corner(false, true),
-        ];
         let stroke = egui::Stroke::new(1.5, colours[axis]);
-        for k in 0..4 {
-            if let (Some(a), Some(b)) = (
-                screen_point(view, rect, ring[k]),
-                screen_point(view, rect, ring[(k + 1) % 4]),
-            ) {
-                painter.line_segment([a, b], stroke);
-            }
+        paint_plane(painter, view, rect, (axis, centre[axis]), dims, stroke);
+    }
+}
+
+/// The outline across the grid of the plane where coordinate `axis` is `at`.
+fn paint_plane(
+    painter: &egui::Painter,
+    view: &ViewCamera,
+    rect: egui::Rect,
+    (axis, at): (usize, f64),
+    dims: IVec3,
+    stroke: egui::Stroke,
+) {
+    let size = dims.as_dvec3();
+    let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+    let corner = |cu: bool, cw: bool| {
+        let mut p = DVec3::ZERO;
+        p[axis] = at;
+        p[u] = if cu { size[u] } else { 0.0 };
+        p[w] = if cw { size[w] } else { 0.0 };
+        p
+    };
+    let ring = [
+        corner(false, false),
+        corner(true, false),
+        corner(true, true),
+        corner(false, true),
+    ];
+    for k in 0..4 {
+        if let (Some(a), Some(b)) = (
+            screen_point(view, rect, ring[k]),
+            screen_point(view, rect, ring[(k + 1) % 4]),
+        ) {
+            painter.line_segment([a, b], stroke);
         }
     }
 }

@@ -33,6 +33,9 @@ pub struct Brush {
     pub tool: Tool,
     /// How deep a selection box goes into the surface, in voxels.
     pub select_depth: i32,
+    /// An attach stroke follows the surface under the cursor (each point on the face it
+    /// hits) instead of keeping to the first face's layer.
+    pub follow_surface: bool,
 }
 
 /// What the left button does in the viewport.
@@ -58,6 +61,7 @@ impl Default for Brush {
             in_selection: false,
             tool: Tool::Brush,
             select_depth: 16,
+            follow_surface: false,
         }
     }
 }
@@ -170,7 +174,8 @@ pub fn start(
 }
 
 /// The next point of a stroke under the cursor: on the stroke's layer for attach strokes
-/// and boxes, else the voxel under the cursor (None: the cursor is off the scene).
+/// and boxes (an attach stroke that follows the surface: in front of the face under the
+/// cursor), else the voxel under the cursor (None: the cursor is off the scene).
 pub fn next(
     view: &WorldView<'_>,
     brush: &Brush,
@@ -178,7 +183,9 @@ pub fn next(
     origin: DVec3,
     dir: DVec3,
 ) -> Option<IVec3> {
-    if brush.mode == BrushMode::Attach || brush.shape == BrushShape::Box {
+    if brush.mode == BrushMode::Attach && brush.follow_surface && brush.shape != BrushShape::Box {
+        start(view, BrushMode::Attach, origin, dir).map(|(v, _)| v)
+    } else if brush.mode == BrushMode::Attach || brush.shape == BrushShape::Box {
         on_layer(layer, origin, dir, view.dims().voxels())
     } else {
         pick(view, origin, dir).map(|(hit, _)| hit.voxel)
@@ -238,6 +245,28 @@ mod tests {
             .unwrap();
         }
         w
+    }
+
+    #[test]
+    fn an_attach_stroke_that_follows_the_surface_climbs_onto_the_pillar() {
+        let w = world();
+        let view = w.read();
+        let down = DVec3::NEG_Y;
+        let (_, layer) =
+            start(&view, BrushMode::Attach, DVec3::new(20.5, 40.0, 20.5), down).unwrap();
+        let brush = Brush {
+            follow_surface: true,
+            ..Brush::default()
+        };
+        let over = next(&view, &brush, layer, DVec3::new(11.5, 40.0, 11.5), down);
+        assert_eq!(over, Some(IVec3::new(11, 11, 11)), "on top of the pillar");
+        // Boxes keep to their layer whatever the option says.
+        let boxed = Brush {
+            shape: BrushShape::Box,
+            ..brush
+        };
+        let over = next(&view, &boxed, layer, DVec3::new(11.5, 40.0, 11.5), down);
+        assert_eq!(over, Some(IVec3::new(11, 4, 11)));
     }
 
     #[test]
