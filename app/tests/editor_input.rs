@@ -513,3 +513,123 @@ fn a_killed_editor_offers_its_autosave_and_recovering_gives_its_content() {
     );
     s.kill();
 }
+
+/// An XWD screenshot (Xvfb at depth 24: 32-bit pixels) as a pixel reader.
+struct Shot {
+    bytes: Vec<u8>,
+    start: usize,
+    line: usize,
+    bgr: bool,
+}
+
+impl Shot {
+    fn take(display: &str) -> Self {
+        let out = std::process::Command::new("xwd")
+            .args(["-root", "-silent", "-display", display])
+            .output()
+            .expect("xwd runs");
+        assert!(out.status.success(), "xwd failed");
+        let bytes = out.stdout;
+        let word = |i: usize| u32::from_be_bytes(bytes[4 * i..4 * i + 4].try_into().unwrap());
+        assert_eq!(word(11), 32, "32-bit pixels");
+        let (header, byte_order, line, ncolours) = (
+            word(0) as usize,
+            word(7),
+            word(12) as usize,
+            word(19) as usize,
+        );
+        Self {
+            start: header + 12 * ncolours,
+            line,
+            bgr: byte_order == 0,
+            bytes,
+        }
+    }
+
+    fn rgb(&self, x: u32, y: u32) -> [u8; 3] {
+        let p = self.start + y as usize * self.line + 4 * x as usize;
+        let b = &self.bytes[p..p + 4];
+        if self.bgr {
+            [b[2], b[1], b[0]]
+        } else {
+            [b[1], b[2], b[3]]
+        }
+    }
+
+    /// Whether a pixel is the grass of the terrain (clearly green).
+    fn grass(&self, x: u32, y: u32) -> bool {
+        let [r, g, b] = self.rgb(x, y).map(i32::from);
+        g > r + 25 && g > b + 25
+    }
+}
+
+#[test]
+fn the_docks_leave_the_viewport_where_f_frames_the_scene_and_the_palette_shows() {
+    let Some(x) = tools_ready() else { return };
+    let dir = scratch("layout");
+    let Some(mut s) = Session::recorded(&x, &dir, "960x540") else {
+        return;
+    };
+    s.mouse_to((480, 270));
+    s.key("f", "KeyF", "input key Code(KeyF) down");
+    // The framed view converged a little (a few frames after the key).
+    for _ in 0..4 {
+        s.report.frame();
+    }
+    let line = s
+        .report
+        .lines()
+        .into_iter()
+        .rev()
+        .find(|l| l.starts_with("viewport "))
+        .expect("the editor reports its viewport");
+    let v: Vec<u32> = line[9..].split(' ').map(|n| n.parse().unwrap()).collect();
+    let (vx, vy, vw, vh) = (v[0], v[1], v[2], v[3]);
+    assert!(
+        vx > 100 && vx + vw < 860 && vw > 400,
+        "docks on both sides: {line}"
+    );
+    let shot = Shot::take(&x.display);
+    // The palette: the right dock shows the 256 colours (many distinct ones).
+    let mut colours = std::collections::HashSet::new();
+    for py in (vy + 50..vy + 360).step_by(3) {
+        for px in (vx + vw + 8..952).step_by(3) {
+            colours.insert(shot.rgb(px, py));
+        }
+    }
+    assert!(
+        colours.len() > 100,
+        "the palette shows {} colours",
+        colours.len()
+    );
+    // F framed the scene inside the viewport: grass inside, none on its border.
+    let inside = (vy + vh / 4..vy + 3 * vh / 4)
+        .step_by(4)
+        .flat_map(|py| {
+            (vx + vw / 4..vx + 3 * vw / 4)
+                .step_by(4)
+                .map(move |px| (px, py))
+        })
+        .filter(|&(px, py)| shot.grass(px, py))
+        .count();
+    assert!(
+        inside > 100,
+        "the terrain shows in the viewport ({inside} grass samples)"
+    );
+    let border: Vec<(u32, u32)> = (vy + 2..vy + vh - 2)
+        .flat_map(|py| [(vx + 2, py), (vx + vw - 3, py)])
+        .chain((vx + 2..vx + vw - 2).flat_map(|px| [(px, vy + 2), (px, vy + vh - 3)]))
+        .filter(|&(px, py)| shot.grass(px, py))
+        .collect();
+    assert!(
+        border.is_empty(),
+        "the framed scene reaches the viewport's edge at {:?}",
+        &border[..border.len().min(8)]
+    );
+    let out = s.quit();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -261,10 +261,15 @@ impl Editor {
         }
         // The viewport is what the bars and docks left this frame (a script run's capture
         // is compared with whole-window renders: the whole window, the panels over it).
-        self.view_area = match self.panels.viewport {
+        let area = match self.panels.viewport {
             Some(r) if self.script.is_none() => pixel_area(r, self.egui.pixels_per_point(), size),
             _ => (0, 0, size.0, size.1),
         };
+        if area != self.view_area {
+            let (x, y, w, h) = area;
+            self.report.line(format_args!("viewport {x} {y} {w} {h}"));
+        }
+        self.view_area = area;
         let shown = (self.view_area.2, self.view_area.3);
         let internal = gfx.viewport.fit_internal(self.internal_size(shown));
         let egui::FullOutput {
