@@ -180,12 +180,14 @@ fn versions_and_hostile_files_are_clear_errors() {
         ),
         (text.replacen("data: \"VlhC", "data: \"AAAA", 1), "VXB1"),
         ("\u{0}\u{1}garbage".to_string(), "not a voxbrick project"),
+        ("(foo: 1)".to_string(), "begins with `(format_version: 1,`"),
     ];
     for (bad, want) in cases {
         let err = project::from_bytes(bad.as_bytes(), p, 2)
             .unwrap_err()
             .to_string();
         assert!(err.contains(want), "expected {want:?} in: {err}");
+        assert!(!err.contains("Probe"), "no internal names: {err}");
         assert!(
             err.starts_with("test.ron: "),
             "the error names the file: {err}"
