@@ -414,29 +414,42 @@ pub fn draw(
     }
     if state.help_open {
         let mut open = true;
-        window(area, "Shortcuts").open(&mut open).show(ctx, |ui| {
-            // Scrolls when the window is small (or the UI scale large).
-            egui::ScrollArea::both().show(ui, |ui| {
-                egui::Grid::new("keys").striped(true).show(ui, |ui| {
+        // As wide as the viewport allows; the descriptions wrap rather than clip.
+        let width = (area.width() - 24.0).clamp(200.0, 720.0);
+        window(area, "Shortcuts")
+            .open(&mut open)
+            .default_width(width)
+            .show(ctx, |ui| {
+                // Scrolls when the window is short (or the UI scale large).
+                egui::ScrollArea::vertical().show(ui, |ui| {
+                    // A row per shortcut: the keys in a column of their own, the description
+                    // wrapped in what is left.
                     for (keys, what) in SHORTCUTS {
-                        ui.monospace(*keys);
-                        ui.label(*what);
-                        ui.end_row();
+                        ui.horizontal_top(|ui| {
+                            ui.allocate_ui_with_layout(
+                                egui::vec2(210.0, 0.0),
+                                egui::Layout::top_down(egui::Align::Min),
+                                |ui| {
+                                    ui.set_width(210.0);
+                                    ui.monospace(*keys);
+                                },
+                            );
+                            ui.add(egui::Label::new(*what).wrap());
+                        });
+                    }
+                    if !state.keys.is_empty() {
+                        ui.separator();
+                        ui.label("The key map in force (keys.ron in the config folder):");
+                        egui::Grid::new("keymap").striped(true).show(ui, |ui| {
+                            for (keys, action) in &state.keys {
+                                ui.monospace(keys);
+                                ui.label(action);
+                                ui.end_row();
+                            }
+                        });
                     }
                 });
-                if !state.keys.is_empty() {
-                    ui.separator();
-                    ui.label("The key map in force (keys.ron in the config folder):");
-                    egui::Grid::new("keymap").striped(true).show(ui, |ui| {
-                        for (keys, action) in &state.keys {
-                            ui.monospace(keys);
-                            ui.label(action);
-                            ui.end_row();
-                        }
-                    });
-                }
             });
-        });
         state.help_open = open;
     }
     if state.new_open {
