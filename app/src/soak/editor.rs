@@ -539,7 +539,10 @@ impl EditorSession {
     /// panel click has it): Esc gives it back, as a user would press it.
     fn release_keyboard(&mut self) -> Result<()> {
         self.key(KeyCode::Escape, NO_KEYS)?;
-        self.frame()
+        self.frame()?;
+        // What egui did in that frame (a panel click it had queued: a palette swatch's new
+        // material) is an edit on its way: done before anything is compared.
+        self.settle()
     }
 
     /// Ctrl+S, then the file read back: the same content hash. With `reopen`, the file is
