@@ -492,6 +492,10 @@ impl EditorSession {
                 self.count("bad file dropped");
                 let bad = self.opts.out_dir.join("not-a-scene.ron");
                 std::fs::write(&bad, "(format_version: 1, this is not a project")?;
+                // What egui still has queued (a panel click's edit) lands first, or the
+                // comparison below would blame the drop for it.
+                self.frame()?;
+                self.settle()?;
                 let before = self.doc_state();
                 let generation = self.ed().generation();
                 self.send(Input::Dropped(bad))?;
