@@ -80,83 +80,96 @@ pub fn docks(
     // The table can shrink (an undone addition, unused materials removed): the current
     // material stays an entry of it.
     brush.material = brush.material.min((table.len() - 1) as u8);
-    let strip = |root: &mut egui::Ui, id: &str, left: bool, label: &str| {
-        let panel = if left {
-            egui::Panel::left(id.to_string())
-        } else {
-            egui::Panel::right(id.to_string())
-        };
-        panel
-            .resizable(false)
-            .exact_size(24.0)
-            .show(root, |ui| {
-                ui.button(if left { "⏵" } else { "⏴" })
-                    .on_hover_text(label)
-                    .clicked()
-            })
-            .inner
-    };
     // A narrow window keeps a usable viewport: the palette's dock folds first, then the
     // tools' (the user's choice comes back when the window is wide again).
     let width = root.available_rect_before_wrap().width();
     let show_tools = !state.tools_hidden && width >= DOCK_WIDTH + MIN_VIEWPORT;
     let docks = if show_tools { 2.0 } else { 1.0 };
     let show_palette = !state.palette_hidden && width >= docks * DOCK_WIDTH + MIN_VIEWPORT;
-    if !show_tools {
-        if strip(
-            root,
-            "tools strip",
-            true,
-            "Show the tools (a wider window has room)",
-        ) {
-            state.tools_hidden = false;
-        }
-    } else {
-        egui::Panel::left("tools")
-            .resizable(false)
-            .exact_size(DOCK_WIDTH)
-            .show(root, |ui| {
-                ui.horizontal(|ui| {
-                    ui.strong("Tools");
-                    ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
-                        state.tools_hidden = ui.small_button("⏴").on_hover_text("Hide").clicked();
-                    });
-                });
-                egui::ScrollArea::vertical().show(ui, |ui| tools(ui, brush, &table, doc, out));
-            });
+    let tools_toggled = dock(root, "tools", true, "Tools", show_tools, |ui| {
+        tools(ui, brush, &table, doc, out)
+    });
+    if let Some(hidden) = tools_toggled {
+        state.tools_hidden = hidden;
     }
     if !show_palette {
         state.palette_grid = None;
-        if strip(
-            root,
-            "palette strip",
-            false,
-            "Show the palette (a wider window has room)",
-        ) {
-            state.palette_hidden = false;
-        }
-    } else {
-        egui::Panel::right("palette")
-            .resizable(false)
-            .exact_size(DOCK_WIDTH)
-            .show(root, |ui| {
-                ui.horizontal(|ui| {
-                    state.palette_hidden = ui.small_button("⏵").on_hover_text("Hide").clicked();
-                    ui.strong("Palette and materials");
-                });
-                egui::ScrollArea::vertical().show(ui, |ui| {
-                    let selected = doc.scene.selection.is_some();
-                    palette(ui, state, brush, &table, selected, out);
-                    ui.separator();
-                    let header = egui::CollapsingHeader::new("History")
-                        .open(Some(state.history_open))
-                        .show(ui, |ui| history(ui, doc, out));
-                    if header.header_response.clicked() {
-                        state.history_open = !state.history_open;
-                    }
-                });
-            });
     }
+    let selected = doc.scene.selection.is_some();
+    let palette_toggled = dock(
+        root,
+        "palette",
+        false,
+        "Palette and materials",
+        show_palette,
+        |ui| {
+            palette(ui, state, brush, &table, selected, out);
+            ui.separator();
+            let header = egui::CollapsingHeader::new("History")
+                .open(Some(state.history_open))
+                .show(ui, |ui| history(ui, doc, out));
+            if header.header_response.clicked() {
+                state.history_open = !state.history_open;
+            }
+        },
+    );
+    if let Some(hidden) = palette_toggled {
+        state.palette_hidden = hidden;
+    }
+}
+
+/// A dock at the window's left or right side: `title` with a hide button over `content`
+/// (scrolling), or — when not `shown` (hidden, or no room) — a strip whose button shows
+/// it. Some(hidden) when the user clicked either button.
+fn dock(
+    root: &mut egui::Ui,
+    id: &str,
+    left: bool,
+    title: &str,
+    shown: bool,
+    content: impl FnOnce(&mut egui::Ui),
+) -> Option<bool> {
+    let side = |id: String| {
+        if left {
+            egui::Panel::left(id)
+        } else {
+            egui::Panel::right(id)
+        }
+        .resizable(false)
+    };
+    // Arrows point where the dock goes: towards its side to hide, away to show.
+    let (hide, show) = if left { ("⏴", "⏵") } else { ("⏵", "⏴") };
+    if !shown {
+        let label = format!("Show {title} (a narrow window folds it)");
+        let clicked = side(format!("{id} strip"))
+            .exact_size(24.0)
+            .show(root, |ui| ui.button(show).on_hover_text(label).clicked())
+            .inner;
+        return clicked.then_some(false);
+    }
+    side(id.to_string())
+        .exact_size(DOCK_WIDTH)
+        .show(root, |ui| {
+            // The hide button at the dock's outer edge, the title beside it.
+            let hidden = ui
+                .horizontal(|ui| {
+                    if left {
+                        ui.strong(title);
+                        ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+                            ui.small_button(hide).on_hover_text("Hide").clicked()
+                        })
+                        .inner
+                    } else {
+                        let clicked = ui.small_button(hide).on_hover_text("Hide").clicked();
+                        ui.strong(title);
+                        clicked
+                    }
+                })
+                .inner;
+            egui::ScrollArea::vertical().show(ui, content);
+            hidden.then_some(true)
+        })
+        .inner
 }
 
 /// Draws the editing windows that float over the viewport (terrain).

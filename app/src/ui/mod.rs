@@ -372,6 +372,10 @@ impl Editor {
             recorded_opens: 0,
             ended_recording: None,
         };
+        // No fades or slides: egui's clock stands still while a slow frame blocks the loop
+        // (host::InputClock), so on a slow device a 0.1 s fade took seconds and dialogs
+        // appeared as ghosts (seen at 1280 × 720 on lavapipe).
+        editor.egui.all_styles_mut(|s| s.animation_time = 0.0);
         editor.panels.errors.extend(settings_error);
         if editor.script.is_none() {
             let (keymap, error) = editor.config.keymap();
