@@ -2,7 +2,7 @@
 // (half-open voxels, crossing times (b − o)/d, positive axes step before negative ones at a
 // tie, coarse and brick skipping, full cells), in f32, plus skipping of empty 4³ and 2³
 // blocks inside bricks (the same event rule at their planes, so the same hits). Layouts:
-// ARCHITECTURE.md "GPU-facing layout"; keep in sync with brickmap/src/{brick,grid,material}.rs
+// docs/DESIGN.md "GPU-facing layout of the world"; keep in sync with brickmap/src/{brick,grid,material}.rs
 // and render/src/vulkan/world.rs. Every shader binds the world at 0..4; its own buffers start
 // at 5.
 

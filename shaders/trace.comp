@@ -1,4 +1,4 @@
-// The path tracer: DESIGN.md's light transport, a line-by-line port of
+// The path tracer: docs/DESIGN.md's light transport, a line-by-line port of
 // render/src/cpu/mod.rs (CpuScene::radiance) in f32. Keep in sync with it and with
 // render/src/vulkan/trace.rs (TraceParams).
 #version 450

@@ -2,6 +2,13 @@
 //! in a RON file, interpolated by time (Catmull-Rom cubics over the keyframe times, yaw
 //! unwrapped to the nearer turn), so where the camera is at a time does not depend on the
 //! frame rate; the sun circles the scene at the path's rate.
+//!
+//! In detail:
+//! `CameraPath`: keyframes (time, position, yaw, pitch) from RON
+//! (`assets/bench/thesis_path.ron` built in), checked (≥ 2, times from 0 increasing, pitch
+//! within ±89), yaw unwrapped to the nearer turn, Catmull-Rom cubics over the keyframe times
+//! (`camera_at(t)`: the path does not depend on the frame rate), `sun_at(t)`: the sun turned
+//! about the vertical axis through the grid centre; `PathError`.
 
 use glam::DVec3;
 use render::{Camera, Projection, Sun};

@@ -1,5 +1,6 @@
-//! voxbrick's application library: the scene document, file formats and CLI commands that
-//! the `voxbrick` binary and the editor use.
+//! voxbrick's application library: the scene and its document engine (commands, history,
+//! scripts), the file formats, the interactive editor (`ui`), the soak test and the GPU
+//! session opener. The `voxbrick` binary (`main.rs`, its subcommands in `cli/`) is built on it.
 
 pub mod atomic;
 pub mod camera_path;

@@ -1,6 +1,13 @@
 //! `voxbrick`: the voxel scene editor. Without a subcommand it opens the editor window (on
 //! a file, or the built-in default scene); subcommands build, convert, inspect, render,
 //! replay and benchmark scenes headlessly.
+//!
+//! In detail:
+//! clap CLI: no subcommand opens the editor (a file or the default scene; `--script`,
+//! `--capture`, `--window`, `--validation`, `--record`: the session as a replay script from a
+//! copy of the file, carried across File → Open with a copy of each opened file beside it);
+//! `stats`, `new`, `convert`, `info`, `render`, `replay`, `bench-gpu`, `bench-viewport`;
+//! one-line errors.
 
 mod cli;
 

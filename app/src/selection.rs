@@ -6,6 +6,17 @@
 //! (empty clipboard voxels leave the destination alone); what lands outside the grid is lost,
 //! and undo brings it back. The selection moves with what it moved and becomes what was
 //! pasted.
+//!
+//! In detail:
+//! `Region` (boxes added and subtracted in order; corners may leave the grid), `SelectOp`,
+//! `Selection` (region + its `VoxelSet`, computed once per change), `Clip` (the copied solid
+//! voxels per source brick, relative to the copy's minimum corner), and the one `Restore` edit
+//! a move or a paste is (each target brick written once, so the inverse is the world's exact
+//! sparse one; a shifted brick straddles at most 2×2×2 targets). A selection is a region of
+//! space: fill makes its empty voxels solid; move / copy / cut take its solid voxels; what
+//! lands outside the grid is lost and undo brings it back. `Scene` keeps the session's
+//! selection and clipboard (never saved; the editor carries the clipboard to the next
+//! document). Outside `editor/` so `scene.rs` can hold it without an import loop.
 
 use brickmap::{BrickUndo, EditInverse, EditOp, Mask, PriorMaterials, VoxelSet, WorldView};
 use glam::{IVec3, UVec3};

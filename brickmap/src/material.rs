@@ -12,7 +12,7 @@ use bytemuck::{Pod, Zeroable};
 /// Entries in each parameter table.
 pub const PARAMS: usize = 64;
 
-/// How a material scatters light (see DESIGN.md's light-transport specification).
+/// How a material scatters light (see docs/DESIGN.md's light-transport specification).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum MaterialKind {
     /// Ideal diffuse, albedo = colour.

@@ -1,6 +1,6 @@
 //! CPU ray cast through coarse grid → brick grid → voxels, by an exact integer DDA.
 //!
-//! Exactness: voxel v fills the half-open box [v, v+1) (DESIGN.md), so the ray point at
+//! Exactness: voxel v fills the half-open box [v, v+1) (docs/DESIGN.md), so the ray point at
 //! parameter t belongs to voxel ⌊o + t·d⌋. The crossing time of the plane `b` on axis i is
 //! computed as the correctly rounded `(b − oᵢ) / dᵢ` and nothing else (no accumulated
 //! increments), so event order, ties at edges and corners included, is decided on the same

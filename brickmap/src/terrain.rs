@@ -1,6 +1,6 @@
 //! Heightfield terrain as whole bricks: each brick column is built once (a full mask for the
 //! solid interior, per-voxel materials only where they differ) and written with one bulk
-//! edit. The scene issue's noise-driven generator builds on this.
+//! edit. `NoiseTerrain`, the noise-driven generator, builds on this.
 
 use crate::brick::{Mask, voxel_bit};
 use crate::edit::{BrickUndo, EditInverse, EditOp, PriorMaterials};

@@ -369,7 +369,7 @@ impl Sky {
 pub struct RenderSettings {
     /// Samples per pixel per frame, 1..=1024.
     pub samples_per_pixel: u32,
-    /// Scattering vertices per path, 1..=64 (DESIGN.md's B).
+    /// Scattering vertices per path, 1..=64 (docs/DESIGN.md's B).
     pub max_bounces: u32,
     /// Internal resolution (width, height), each 1..=16384.
     pub internal_resolution: (u32, u32),

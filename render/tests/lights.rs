@@ -1,4 +1,4 @@
-//! Emissive voxels as lights (issue 15): light sampling with MIS must converge to the image
+//! Emissive voxels as lights: light sampling with MIS must converge to the image
 //! BSDF sampling alone converges to, on the CPU reference and on the GPU, in rooms lit by one
 //! voxel, by thousands, by very different strengths, and through glass; and the GPU must
 //! never produce NaN, also when the last light face is gone.

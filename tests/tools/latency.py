@@ -33,11 +33,14 @@ for k in range(12):
         ls=lines()[n:]
         idx=[i for i,l in enumerate(ls) if l.startswith('input press')]
         if idx and any(l.startswith('frame ') for l in ls[idx[0]:]):
-            res.append(time.time()-t); break
-        if time.time()-t>30: res.append(float('inf')); break
+            res.append((k%2, time.time()-t)); break
+        if time.time()-t>30: res.append((k%2, float('inf'))); break
         time.sleep(0.005)
     time.sleep(1.0)
 fr=[l for l in lines() if l.startswith('frame ')]
 p.kill()
-res.sort()
-print(out, 'median %.3f s, max %.3f s, of %d clicks; frames %d' % (res[len(res)//2], res[-1], len(res), len(fr)))
+def summary(times):
+    times = sorted(times)
+    return 'median %.3f s, max %.3f s, of %d clicks' % (times[len(times)//2], times[-1], len(times))
+print(out, 'all:', summary([t for _, t in res]), '· View menu:', summary([t for k, t in res if k == 0]),
+      '· viewport:', summary([t for k, t in res if k == 1]), '· frames %d' % len(fr))

@@ -1,6 +1,15 @@
 //! Everything the editor can do to a document, as serializable commands (scripts and the
 //! recorder use the same form). `apply` executes one and returns how to undo it
 //! ([`Inverse`]). Strokes are in `brush`, flood fill in `fill`.
+//!
+//! In detail:
+//! every editor command (serde, shared by scripts and the recorder): label, coalescing key,
+//! `apply` (returns its `Inverse`; on error the scene is as it was). Selection commands:
+//! `Select`, `DeleteSelection` / `FillSelection` / `PaintSelection` (a `Shape::Set` edit),
+//! `MoveSelection` and `Paste` (voxels and the selection in one `Compound` inverse), `Cut`;
+//! `RemoveUnusedMaterials` (one `Restore` rewriting the bricks whose indices move down, then
+//! the shorter table; undo puts the table back first); `Copy` changes only the clipboard
+//! (`changes_document` is false: recorded, no history step, the document stays clean).
 
 pub use super::brush::{
     Axis, BrushMode, BrushShape, Mirror, PREVIEW_LIMIT, Stroke, preview, preview_bricks,

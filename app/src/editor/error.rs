@@ -1,6 +1,13 @@
 //! The editor engine's one error type: what a command, an undo or a redo can fail with. The
 //! UI tells them apart (a refused edit is shown and forgotten; a file error names the file);
 //! whenever one is returned, the scene and the history are as they were.
+//!
+//! In detail:
+//! `EditError`, the engine's one error enum (invalid command, world, parameter, file, nothing
+//! to undo / redo, nothing to do: no selection, an empty clipboard, no unused material): the UI
+//! tells them apart (`is_no_op`: a status-line notice, not the Error window). Commands, undo
+//! and redo return it; a script step (`ScriptRun::step`) returns `anyhow::Result`, as it
+//! also reports renders, files and expectations.
 
 use crate::formats::FormatError;
 use brickmap::BrickmapError;

@@ -1,6 +1,12 @@
 //! How commands are undone: sparse world inverses for voxels (never snapshots), the previous
 //! table (about 2 KB) for table edits, the previous value for properties; and the helpers
 //! that apply edits all-or-nothing.
+//!
+//! In detail:
+//! `Inverse`: world inverses for voxels (never snapshots), the previous table (~2 KB) for table
+//! edits, the previous value for properties and the selection, `Compound` (several, undone last
+//! first; a failing part puts back the parts already applied); `apply_all` / `with_table` (all
+//! or nothing).
 
 use super::error::Result;
 use crate::scene::Scene;

@@ -1,6 +1,13 @@
 //! How far a long edit (terrain generation) has got, for a progress bar: the edit's workers
 //! count what they finished with atomics; the UI reads the fraction without any lock (the
 //! document is locked by the edit meanwhile).
+//!
+//! In detail:
+//! `Progress` (atomics: work done of work to do) and `Counted`, a column source wrapper that
+//! counts generated columns; `Document::progress` is shared with the UI, which reads it without
+//! the document's lock (a terrain generation holds it): while an edit runs the loop wakes ten
+//! times a second and a long edit's percentage goes in the window title (no frame can be drawn
+//! meanwhile).
 
 use std::sync::atomic::{AtomicU64, Ordering};
 

@@ -189,7 +189,7 @@ mod tests {
     #[test]
     fn hostile_and_damaged_files_are_refused_naming_the_chunk_and_offset() {
         let cases: Vec<(Vec<u8>, &str)> = vec![
-            // The file: a 2·10⁹³ model whose XYZI claims 2·10⁹ voxels and holds none.
+            // The hostile file that was reported: a 2·10⁹³ model whose XYZI claims 2·10⁹ voxels and holds none.
             (
                 file(
                     &[

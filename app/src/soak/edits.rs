@@ -105,8 +105,8 @@ impl Session {
         let before = self.state();
         let label = c.label();
         match self.edit(Edit::Command(c))? {
-            Edited::Command(_, Ok(_)) => Ok(()),
-            Edited::Command(_, Err(e)) => {
+            Edited::Command(_, Ok(_), _) => Ok(()),
+            Edited::Command(_, Err(e), _) => {
                 self.report.refused += 1;
                 ensure!(
                     self.state() == before,

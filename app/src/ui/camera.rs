@@ -3,6 +3,15 @@
 //! keeps the pivot and its distance, pan keeps the orientation, zoom keeps the point under
 //! the cursor where it is on screen, fly moves eye and pivot together, and the projection
 //! toggle keeps the pivot and the size things have on the pivot plane.
+//!
+//! In detail:
+//! `ViewCamera`: the scene's `Camera` plus the pivot distance; orbit (keeps pivot and
+//! distance), pan (keeps orientation, scene follows the cursor), zoom towards the point under
+//! the cursor (exact CPU cast hit, else the pivot plane; keeps its pixel; orthographic: the
+//! height scales and the image plane stays), fly, frame a box, the perspective / orthographic
+//! toggle (O, Numpad 5: keeps the pivot and the pivot plane's scale; going orthographic, the
+//! eye backs off until the grid is in front of the image plane). View state, never history;
+//! "use this view as the scene camera" is `SetCamera`.
 
 use glam::DVec3;
 use render::{Camera, Projection};

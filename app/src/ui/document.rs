@@ -45,7 +45,7 @@ impl Editor {
     pub(super) fn edited(&mut self, edited: Edited) {
         self.edits.finished();
         match edited {
-            Edited::Command(label, result) => {
+            Edited::Command(label, result, said) => {
                 let outcome = match &result {
                     Ok(_) => "ok".to_string(),
                     Err(e) => format!("error {e}"),
@@ -55,7 +55,11 @@ impl Editor {
                 match result {
                     Err(e) if e.is_no_op() => self.panels.notify(format!("{label}: {e}")),
                     Err(e) => self.panels.errors.push(format!("{label}: {e}")),
-                    Ok(_) => {}
+                    Ok(_) => {
+                        if let Some(text) = said {
+                            self.panels.notify(text);
+                        }
+                    }
                 }
             }
             Edited::Undo(result) => self.history_done("Undid", result),

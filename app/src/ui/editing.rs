@@ -3,10 +3,22 @@
 //! slider drag is one undo step, and only the material tables are uploaded), and the
 //! history list (every step with the voxels it changed; click one to go back or forward to
 //! it; how many of the oldest steps the memory budget dropped).
+//!
+//! In detail:
+//! the docks (`docks`): Tools on the left (with its Selection section: what is selected, box
+//! depth, "brush only inside the selection", the operations as buttons), on the right the 256
+//! colours always shown (click: paint with the colour — the first material of it, lambertian
+//! first, else a new lambertian one; right-click: edit it), the current material (a dielectric
+//! with too few scene bounces says so and offers `DIELECTRIC_BOUNCES`) and a History section
+//! (click a step to undo / redo to it; the dropped count); each collapses to a strip, and a
+//! window too narrow for both docks and a 240-point viewport folds the palette's, then the
+//! tools' (the user's choice returns when it is wide again). The Terrain window floats over the
+//! viewport.
 
 use super::input::Action;
 use super::panels::{UiEvent, window};
 use super::selecting::Nudge;
+use super::swatch::{DIELECTRIC_BOUNCES, swatch};
 use super::tools::{Brush, MAX_SIZE, Tool};
 use crate::editor::Document;
 use crate::editor::command::{
@@ -35,21 +47,6 @@ pub struct EditingState {
 fn rgb(table: &MaterialTable, colour: u8) -> egui::Color32 {
     let [r, g, b] = table.colour(colour);
     egui::Color32::from_rgb(r, g, b)
-}
-
-/// A square swatch; returns its response.
-fn swatch(ui: &mut egui::Ui, colour: egui::Color32, selected: bool, size: f32) -> egui::Response {
-    let (rect, response) = ui.allocate_exact_size(egui::vec2(size, size), egui::Sense::click());
-    ui.painter().rect_filled(rect, 2.0, colour);
-    if selected {
-        ui.painter().rect_stroke(
-            rect,
-            2.0,
-            egui::Stroke::new(2.0, egui::Color32::WHITE),
-            egui::StrokeKind::Outside,
-        );
-    }
-    response
 }
 
 fn kind_name(k: MaterialKind) -> &'static str {
@@ -103,7 +100,15 @@ pub fn docks(
         "Palette and materials",
         show_palette,
         |ui| {
-            palette(ui, state, brush, &table, selected, out);
+            palette(
+                ui,
+                state,
+                brush,
+                &table,
+                selected,
+                &doc.scene.params.settings,
+                out,
+            );
             ui.separator();
             let header = egui::CollapsingHeader::new("History")
                 .open(Some(state.history_open))
@@ -278,8 +283,16 @@ fn tools(
     ui.horizontal_wrapped(|ui| {
         for i in 0..table.len() {
             let Ok(m) = table.get(i as u8) else { continue };
-            let r = swatch(ui, rgb(table, m.colour), brush.material == i as u8, 18.0)
-                .on_hover_text(format!("{i}: {}", kind_name(m.kind)));
+            let r = swatch(
+                ui,
+                rgb(table, m.colour),
+                Some(m.kind),
+                brush.material == i as u8,
+                18.0,
+            )
+            .on_hover_text(format!("{i}: {}", kind_name(m.kind)));
+            let name = format!("material {i}: {}", kind_name(m.kind));
+            r.widget_info(|| egui::WidgetInfo::labeled(egui::WidgetType::Button, true, &name));
             if r.clicked() {
                 brush.material = i as u8;
             }
@@ -364,18 +377,22 @@ fn palette(
     brush: &mut Brush,
     table: &MaterialTable,
     selected: bool,
+    settings: &render::RenderSettings,
     out: &mut Vec<UiEvent>,
 ) {
-    ui.label("click: paint with a colour · right-click: edit it");
     let current = table.get(brush.material).map(|m| m.colour).ok();
     let grid = egui::Grid::new("palette")
         .spacing(egui::vec2(1.0, 1.0))
         .min_col_width(12.5)
+        .min_row_height(12.5)
         .show(ui, |ui| {
             for row in 0..16u8 {
                 for col in 0..16u8 {
                     let i = row * 16 + col;
-                    let r = swatch(ui, rgb(table, i), current == Some(i), 12.5);
+                    let r = swatch(ui, rgb(table, i), None, current == Some(i), 12.5)
+                        .on_hover_text(format!(
+                            "colour {i} · click: paint with it · right-click: edit it"
+                        ));
                     if r.clicked() {
                         paint_with_colour(i, state, brush, table, out);
                     }
@@ -388,18 +405,6 @@ fn palette(
         });
     state.palette_grid = Some(grid.response.rect);
     ui.horizontal_wrapped(|ui| {
-        if ui
-            .button("Load palette…")
-            .on_hover_text("a 256 × 1 PNG strip or a .vox file")
-            .clicked()
-        {
-            out.push(UiEvent::PaletteFile { save: false });
-        }
-        if ui.button("Save palette as PNG…").clicked() {
-            out.push(UiEvent::PaletteFile { save: true });
-        }
-    });
-    ui.horizontal_wrapped(|ui| {
         let mut c = table.colour(state.colour);
         ui.label(format!("colour {}", state.colour));
         if ui.color_edit_button_srgb(&mut c).changed() {
@@ -408,6 +413,18 @@ fn palette(
                 rgb: c,
             });
         }
+        ui.menu_button("palette file", |ui| {
+            if ui
+                .button("Load palette…")
+                .on_hover_text("a 256 × 1 PNG strip or a .vox file")
+                .clicked()
+            {
+                out.push(UiEvent::PaletteFile { save: false });
+            }
+            if ui.button("Save palette as PNG…").clicked() {
+                out.push(UiEvent::PaletteFile { save: true });
+            }
+        });
     });
     ui.separator();
     let Ok(m) = table.get(brush.material) else {
@@ -417,8 +434,28 @@ fn palette(
         "material {} ({} of 256)",
         brush.material,
         table.len()
-    ));
-    ui.weak("an edit here changes every voxel of this material");
+    ))
+    .on_hover_text("an edit here changes every voxel of this material");
+    if m.kind == MaterialKind::Dielectric && settings.max_bounces < DIELECTRIC_BOUNCES {
+        // Paths end inside the glass: it shows dark until light can pass through it.
+        ui.colored_label(
+            ui.visuals().warn_fg_color,
+            format!("shows dark at {} bounces", settings.max_bounces),
+        )
+        .on_hover_text(format!(
+            "light needs {DIELECTRIC_BOUNCES} bounces to pass through glass or water"
+        ));
+        if ui
+            .button(format!("use {DIELECTRIC_BOUNCES} bounces"))
+            .on_hover_text("the scene's bounces (Render settings; one step in the history)")
+            .clicked()
+        {
+            let mut more = settings.clone();
+            more.max_bounces = DIELECTRIC_BOUNCES;
+            out.push(UiEvent::SetSettings(more));
+        }
+    }
+    ui.weak("changes every voxel of this material");
     let mut spec: MaterialSpec = m.into();
     let before = spec;
     egui::ComboBox::from_label("type")
@@ -434,16 +471,21 @@ fn palette(
             }
         });
     if m.kind != MaterialKind::Lambertian {
-        ui.add(egui::Slider::new(&mut spec.param, 0..=63).text("parameter slot"));
+        // Names above their sliders: beside them they would pass the dock's width.
+        egui::CollapsingHeader::new("parameter slot")
+            .id_salt("material slot")
+            .show(ui, |ui| {
+                ui.weak("materials of a kind that share a slot share its value");
+                ui.add(egui::Slider::new(&mut spec.param, 0..=63));
+            });
         let (name, lo, hi) = match m.kind {
             MaterialKind::Metal => ("roughness", 0.0, 1.0),
             MaterialKind::Dielectric => ("index of refraction", 1.0, 4.0),
             _ => ("strength", 0.0, 100.0),
         };
+        ui.label(name);
         if let Ok(mut value) = table.param(m.kind, m.param)
-            && ui
-                .add(egui::Slider::new(&mut value, lo..=hi).text(name))
-                .changed()
+            && ui.add(egui::Slider::new(&mut value, lo..=hi)).changed()
         {
             out.push(UiEvent::SetParam {
                 kind: spec.kind,
@@ -453,9 +495,14 @@ fn palette(
         }
     }
     ui.horizontal_wrapped(|ui| {
-        swatch(ui, rgb(table, m.colour), false, 16.0);
+        swatch(ui, rgb(table, m.colour), Some(m.kind), false, 16.0);
         ui.label(format!("colour {}", m.colour));
-        if m.colour != state.colour && ui.button("use the selected colour").clicked() {
+        if m.colour != state.colour
+            && ui
+                .button(format!("use {}", state.colour))
+                .on_hover_text("the colour selected in the palette")
+                .clicked()
+        {
             spec.colour = state.colour;
         }
     });
@@ -466,9 +513,22 @@ fn palette(
         });
     }
     ui.horizontal_wrapped(|ui| {
-        if table.len() < 256 && ui.button("duplicate as a new material").clicked() {
+        if table.len() < 256
+            && ui
+                .button("duplicate")
+                .on_hover_text("a new material, a copy of this one, for the brush")
+                .clicked()
+        {
             out.push(UiEvent::AddMaterial(spec));
             brush.material = table.len() as u8;
+        }
+        if table.len() > 1
+            && ui
+                .button("remove unused")
+                .on_hover_text("drop the materials no voxel uses; later ones move down")
+                .clicked()
+        {
+            out.push(UiEvent::Action(Action::RemoveUnusedMaterials));
         }
         // The selected voxels get a material of their own, to edit apart from the rest.
         if table.len() < 256
@@ -482,14 +542,6 @@ fn palette(
             brush.material = table.len() as u8;
             out.push(UiEvent::AddMaterial(spec));
             out.push(UiEvent::Action(Action::PaintSelection));
-        }
-        if table.len() > 1
-            && ui
-                .button("remove unused")
-                .on_hover_text("drop the materials no voxel uses; later ones move down")
-                .clicked()
-        {
-            out.push(UiEvent::Action(Action::RemoveUnusedMaterials));
         }
     });
 }

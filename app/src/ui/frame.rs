@@ -2,8 +2,23 @@
 //! per redraw (results of edits and files, backlog input, fly keys, a script step, the
 //! panels, trace and present), progressive refinement and the samples-per-frame controller,
 //! and the script run's capture.
+//!
+//! In detail:
+//! the editor's frames: attaching the GPU session to a host, `redraw`/`draw` (results, backlog
+//! input, fly keys, a script step, panels, trace, present), refinement and the
+//! samples-per-frame controller, the script capture. The UI first: for `UI_FIRST` (0.35 s)
+//! after pointer or key input on the UI (`ui_touched`, set in handle.rs), while a popup is open
+//! or a widget is dragged, refinement waits (target 1 sample: a change still shows at once) and
+//! such frames do not keep the loop busy (`about_to_wait` wakes it when the wait ends), so no
+//! trace delays a menu. The viewport is drawn in its rectangle only (`view_area`, from the
+//! panels' last layout; a script run: the whole window, as the captures are compared with
+//! whole-window renders): aspect, picking, framing (`Camera::framing_in`: the narrower field of
+//! view) and the traced size follow it.
 
 use super::*;
+
+/// How long after pointer or key input on the UI refinement waits (frames are the UI's).
+pub(super) const UI_FIRST: Duration = Duration::from_millis(350);
 
 impl Editor {
     pub(super) fn create_gfx(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
@@ -211,6 +226,11 @@ impl Editor {
                 .as_ref()
                 .filter(|_| keeps_layer)
                 .map(|d| d.layer);
+            let drawn_box = self
+                .drawing
+                .as_ref()
+                .filter(|_| brush.shape == crate::editor::command::BrushShape::Box)
+                .map(|d| (d.first, d.last));
             let empty = doc.scene.world.read().solid_count() == 0;
             let dragged = self.dragged_box();
             egui_ctx.run_ui(raw, |ui| {
@@ -240,6 +260,11 @@ impl Editor {
                 }
                 if let Some(layer) = layer {
                     preview::paint_layer(&painter, &self.view, rect, layer, dims);
+                }
+                // A box being dragged says its size beside the cursor.
+                let cursor = egui::pos2(self.cursor.0 as f32 / ppp, self.cursor.1 as f32 / ppp);
+                if let Some(b) = drawn_box.or(dragged.map(|(lo, hi, _)| (lo, hi))) {
+                    preview::paint_box_size(&painter, cursor, b);
                 }
                 // The voxels a click pastes, where it pastes them (the box is drawn above).
                 if let Some((at, _)) = paste {
@@ -295,6 +320,20 @@ impl Editor {
         } else {
             internal
         };
+        // While the user works in the UI (a menu or popup open, a widget or window dragged,
+        // pointer or key input on the UI in the last UI_FIRST) refinement waits: a frame
+        // is then the UI's and the display's only, so no trace delays the menus and panels.
+        // A change made there (the sun, a material) still gets its first sample at once.
+        let ui_first = !moving
+            && self.script.is_none()
+            && (egui::Popup::is_any_open(&egui_ctx)
+                || egui_ctx.egui_is_using_pointer()
+                || self.ui_touched.is_some_and(|t| t.elapsed() < UI_FIRST));
+        let target_spp = if ui_first {
+            1
+        } else {
+            self.settings.target_spp
+        };
         let doc = self.doc.clone();
         let doc = doc.read().unwrap_or_else(|p| p.into_inner());
         let mut params = doc.scene.params.clone();
@@ -304,7 +343,7 @@ impl Editor {
             internal,
             output: shown,
             spp: self.budget.spp,
-            target_spp: self.settings.target_spp,
+            target_spp,
             exposure: doc.scene.params.settings.exposure + self.settings.exposure,
             bgra: false,
             // A script run's capture is compared with headless renders: never denoised.
@@ -342,7 +381,9 @@ impl Editor {
                 // by the pixels it left out.
                 let ratio = (f64::from(still.0) * f64::from(still.1))
                     / (f64::from(internal.0) * f64::from(internal.1)).max(1.0);
-                self.adapt_samples(gfx.viewport.last_gpu_seconds().map(|t| t * ratio));
+                if status.added > 0 {
+                    self.adapt_samples(gfx.viewport.last_gpu_seconds().map(|t| t * ratio));
+                }
             }
             Presented::NotReady | Presented::Recreated => gfx.host.request_redraw(),
         }
@@ -363,7 +404,8 @@ impl Editor {
             self.exit = true;
         }
         // Keep drawing while refining, moving, running a script or waiting for files.
-        let busy = gfx.viewport.samples() < self.settings.target_spp
+        // (Refinement that waits for the UI is not: the end of the wait wakes the loop.)
+        let busy = (gfx.viewport.samples() < self.settings.target_spp && !ui_first)
             || moving
             || !self.flying.is_empty()
             || self.script.is_some()

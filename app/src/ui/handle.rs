@@ -3,6 +3,16 @@
 //! keys go through the key map (Esc cancels what is being dragged), buttons start strokes,
 //! selections, pastes, the eyedropper, flood fills or view drags, moves extend them, the
 //! wheel zooms to the cursor, held movement keys fly.
+//!
+//! In detail:
+//! input → the editor: the frame gate and backlog (order kept), keys through the key map (Esc
+//! cancels a drag), buttons start strokes / selections / pastes / eyedropper / flood fill /
+//! view drags, moves extend them, wheel zoom, fly. A press or wheel step is the UI's or the
+//! viewport's by its own position against the layers of the last frame drawn (`on_ui`: a
+//! window, the bars, the docks, or any open popup), never by egui's pointer state, which is a
+//! frame behind (a press right after leaving a window was lost; a drag from a slider edited the
+//! scene). Fly keys move by elapsed time up to the release (no per-frame clamp; a headless
+//! editor steps 1/60 s per tick unless `fly_in_real_time`).
 
 use super::*;
 
@@ -37,6 +47,16 @@ impl Editor {
     fn handle_input(&mut self, input: Input, consumed: bool) {
         if self.gfx.is_none() {
             return;
+        }
+        let to_ui = match &input {
+            Input::Moved { x, y } => self.on_ui((*x, *y)),
+            Input::Button { .. } | Input::Wheel(_) => self.on_ui(self.cursor),
+            Input::Key { .. } => consumed || self.egui.egui_wants_keyboard_input(),
+            Input::Text(_) => true,
+            _ => false,
+        };
+        if to_ui {
+            self.ui_touched = Some(Instant::now());
         }
         match input {
             Input::Close => self.action(Action::Quit),

@@ -2,6 +2,13 @@
 //! presenter (egui included), its input given as [`Input`] events through the same handlers a
 //! window's events reach (egui gets its share first, as egui-winit gives it). The soak test
 //! drives it so; nothing here is a second implementation of the editor.
+//!
+//! In detail:
+//! `Editor::headless`: the same editor without a window (offscreen presenter with egui, no
+//! native dialogs, handshake log in memory): `input`, `frame`, `pump`, `settled`, `aim`,
+//! `on_ui_at`, `ray_at`, `view_area`, `palette_grid`, `notice`, `widget` (where a widget that
+//! says a text was drawn, from egui's accessibility tree, which a headless editor turns on),
+//! `close` — what the soak and `app/tests/editor_handlers.rs` drive.
 
 use super::host::Headless;
 use super::*;
@@ -28,6 +35,8 @@ impl Editor {
         let size = (size.0.max(1), size.1.max(1));
         let presenter = Presenter::offscreen(ctx.clone(), size)?;
         editor.attach(ctx, presenter, Host::Headless(Headless::new(size)), size)?;
+        // Its accessibility tree names the widgets drawn (see [`Editor::widget`]).
+        editor.egui.enable_accesskit();
         Ok(editor)
     }
 
@@ -177,6 +186,23 @@ impl Editor {
         ))
     }
 
+    /// Where the last frame drew a widget whose text is `label` (a button's, a label's, a
+    /// checkbox's): its centre in window pixels. None when no widget says that.
+    pub fn widget(&self, label: &str) -> Option<(f64, f64)> {
+        let Some(Gfx {
+            host: Host::Headless(h),
+            ..
+        }) = &self.gfx
+        else {
+            return None;
+        };
+        let ppp = f64::from(self.egui.pixels_per_point());
+        h.widgets.iter().find(|(l, _)| l == label).map(|(_, r)| {
+            let c = r.center();
+            (f64::from(c.x) * ppp, f64::from(c.y) * ppp)
+        })
+    }
+
     /// How many voxel faces the paste being placed shows (0: no paste, or too large a clip).
     pub fn paste_preview_faces(&self) -> usize {
         if self.pasting {
@@ -209,6 +235,11 @@ impl Editor {
     /// Whether a menu or another popup is open (as of the last frame).
     pub fn popup_open(&self) -> bool {
         egui::Popup::is_any_open(&self.egui)
+    }
+
+    /// Samples per pixel the viewport's image holds.
+    pub fn samples(&self) -> u32 {
+        self.gfx.as_ref().map_or(0, |g| g.viewport.samples())
     }
 
     /// The brush's settings as the Tools window shows them.

@@ -71,6 +71,9 @@ pub(super) struct Headless {
     /// Frames drawn: egui's clock runs at 60 per second of them, so a headless session is a
     /// function of its input, not of the machine's speed.
     frames: u64,
+    /// The last frame's widgets that have a label, with their rectangles in points (from
+    /// egui's accessibility tree): how tests find a button by what it says.
+    pub widgets: Vec<(String, egui::Rect)>,
 }
 
 impl Headless {
@@ -82,6 +85,7 @@ impl Headless {
             redraw: true,
             title: String::new(),
             frames: 0,
+            widgets: Vec::new(),
         }
     }
 
@@ -155,11 +159,27 @@ impl Host {
 
     /// What egui asks of the platform (cursor icon, clipboard, links): a window's only.
     pub fn handle_platform_output(&mut self, output: egui::PlatformOutput) {
-        if let Host::Window {
-            egui_state, window, ..
-        } = self
-        {
-            egui_state.handle_platform_output(window, output);
+        match self {
+            Host::Window {
+                egui_state, window, ..
+            } => egui_state.handle_platform_output(window, output),
+            Host::Headless(h) => {
+                if let Some(update) = output.accesskit_update {
+                    h.widgets = update
+                        .nodes
+                        .iter()
+                        .filter_map(|(_, node)| {
+                            let label = node.label().or(node.value())?;
+                            let b = node.bounds()?;
+                            let rect = egui::Rect::from_min_max(
+                                egui::pos2(b.x0 as f32, b.y0 as f32),
+                                egui::pos2(b.x1 as f32, b.y1 as f32),
+                            );
+                            Some((label.to_string(), rect))
+                        })
+                        .collect();
+                }
+            }
         }
     }
 }

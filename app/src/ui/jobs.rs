@@ -52,8 +52,9 @@ impl Edit {
 
 /// What an edit did.
 pub enum Edited {
-    /// A command ran (its label).
-    Command(String, Result<Executed, EditError>),
+    /// A command ran: its label, and for a selection operation that did something, what
+    /// the status line says it did (how many voxels it selected, copied or changed).
+    Command(String, Result<Executed, EditError>, Option<String>),
     /// An undo (the label of what was undone).
     Undo(Result<String, EditError>),
     /// A redo.
@@ -175,7 +176,12 @@ fn run(doc: &SharedDocument, edit: Edit) -> Edited {
     match edit {
         Edit::Command(c) => {
             let label = c.label();
-            Edited::Command(label, d.execute(c))
+            let landing = super::selecting::Landing::of(&c);
+            let result = d.execute(c);
+            let said = landing
+                .zip(result.as_ref().ok())
+                .map(|(l, done)| l.say(&label, &d, done));
+            Edited::Command(label, result, said)
         }
         Edit::Undo => Edited::Undo(d.undo()),
         Edit::Redo => Edited::Redo(d.redo()),
@@ -250,7 +256,7 @@ mod tests {
         assert!(q.done.recv_timeout(Duration::from_millis(300)).is_err());
         assert_eq!(hash(), empty);
         drop(frame);
-        let Edited::Command(label, Ok(done)) = next(&mut q) else {
+        let Edited::Command(label, Ok(done), _) = next(&mut q) else {
             panic!("the stroke")
         };
         assert!(label.contains("Sphere"), "{label}");
@@ -276,11 +282,11 @@ mod tests {
         let mut q = EditQueue::new(Arc::new(|| {}));
         q.submit(&d, Edit::Command(sphere(-1.0)));
         q.submit(&d, Edit::Command(sphere(3.0)));
-        let Edited::Command(_, Err(EditError::Invalid(message))) = next(&mut q) else {
+        let Edited::Command(_, Err(EditError::Invalid(message)), _) = next(&mut q) else {
             panic!("a bad brush size is invalid")
         };
         assert!(message.contains("brush size"), "{message}");
-        assert!(matches!(next(&mut q), Edited::Command(_, Ok(_))));
+        assert!(matches!(next(&mut q), Edited::Command(_, Ok(_), _)));
         assert_eq!(d.read().unwrap().history.undo_len(), 1);
     }
 
@@ -297,7 +303,7 @@ mod tests {
             })
         };
         q.submit(&d, import("/no/such/file.vox".into()));
-        let Edited::Command(label, Err(EditError::File(e))) = next(&mut q) else {
+        let Edited::Command(label, Err(EditError::File(e)), _) = next(&mut q) else {
             panic!("a missing file is a file error")
         };
         assert!(label.contains("Import"), "{label}");
@@ -312,7 +318,7 @@ mod tests {
         sphere(2.0).apply(&mut scene, &dir).unwrap();
         scene.save(&vox).unwrap();
         q.submit(&d, import(vox.display().to_string()));
-        let Edited::Command(_, Ok(done)) = next(&mut q) else {
+        let Edited::Command(_, Ok(done), _) = next(&mut q) else {
             panic!("the import works")
         };
         assert!(done.changed_voxels > 0);

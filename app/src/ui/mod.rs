@@ -3,6 +3,17 @@
 //! view camera or actions, the document shared with the file worker, one frame per redraw
 //! through the GPU session ([`Viewport`]) and the window's [`Presenter`]. Progressive
 //! refinement adds samples until the target, then the loop waits for events.
+//!
+//! In detail:
+//! the editor: `run` owns the winit 0.30 event loop; `Editor` (ApplicationHandler) keeps the
+//! document as `Arc<RwLock<Document>>` (the file worker reads it for saves; every edit goes to
+//! `jobs::EditQueue`), the view camera and slots, view settings, panels, and `Gfx` (presenter,
+//! viewport, `Host`); window events become `Input`s and go to `handle.rs`. Refines until the
+//! target spp, then `ControlFlow::Wait`; internal resolution × `moving_scale` while a stroke is
+//! drawn and for 150 ms after a camera move or a stroke; samples per frame adapt to ~16 ms of
+//! GPU time. `--script` runs `ScriptRun` steps live and captures the presented frame at
+//! `--capture-spp`. A GPU error mid-session: unsaved work to the recovery file at once, then a
+//! native dialog (tested with `VOXBRICK_TEST_GPU_FAILURE_AT_FRAME`).
 
 mod actions;
 mod browser;
@@ -24,6 +35,7 @@ pub mod panels;
 mod preview;
 pub mod report;
 mod selecting;
+mod swatch;
 pub mod tools;
 
 use crate::Scene;
@@ -199,6 +211,9 @@ pub struct Editor {
     mods: Mods,
     drag: Option<(Drag, (f64, f64))>,
     cursor: (f64, f64),
+    /// When pointer or key input last went to the UI (a panel, a menu, a window): for
+    /// [`frame::UI_FIRST`] after it, refinement waits and frames are the UI's.
+    ui_touched: Option<Instant>,
     flying: HashSet<KeyCode>,
     last_tick: Instant,
     moving_until: Instant,
@@ -336,6 +351,7 @@ impl Editor {
             mods: Mods::default(),
             drag: None,
             cursor: (0.0, 0.0),
+            ui_touched: None,
             flying: HashSet::new(),
             last_tick: Instant::now(),
             moving_until: Instant::now(),
@@ -527,8 +543,9 @@ impl ApplicationHandler<Wake> for Editor {
     }
 
     fn new_events(&mut self, _event_loop: &ActiveEventLoop, cause: winit::event::StartCause) {
+        // A long edit's progress, or refinement that waited while the UI was used.
         if matches!(cause, winit::event::StartCause::ResumeTimeReached { .. })
-            && self.progress.fraction().is_some()
+            && (self.progress.fraction().is_some() || self.ui_touched.is_some())
         {
             self.request_redraw();
         }
@@ -546,10 +563,22 @@ impl ApplicationHandler<Wake> for Editor {
             ));
             return;
         }
+        let mut wake: Option<Instant> = None;
         if self.settings.autosave_secs > 0 && self.script.is_none() {
-            event_loop.set_control_flow(ControlFlow::WaitUntil(
-                self.last_autosave + Duration::from_secs(self.settings.autosave_secs),
-            ));
+            wake = Some(self.last_autosave + Duration::from_secs(self.settings.autosave_secs));
+        }
+        // Refinement resumes when the UI has been left alone for `UI_FIRST`.
+        if let Some(t) = self.ui_touched {
+            let resume = t + frame::UI_FIRST;
+            if resume > Instant::now() {
+                wake = Some(wake.map_or(resume, |w| w.min(resume)));
+            } else {
+                self.ui_touched = None;
+                self.request_redraw();
+            }
+        }
+        if let Some(w) = wake {
+            event_loop.set_control_flow(ControlFlow::WaitUntil(w));
         }
     }
 

@@ -2,6 +2,14 @@
 //! statistics, the shortcut list, and the dialogs (unsaved changes, recovery, errors). They
 //! read the state and return what the user asked for as [`UiEvent`]s; the frame loop applies
 //! them (scene settings as undoable commands, view settings directly).
+//!
+//! In detail:
+//! egui: menus, status bar (with a passing notice, 4 s: a save done, an undo or redo, a no-op),
+//! the docks, then the viewport's rectangle (what the bars and docks leave; windows are kept
+//! inside it), render settings (view: target spp, internal scale, exposure, denoise, autosave;
+//! scene: bounces as `SetSettings`), sun and sky (`SetSun`/`SetSky`, coalesced per drag),
+//! statistics, shortcuts, new scene, the unsaved-changes and recovery questions, errors.
+//! Returns `UiEvent`s the loop applies.
 
 use super::input::{Action, SHORTCUTS};
 use crate::editor::Document;

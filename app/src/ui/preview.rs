@@ -4,6 +4,19 @@
 //! on its own thread (a radius-64 brush takes ~50 ms: the UI keeps drawing the previous
 //! preview meanwhile; a small brush's arrives by the next frame), and drawn each frame from
 //! the kept faces. A brush too large to examine voxel by voxel shows its bounding box.
+//!
+//! In detail:
+//! the brush preview: `command::preview` (exactly the voxels a click changes, tested against
+//! the click; computed a brick at a time from the shape's coverage and mask and the brick's
+//! voxels) recomputed on its own thread only when the stroke or the document revision changes
+//! (the UI draws the latest one meanwhile: a radius-64 brush takes ~50 ms); its outer faces
+//! that face the camera drawn translucent under the panels; a brush over 4 M examined voxels
+//! shows its bounding box. Also the empty scene's bounds and floor lines (`paint_floor`); every
+//! overlay projects into the viewport's rectangle, as picking does. A box being dragged (a box
+//! stroke, a selection box) says its size beside the cursor (`paint_box_size`). While a stroke
+//! keeps to a layer (attach without "follow the surface", boxes) that layer's plane is outlined
+//! across the grid (`paint_layer`); a paste being placed shows the clipboard's voxels
+//! (`set_paste` / `paint_paste`, faces computed once per clip up to 200 000 voxels).
 
 use super::camera::ViewCamera;
 use super::files::SharedDocument;
@@ -294,6 +307,24 @@ pub fn paint_layer(
     paint_plane(painter, view, rect, (layer.axis, at), dims, stroke);
 }
 
+/// The size of a box being dragged (a box stroke, a selection box), in voxels along x, y
+/// and z, written beside the cursor: what the drag will make before the release.
+pub fn paint_box_size(painter: &egui::Painter, cursor: egui::Pos2, (lo, hi): (IVec3, IVec3)) {
+    let text = box_size_text(lo, hi);
+    let at = cursor + egui::vec2(16.0, 12.0);
+    let font = egui::FontId::proportional(13.0);
+    let galley = painter.layout_no_wrap(text, font, egui::Color32::WHITE);
+    let back = egui::Rect::from_min_size(at, galley.size()).expand(3.0);
+    painter.rect_filled(back, 3.0, egui::Color32::from_black_alpha(170));
+    painter.galley(at, galley, egui::Color32::WHITE);
+}
+
+/// "w × h × d voxels" of the box from `lo` to `hi` (inclusive).
+pub fn box_size_text(lo: IVec3, hi: IVec3) -> String {
+    let n = (hi - lo).abs() + IVec3::ONE;
+    format!("{} × {} × {} voxels", n.x, n.y, n.z)
+}
+
 /// Draws the enabled mirror planes as their outlines across the grid (x red, y green,
 /// z blue).
 pub fn paint_mirror(
@@ -435,6 +466,14 @@ fn bounds(stroke: &Stroke, selection: Option<&Selection>) -> Option<(DVec3, DVec
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_dragged_box_says_its_size_whichever_way_it_was_dragged() {
+        let (a, b) = (IVec3::new(10, 4, 7), IVec3::new(3, 4, 9));
+        assert_eq!(box_size_text(a.min(b), a.max(b)), "8 × 1 × 3 voxels");
+        assert_eq!(box_size_text(a, b), "8 × 1 × 3 voxels");
+        assert_eq!(box_size_text(a, a), "1 × 1 × 1 voxels");
+    }
 
     #[test]
     fn one_voxel_has_six_outer_faces_and_two_touching_have_ten() {

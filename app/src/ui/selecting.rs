@@ -11,8 +11,8 @@ use super::camera::ViewCamera;
 use super::input::Mods;
 use super::jobs::Edit;
 use super::tools::{self, Layer};
-use crate::editor::Document;
 use crate::editor::command::{BrushMode, Command};
+use crate::editor::{Document, Executed};
 use crate::selection::{SelectOp, Selection};
 use glam::{DVec3, IVec3};
 use serde::{Deserialize, Serialize};
@@ -127,6 +127,57 @@ pub fn nudge_offset(n: Nudge, forward: DVec3) -> IVec3 {
 /// face: its bottom centre there.
 pub fn paste_at(v: IVec3, size: IVec3) -> IVec3 {
     v - IVec3::new(size.x / 2, 0, size.z / 2)
+}
+
+/// What a selection operation is said to have done on the status line, so that each one
+/// visibly lands (a select all, a copy or a fill shows nothing else happening).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Landing {
+    /// The selection changed: how many voxels it holds.
+    Selected,
+    /// The clipboard took a copy: how many voxels.
+    Copied,
+    /// Voxels changed (a delete, fill, paint, cut, move or paste): how many.
+    Changed,
+}
+
+impl Landing {
+    /// The landing of a command that is a selection operation.
+    pub fn of(c: &Command) -> Option<Self> {
+        match c {
+            Command::Select(_) => Some(Landing::Selected),
+            Command::Copy => Some(Landing::Copied),
+            Command::DeleteSelection
+            | Command::FillSelection(_)
+            | Command::PaintSelection(_)
+            | Command::MoveSelection(_)
+            | Command::Cut
+            | Command::Paste { .. } => Some(Landing::Changed),
+            _ => None,
+        }
+    }
+
+    /// The status line's text after the command `label` ran on `doc` and did `done`.
+    pub fn say(self, label: &str, doc: &Document, done: &Executed) -> String {
+        let voxels = |n: u64| {
+            if n == 1 {
+                "1 voxel".to_string()
+            } else {
+                format!("{n} voxels")
+            }
+        };
+        match self {
+            Landing::Selected => match &doc.scene.selection {
+                Some(s) => format!("{label}: {} selected", voxels(s.voxels.count())),
+                None => format!("{label}: nothing selected"),
+            },
+            Landing::Copied => match &doc.scene.clipboard {
+                Some(c) => format!("Copied {} to the clipboard", voxels(c.voxels)),
+                None => format!("{label}: nothing copied"),
+            },
+            Landing::Changed => format!("{label}: {} changed", voxels(done.changed_voxels)),
+        }
+    }
 }
 
 impl Editor {

@@ -1,7 +1,7 @@
-//! The CPU reference path tracer: the light transport of DESIGN.md, written for clarity in
+//! The CPU reference path tracer: the light transport of docs/DESIGN.md, written for clarity in
 //! f64, as the test oracle for the GPU renderer and the `--device cpu` backend.
 //!
-//! Conventions it fixes (ARCHITECTURE.md repeats them for independent checks):
+//! Conventions it fixes (docs/DESIGN.md repeats them for independent checks):
 //! - Albedo is the material's colour-table entry decoded from sRGB to linear.
 //! - A path carries its medium: a dielectric material it is inside, or air. Inside a medium
 //!   the next interaction is the first voxel that is not that medium (air or another

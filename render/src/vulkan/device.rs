@@ -1,6 +1,20 @@
 //! `GpuContext`: the chosen physical device, the logical device with its compute queue (and a
 //! present queue when a window surface is given), the memory allocator and what the passes
 //! need to know about the device. Destroyed on drop, children before parents.
+//!
+//! In detail:
+//! `GpuContext`: device by best/index/name (with a window: one that presents to it), compute
+//! queue (with a window: graphics + compute, and a present queue of another family if that one
+//! cannot present: `choose_families`, unit-tested; the swapchain's images are then shared
+//! concurrently), gpu-allocator shared as `Arc<Mutex<_>>` with the egui painter (freed before
+//! the device on drop; leaked with a message if still shared), driver name, timestamp period,
+//! the limits in force (`limits.rs`), pipeline statistics
+//! (VK_KHR_pipeline_executable_properties) when the driver has them, a device without subgroup
+//! basic/vote/ballot operations in compute is refused with a clear error (trace.comp needs
+//! them), `shadow_queue` (float atomic adds: VK_EXT_shader_atomic_float enabled when present),
+//! `Presentation` (surface, VK_KHR_swapchain, present queue); `ui_rendering`
+//! (VK_KHR_dynamic_rendering on a Vulkan 1.2 instance) for a window or `draw_ui`. Fields drop
+//! after the body: surface, then instance.
 
 use super::instance::Instance;
 use super::surface::{Surface, WindowHandles};

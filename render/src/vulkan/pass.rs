@@ -1,5 +1,15 @@
 //! A compute pass: one SPIR-V module, N storage buffers in set 0 (bindings 0..N), push
 //! constants, dispatched synchronously with the results made visible to the host.
+//!
+//! In detail:
+//! `ComputePass`: one SPIR-V module, N storage bindings, push constants, specialization
+//! constants; `allocate_set` / `record` (direct or indirect dispatch) for multi-pass frames,
+//! `run`/`run_repeated` for one pass; `SetCache`: descriptor sets made once per (layout,
+//! bindings) and kept by a frame slot, trimmed only at a frame's start (its fence signalled).
+//! `run_batch`: records a frame N times back to back in one submission (barriers between
+//! repetitions), timestamps around each, waits; results visible to the host, later passes and
+//! copies. Benchmarks repeat frames so the GPU never idles (an idle-looking GPU drops its
+//! clocks). `statistics()`.
 
 use super::barrier::{after_earlier_passes, barrier};
 use super::buffer::Binding;

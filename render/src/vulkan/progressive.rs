@@ -3,6 +3,15 @@
 //! sky, settings); any change restarts it. The display pass divides by the sample count,
 //! applies exposure, the ACES fitted curve and sRGB, and upscales bilinearly to the output
 //! resolution (exposure is display-only: changing it keeps the samples).
+//!
+//! In detail:
+//! `Progressive`: a device-local accumulation buffer (radiance sum + count per pixel) at the
+//! internal resolution; `frame` adds samples (batches shaped by `batch_shape`: never more than
+//! asked) and restarts when the image key (every trace parameter + variant) changes or the
+//! world changed; `record_batch` is the interactive frame's one dispatch (never past the
+//! target); `display` = mean → bilinear upscale to the output resolution → exposure → ACES →
+//! sRGB (exposure does not restart); `hdr` reads the mean. The one-shot `PathTracer::render*`
+//! live here too, so trace.rs does not import the accumulation.
 
 use super::buffer::{Binding, HostBuffer, read_device};
 use super::pass::SetCache;

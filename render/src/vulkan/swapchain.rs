@@ -1,6 +1,13 @@
 //! The window's swapchain: B8G8R8A8_UNORM preferred (the display pass writes sRGB-encoded
 //! bytes in that order, copied in raw), MAILBOX where offered (else FIFO), recreated by the
 //! presenter on resize, suboptimal and out-of-date. One render-finished semaphore per image.
+//!
+//! In detail:
+//! `Swapchain`: B8G8R8A8_UNORM preferred, then R8G8B8A8_UNORM, then the sRGB ones (raw
+//! sRGB-encoded bytes are right for all four); MAILBOX else FIFO; min + 1 images; TRANSFER_DST
+//! (copy in) + COLOR_ATTACHMENT (egui) + TRANSFER_SRC when offered (capture); one
+//! render-finished semaphore per image; acquire with a 100 ms bound (out of date / timeout →
+//! recreate / retry).
 
 use super::{GpuContext, GpuError, vk_call};
 use ash::vk;

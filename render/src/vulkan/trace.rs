@@ -3,6 +3,36 @@
 //! scene needs ([`Variant`], built on first use and cached). With the sun, shadow rays are
 //! queued and traced by a second pass (`shaders/shadow.comp`, one invocation per ray) where
 //! the device can (float atomic adds, subgroup ballots).
+//!
+//! In detail:
+//! `TraceParams` (mirrors `Params` in trace.comp), `Variant` (specialization constants:
+//! material kinds from the table, sun, gradient sky, bounce count, ray counting, experiments,
+//! `lights`: light sampling of emissive voxels, on when the world has light faces; `Variant {
+//! lights: false, .. }` is the BSDF-only estimator) with a per-tracer pipeline cache (the
+//! one-shot `PathTracer::render*` are in `progressive.rs`). A dispatch runs `image[2]` samples
+//! per invocation in `slices` invocations per pixel (workgroup z): an image below
+//! `FULL_DISPATCH` (1.2 Mpixel) is split up to `MAX_SLICES` = 8 ways with `SLICED_SAMPLES` = 4
+//! each, by trace.comp's second module (`SAMPLE_SLICES` defined by build.rs: its invocations
+//! add to the accumulation with float atomics, zeroed by `vkCmdFillBuffer` when an accumulation
+//! starts; sample index = first + slice · per-invocation + s, so the samples are the unsplit
+//! ones); otherwise 8 per invocation from `LARGE_IMAGE` pixels, else 4, and at most 4 for a
+//! `lights` variant (`samples_per_dispatch_for`; `set_samples_per_dispatch`,
+//! `set_sample_slices`; measurements at `SAMPLES_PER_DISPATCH` and `FULL_DISPATCH`). Devices
+//! without float atomics never split. With the sun or light faces and a capable device a frame
+//! is two passes: trace.comp queues shadow rays (48 B each, the light slot of a light face's
+//! ray in `light.w`, `NO_LIGHT` for the sun's; header reset by `vkCmdUpdateBuffer`, slots
+//! reserved with one atomic per subgroup, capacity one ray per sample within 2¹⁶..2²¹, with
+//! light faces one per vertex up to 2²³; overflow traced in place), then shadow.comp traces
+//! them one per invocation by an indirect dispatch and adds unblocked light with float atomics
+//! (a light face's ray may end in its light's voxel, found from the slot). A vertex may hold
+//! two pending shadow rays (the sun's and a light face's) only in `lights` variants; without
+//! them the code is the sun-only code (measured: thesis complexities unchanged).
+//! `set_deferred_shadows`/`set_queue_limit` for benchmarks and tests. A dispatch is planned
+//! once (`plan`: pipelines, queue, bindings) and recorded by `record_plan`, either in a waited
+//! submission (`dispatch_repeated`) or into a frame's command buffer with cached sets
+//! (`record`). The queue holds at most `queue_fit` rays (the device's limits); a larger queue
+//! replaces the old one only after a device wait (the other frame in flight may still trace
+//! with it).
 
 use super::barrier::barrier;
 use super::buffer::{Binding, HostBuffer};
@@ -194,7 +224,7 @@ pub struct Variant {
     pub sun: bool,
     /// A gradient sky (else uniform).
     pub gradient_sky: bool,
-    /// Scattering vertices per path (DESIGN.md's B).
+    /// Scattering vertices per path (docs/DESIGN.md's B).
     pub max_bounces: u32,
     /// Count rays into the counters buffer (for Mrays/s; not for timing).
     pub count_rays: bool,

@@ -552,7 +552,7 @@ pub fn inside_glass(orthographic: bool) -> (World, SceneParams, f64) {
     (w, p, 1.5 * 1.5 * SKY[0] as f64)
 }
 
-/// Closed rooms under a black sky, no sun, lit only by emissive voxels (issue 15's cases):
+/// Closed rooms under a black sky, no sun, lit only by emissive voxels (the light-sampling cases):
 /// one voxel; thousands of voxels (a ceiling panel); voxels of strengths 1 and 1000; a lamp
 /// whose light reaches the view through a glass pane, and one sealed in glass. Named, 4
 /// bounces. The camera sees no lamp directly (the noise compared is the lighting's, not the
