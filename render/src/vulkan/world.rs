@@ -34,6 +34,12 @@ pub const RING_SLOT_BYTES: u64 = 4 << 20;
 /// Changed runs at most this many bytes apart are uploaded as one copy region (so uploads
 /// stay within 1.5× of the changed words).
 const MERGE_GAP: usize = 4;
+/// The first upload of a world merges runs up to this many bytes apart: it writes a whole
+/// world into zeroed buffers, where every gap between two bricks' non-zero words would
+/// otherwise be a copy region of its own (a 256 × 128 × 256 world of 40 boxes made
+/// hundreds of thousands, and each region costs the driver and the validation layer far
+/// more than copying a few KiB of zeros).
+const FIRST_UPLOAD_GAP: usize = 4096;
 
 /// What one update did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -146,8 +152,8 @@ fn zeroed_buffer(ctx: &GpuContext, size: u64) -> Result<HostBuffer, GpuError> {
 }
 
 /// Runs of words of `new` that differ from `old` (equal lengths), as byte ranges relative to
-/// both; runs at most [`MERGE_GAP`] bytes apart are merged.
-fn changed_runs(old: &[u8], new: &[u8]) -> Vec<Range<usize>> {
+/// both; runs at most `gap` bytes apart are merged.
+fn changed_runs(old: &[u8], new: &[u8], gap: usize) -> Vec<Range<usize>> {
     let mut runs: Vec<Range<usize>> = Vec::new();
     let mut at = 0;
     while at < new.len() {
@@ -162,7 +168,7 @@ fn changed_runs(old: &[u8], new: &[u8]) -> Vec<Range<usize>> {
                 continue;
             }
             match runs.last_mut() {
-                Some(last) if w <= last.end + MERGE_GAP => last.end = we,
+                Some(last) if w <= last.end + gap => last.end = we,
                 _ => runs.push(w..we),
             }
         }
@@ -213,7 +219,7 @@ impl GpuWorld {
         };
         let whole = sizes.map(|s| std::iter::once(0..s).collect());
         let staged = world
-            .stage(ctx, view, &whole)
+            .stage(ctx, view, &whole, FIRST_UPLOAD_GAP)
             .and_then(|_| world.drain(ctx));
         match staged {
             Ok(_) => Ok(world),
@@ -231,7 +237,7 @@ impl GpuWorld {
     pub fn update(&mut self, ctx: &GpuContext, world: &World) -> Result<UploadReport, GpuError> {
         let dirty = world.take_dirty();
         let view = world.read();
-        let mut report = self.stage(ctx, &view, &dirty.ranges)?;
+        let mut report = self.stage(ctx, &view, &dirty.ranges, MERGE_GAP)?;
         drop(view);
         report.add(&self.flush(ctx)?);
         Ok(report)
@@ -265,12 +271,14 @@ impl GpuWorld {
         })
     }
 
-    /// Grows regions that the world outgrew, then queues the changed words of `ranges`.
+    /// Grows regions that the world outgrew, then queues the changed words of `ranges`,
+    /// runs at most `gap` bytes apart as one.
     fn stage(
         &mut self,
         ctx: &GpuContext,
         view: &WorldView<'_>,
         ranges: &[Vec<Range<u64>>; N],
+        gap: usize,
     ) -> Result<UploadReport, GpuError> {
         let mut report = UploadReport::default();
         let sizes = GpuBuffer::ALL.map(|b| view.gpu_buffer_size(b));
@@ -294,7 +302,7 @@ impl GpuWorld {
                 bytes.clear();
                 view.copy_gpu_range(which, start..end, &mut bytes);
                 let old = &mut self.shadow[i][start as usize..end as usize];
-                for run in changed_runs(old, &bytes) {
+                for run in changed_runs(old, &bytes, gap) {
                     old[run.clone()].copy_from_slice(&bytes[run.clone()]);
                     report.queued_bytes += run.len() as u64;
                     self.queue.push_back(Upload {
@@ -411,13 +419,19 @@ mod tests {
         new[13] = 1; // word 12..16: gap of 4 bytes → merged with 4..8
         new[100] = 1; // far away: own run
         new[199] = 1; // last word
-        assert_eq!(changed_runs(&old, &new), vec![4..16, 100..104, 196..200]);
-        assert!(changed_runs(&old, &old).is_empty());
+        assert_eq!(
+            changed_runs(&old, &new, MERGE_GAP),
+            vec![4..16, 100..104, 196..200]
+        );
+        assert!(changed_runs(&old, &old, MERGE_GAP).is_empty());
         // A 2-word gap is not merged.
         let mut n2 = old.clone();
         n2[0] = 1;
         n2[12] = 1;
-        assert_eq!(changed_runs(&old, &n2), vec![0..4, 12..16]);
+        assert_eq!(changed_runs(&old, &n2, MERGE_GAP), vec![0..4, 12..16]);
+        // The first upload's gap joins runs a few KiB apart, not farther.
+        assert_eq!(changed_runs(&old, &new, 88), vec![4..104, 196..200]);
+        assert_eq!(changed_runs(&old, &new, FIRST_UPLOAD_GAP), vec![4..200]);
     }
 
     #[test]
