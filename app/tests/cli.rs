@@ -293,6 +293,10 @@ fn bench_plays_the_path_and_writes_its_report() {
         "16",
         "--edit-frames",
         "2",
+        "--view-size",
+        "16x9",
+        "--view-spp",
+        "1",
         "--out",
         s(&dir),
     ])
@@ -464,6 +468,8 @@ fn bench_skips_measures_each_skip_on_two_scenes() {
         "64x36",
         "--rounds",
         "1",
+        "--reference-seconds",
+        "8",
         "--out",
         s(&dir),
     ])

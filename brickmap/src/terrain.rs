@@ -177,10 +177,13 @@ mod tests {
     }
 }
 
-/// Noise functions the generator can use.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// Noise functions the generator can use (also as commands and scripts name them).
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
 pub enum NoiseKind {
     /// Classic gradient noise.
+    #[default]
     Perlin,
     /// OpenSimplex (fewer directional artefacts).
     OpenSimplex,

@@ -160,7 +160,7 @@ fn every_command() -> Vec<Command> {
             octaves: 4,
             height_range: (10, 50),
             water_level: 24,
-            noise: app::editor::command::NoiseSpec::OpenSimplex,
+            noise: app::editor::command::NoiseKind::OpenSimplex,
             bands: app::editor::command::Bands {
                 rock_line: 0.3,
                 snow_line: 0.5,

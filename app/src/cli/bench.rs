@@ -9,6 +9,7 @@
 
 use super::bench_viewport::edit_request;
 use super::plot::{Series, line_plot};
+use super::{args, emit};
 use anyhow::{Context, Result, bail};
 use app::camera_path::CameraPath;
 use app::scene::Scene;
@@ -23,26 +24,47 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 /// What `bench` runs.
+#[derive(clap::Args)]
 pub(crate) struct Bench {
-    pub(crate) device: String,
-    /// A camera path file (None: the built-in thesis path).
-    pub(crate) path: Option<PathBuf>,
+    /// Device name filter ("gpu": the best).
+    #[arg(long, default_value = "gpu")]
+    device: String,
+    /// A camera path file (RON; default: the built-in thesis path, assets/bench).
+    #[arg(long)]
+    path: Option<PathBuf>,
     /// Frames along the path, evenly spaced in path time.
-    pub(crate) frames: usize,
-    /// Dispatches per frame (their median is the frame's time).
-    pub(crate) repeat: u32,
-    /// Internal resolutions.
-    pub(crate) sizes: Vec<(u32, u32)>,
-    /// Preset names to run (empty: all).
-    pub(crate) presets: Vec<String>,
-    /// CPU reference: resolution and frames along the path (0: none).
-    pub(crate) cpu_size: (u32, u32),
-    pub(crate) cpu_frames: usize,
-    /// Sculpting while rendering: sphere radii (empty: none) and frames per radius.
-    pub(crate) edit_radii: Vec<f64>,
-    pub(crate) edit_frames: usize,
-    /// Where the report goes.
-    pub(crate) out: PathBuf,
+    #[arg(long, default_value_t = 240)]
+    frames: usize,
+    /// Back-to-back dispatches per frame (their median is the frame's time).
+    #[arg(long, default_value_t = 5)]
+    repeat: u32,
+    /// Internal resolutions, WxH, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1024x576,1920x1080", value_parser = args::resolution)]
+    sizes: Vec<(u32, u32)>,
+    /// Presets to run (complexity-1, complexity-2, complexity-3, physical; default all).
+    #[arg(long, value_delimiter = ',')]
+    presets: Vec<String>,
+    /// CPU reference resolution.
+    #[arg(long, default_value = "128x72", value_parser = args::resolution)]
+    cpu_size: (u32, u32),
+    /// CPU reference frames along the path (0: none).
+    #[arg(long, default_value_t = 24)]
+    cpu_frames: usize,
+    /// Sculpting while rendering: sphere radii, comma-separated (empty: none).
+    #[arg(long, value_delimiter = ',', default_value = "16,64")]
+    edit_radii: Vec<f64>,
+    /// Edits (frames) per radius.
+    #[arg(long, default_value_t = 120)]
+    edit_frames: usize,
+    /// Size of the keyframe views (views/*.png), WxH.
+    #[arg(long, default_value = "320x180", value_parser = args::resolution)]
+    view_size: (u32, u32),
+    /// Samples per pixel of the keyframe views.
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    view_spp: u32,
+    /// Folder for the report.
+    #[arg(long, default_value = "bench-report")]
+    out: PathBuf,
 }
 
 /// A renderer setting of the benchmark.
@@ -475,8 +497,22 @@ fn row(s: &Summary) -> String {
     )
 }
 
+/// Runs the benchmark, writes the report files and prints the Markdown.
+pub(crate) fn run(mut b: Bench, workers: usize) -> Result<()> {
+    if b.edit_radii
+        .iter()
+        .any(|r| !(r.is_finite() && *r > 0.0 && *r <= 256.0))
+    {
+        bail!("--edit-radii must be in (0, 256]");
+    }
+    b.frames = b.frames.max(1);
+    b.repeat = b.repeat.max(1);
+    b.edit_frames = b.edit_frames.max(1);
+    emit(&bench(b, workers)?)
+}
+
 /// Runs the benchmark; writes the report files and returns the Markdown.
-pub(crate) fn bench(b: Bench, workers: usize) -> Result<String> {
+fn bench(b: Bench, workers: usize) -> Result<String> {
     let path = match &b.path {
         Some(p) => CameraPath::load(p)?,
         None => CameraPath::thesis(),
@@ -509,7 +545,8 @@ pub(crate) fn bench(b: Bench, workers: usize) -> Result<String> {
         }
     }
     let clocks_after = clocks();
-    // What the path shows: each keyframe's view at complexity 3 (16 spp, 320 × 180).
+    // What the path shows: each keyframe's view at complexity 3 (by default 16 spp,
+    // 320 × 180).
     std::fs::create_dir_all(b.out.join("views"))
         .with_context(|| format!("creating {}", b.out.display()))?;
     {
@@ -517,12 +554,7 @@ pub(crate) fn bench(b: Bench, workers: usize) -> Result<String> {
         let centre = view.dims().voxels().as_dvec3() * 0.5;
         for k in &path.keyframes {
             let p = params_at(&scene.params, &path, &PRESETS[2], k.time_s, centre);
-            let job = RenderJob {
-                width: 320,
-                height: 180,
-                spp: 16,
-                seed: 1,
-            };
+            let job = RenderJob::sized(b.view_size, b.view_spp, 1);
             let (img, _) = session.render(&view, &p, &job)?;
             let file = b.out.join("views").join(format!("t{:04.1}s.png", k.time_s));
             app::atomic::write_atomic(&file, |w| img.write_png(w, p.settings.exposure))?;

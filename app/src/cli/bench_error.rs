@@ -16,6 +16,7 @@
 //! table gives, at the error the renderer's defaults reach at N spp, how much less GPU time
 //! each choice needs (log-log interpolation along its own curve).
 
+use super::args;
 use super::bench::{PRESETS, Preset, params_at, select_presets};
 use super::plot::{Axes, Series, plot};
 use anyhow::{Context, Result, bail};
@@ -30,24 +31,37 @@ use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-/// What `bench-error` runs.
+/// `voxbrick bench-error`: what to measure.
+#[derive(clap::Args)]
 pub(crate) struct BenchError {
-    pub(crate) device: String,
-    /// A camera path file (None: the built-in thesis path).
-    pub(crate) path: Option<PathBuf>,
-    /// Path times of the views (empty: 0, 9 and 15 s).
-    pub(crate) views: Vec<f64>,
-    pub(crate) size: (u32, u32),
-    /// Samples of each reference (two halves of R/2).
-    pub(crate) reference_spp: u32,
-    /// The most samples per pixel measured (a power of two).
-    pub(crate) max_spp: u32,
-    /// The references' numbers (the defaults': scrambled Sobol; independent ones cross-check
-    /// Sobol's curves against an estimator that shares nothing with them).
-    pub(crate) reference_sequence: Sequence,
-    /// Preset names (empty: all, and "physical + lamps").
-    pub(crate) presets: Vec<String>,
-    pub(crate) out: PathBuf,
+    /// Device name filter ("gpu": the best).
+    #[arg(long, default_value = "gpu")]
+    device: String,
+    /// A camera path file (RON; default: the built-in thesis path).
+    #[arg(long)]
+    path: Option<PathBuf>,
+    /// Path times of the views in seconds, comma-separated (default 0,9,15).
+    #[arg(long, value_delimiter = ',')]
+    views: Vec<f64>,
+    /// Image size, WxH.
+    #[arg(long, default_value = "512x288", value_parser = args::resolution)]
+    size: (u32, u32),
+    /// Samples of each reference (at least 8 × --max-spp; two independent halves).
+    #[arg(long, default_value_t = 8192)]
+    reference_spp: u32,
+    /// The most samples per pixel measured (a power of two, 4 or more).
+    #[arg(long, default_value_t = 256)]
+    max_spp: u32,
+    /// The references' numbers: sobol (the renderer's default) or independent (they
+    /// cross-check Sobol's curves against an estimator that shares nothing with them).
+    #[arg(long, default_value = "sobol", value_parser = args::sequence)]
+    reference_sequence: Sequence,
+    /// Presets (complexity-1, complexity-2, complexity-3, physical, lamps; default all).
+    #[arg(long, value_delimiter = ',')]
+    presets: Vec<String>,
+    /// Folder for the report.
+    #[arg(long, default_value = "error-report")]
+    out: PathBuf,
 }
 
 /// A sampling choice: the renderer's defaults with one thing changed.
@@ -463,7 +477,13 @@ fn cases(names: &[String]) -> Result<Vec<(String, Preset, bool)>> {
     Ok(out)
 }
 
-pub(crate) fn bench_error(b: BenchError, workers: usize) -> Result<String> {
+/// Measures, checks, writes the report files and prints the Markdown; a failed check is
+/// an error (non-zero exit).
+pub(crate) fn run(b: BenchError, workers: usize) -> Result<()> {
+    super::emit(&bench_error(b, workers)?)
+}
+
+fn bench_error(b: BenchError, workers: usize) -> Result<String> {
     if !b.max_spp.is_power_of_two() || b.max_spp < 4 {
         bail!("--max-spp must be a power of two, at least 4");
     }

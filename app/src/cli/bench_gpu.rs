@@ -5,33 +5,64 @@ use super::{emit, with_progress};
 use anyhow::{Context, Result, bail};
 use app::scene::thesis_scene;
 
-/// What `bench-gpu` measures.
+/// `voxbrick bench-gpu`: what to measure.
+#[derive(clap::Args)]
 pub(crate) struct BenchGpu {
-    pub(crate) width: u32,
-    pub(crate) height: u32,
-    pub(crate) frames: usize,
-    pub(crate) experiment: u32,
-    pub(crate) inline_shadows: bool,
-    /// Error against time with a reference of this many samples, instead of the complexities.
-    pub(crate) convergence: Option<u32>,
-    /// Invocations per pixel (None: the renderer's choice).
-    pub(crate) slices: Option<u32>,
-    /// Light sampling of emissive voxels against BSDF sampling alone, with a reference of
-    /// this many samples (`bench_lights`), instead of the complexities.
-    pub(crate) lights: Option<u32>,
+    /// Internal resolution width.
+    #[arg(long, default_value_t = 1024)]
+    width: u32,
+    /// Internal resolution height.
+    #[arg(long, default_value_t = 576)]
+    height: u32,
+    /// Timed dispatches per complexity and variant, in rounds of 10 back to back (after
+    /// two warm-up rounds).
+    #[arg(long, default_value_t = 50)]
+    frames: usize,
+    /// Device name filter (default: a discrete GPU if any).
+    #[arg(long)]
+    device: Option<String>,
+    /// Shader experiment bits (trace.comp `EXPERIMENT`; 0 = the real renderer).
+    #[arg(long, default_value_t = 0)]
+    experiment: u32,
+    /// Trace shadow rays where they start instead of queueing them for the shadow pass.
+    #[arg(long)]
+    inline_shadows: bool,
+    /// Instead of the complexities: image error against GPU time at complexity 3's
+    /// settings (1, 2, 4 … 256 spp against a reference render).
+    #[arg(long)]
+    convergence: bool,
+    /// Instead of the complexities: light sampling of emissive voxels against BSDF
+    /// sampling alone (efficiency at equal error; a lamp-lit room and the thesis scene with
+    /// lamps), and the cost of editing 10 k emissive voxels.
+    #[arg(long, conflicts_with = "convergence")]
+    lights: bool,
+    /// Samples per pixel of the convergence and light-sampling references.
+    #[arg(long, default_value_t = 4096)]
+    reference_spp: u32,
+    /// Invocations each pixel's samples are split among, 1..=8 (default: the renderer's
+    /// choice for the image size).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8))]
+    slices: Option<u32>,
 }
 
-pub(crate) fn bench_gpu(bench: BenchGpu, device: Option<String>, workers: usize) -> Result<()> {
+/// Times the complexities (or, with `--convergence` / `--lights`, those measurements) and
+/// prints the table.
+pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
     let BenchGpu {
         width,
         height,
         frames,
+        device,
         experiment,
         inline_shadows,
         convergence,
-        slices,
         lights,
+        reference_spp,
+        slices,
     } = bench;
+    let frames = frames.max(1);
+    let convergence = convergence.then_some(reference_spp);
+    let lights = lights.then_some(reference_spp);
     use render::vulkan::trace::Variant;
     if let Some(reference_spp) = lights {
         let device = device.as_deref().unwrap_or("gpu");

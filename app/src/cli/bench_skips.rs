@@ -9,6 +9,7 @@
 //! frame at the editor's moving scale and at full size). Writes skips.md and skips.json.
 
 use super::bench::{PRESETS, params_at};
+use super::{args, emit};
 use anyhow::{Context, Result, bail};
 use app::camera_path::CameraPath;
 use brickmap::{
@@ -24,18 +25,27 @@ use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-/// What to measure.
-pub struct BenchSkips {
-    /// Device name filter.
-    pub device: String,
+/// `voxbrick bench-skips`: what to measure.
+#[derive(clap::Args)]
+pub(crate) struct BenchSkips {
+    /// Device name filter ("gpu": the best).
+    #[arg(long, default_value = "gpu")]
+    device: String,
     /// Internal resolution of the traversal and pipeline cases, WxH.
-    pub size: (u32, u32),
-    /// Window size of the moving-resolution case.
-    pub window: (u32, u32),
-    /// Timed rounds (after two of warm-up).
-    pub rounds: usize,
+    #[arg(long, default_value = "1024x576", value_parser = args::resolution)]
+    size: (u32, u32),
+    /// Window size of the moving-resolution case, WxH.
+    #[arg(long, default_value = "1920x1080", value_parser = args::resolution)]
+    window: (u32, u32),
+    /// Timed rounds of 10 dispatches per variant (after two of warm-up).
+    #[arg(long, default_value_t = 5)]
+    rounds: usize,
+    /// Seconds of 60 Hz frames in the accumulation case's reference image.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(2..=1024))]
+    reference_seconds: u32,
     /// Folder for the report.
-    pub out: PathBuf,
+    #[arg(long, default_value = "skips-report")]
+    out: PathBuf,
 }
 
 /// A thing the renderer skips.
@@ -217,19 +227,20 @@ fn traversal_row(
 }
 
 /// Accumulation when still: one frame's samples against a second of frames, as relMSE
-/// against a reference of 64 seconds of frames.
+/// against a reference of `seconds` seconds of frames.
 fn accumulation_row(
     session: &mut Viewport,
     case: &Case,
     size: (u32, u32),
     spp: u32,
+    seconds: u32,
 ) -> Result<Row> {
     let view = case.world.read();
     let reference = session
         .render(
             &view,
             &case.params,
-            &RenderJob::sized(size, 64 * SECOND * spp, 1),
+            &RenderJob::sized(size, seconds * SECOND * spp, 1),
         )?
         .0;
     let one = session
@@ -257,7 +268,7 @@ fn accumulation_row(
         same_image_rel_mse: None,
         note: format!(
             "{spp} spp per frame; without it every frame shows its own samples; reference {} spp",
-            64 * SECOND * spp
+            seconds * SECOND * spp
         ),
     })
 }
@@ -468,7 +479,12 @@ fn needy_scene(skip: Skip, base: &SceneParams, workers: usize) -> Result<Case> {
 }
 
 /// Runs every skip on the benchmark scene and on the scene that needs it.
-pub(crate) fn bench_skips(b: BenchSkips, workers: usize) -> Result<String> {
+/// Measures every skip, writes skips.md and skips.json and prints the table.
+pub(crate) fn run(b: BenchSkips, workers: usize) -> Result<()> {
+    emit(&bench_skips(b, workers)?)
+}
+
+fn bench_skips(b: BenchSkips, workers: usize) -> Result<String> {
     std::fs::create_dir_all(&b.out).with_context(|| format!("creating {}", b.out.display()))?;
     let ctx = app::gpu::context(&b.device, false)?;
     let thesis = app::scene::thesis_scene(workers)?;
@@ -499,7 +515,9 @@ pub(crate) fn bench_skips(b: BenchSkips, workers: usize) -> Result<String> {
             let mut session = Viewport::new(ctx.clone(), &case.world.read())?;
             let spp = preset.spp;
             let row = match skip {
-                Skip::Accumulation => accumulation_row(&mut session, case, b.size, spp)?,
+                Skip::Accumulation => {
+                    accumulation_row(&mut session, case, b.size, spp, b.reference_seconds)?
+                }
                 Skip::MovingResolution => moving_row(&mut session, case, (b.window, spp, rounds))?,
                 _ => traversal_row(&mut session, case, skip, (b.size, spp, rounds))?,
             };

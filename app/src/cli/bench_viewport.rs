@@ -4,28 +4,84 @@
 //! scene. Reports GPU time per frame (timestamp queries), host time to record and submit a
 //! frame, and camera move → first frame showing it (frames and ms, submit to completion).
 
-use anyhow::Result;
+use super::{args, emit, with_progress};
+use anyhow::{Result, bail};
+use app::scene::{SceneSize, default_scene, thesis_scene};
 use brickmap::World;
 use render::SceneParams;
 use render::present::{EguiFrame, Presented, Presenter};
 use render::viewport::{FrameRequest, Viewport};
 use std::time::Instant;
 
-/// What to measure.
-pub struct BenchViewport {
-    /// Output (window) size.
-    pub size: (u32, u32),
-    /// Internal scales to measure.
-    pub scales: Vec<f32>,
+/// `voxbrick bench-viewport`: what to measure.
+#[derive(clap::Args)]
+pub(crate) struct BenchViewport {
+    /// Output (window) size, as WxH.
+    #[arg(long, value_parser = args::window_size, default_value = "1920x1080")]
+    size: (u32, u32),
+    /// Internal scales, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "0.5,1.0")]
+    scales: Vec<f32>,
     /// Timed frames per case (after warm-up).
-    pub frames: usize,
+    #[arg(long, default_value_t = 200)]
+    frames: usize,
     /// Samples per pixel each frame adds.
-    pub spp: u32,
-    /// Also the window's half: the copy into an offscreen image of the window's size and
-    /// egui panels painted on it (the context must be made with `draw_ui`).
-    pub ui: bool,
-    /// Also each case with the viewport's denoiser on.
-    pub denoise: bool,
+    #[arg(long, default_value_t = 1)]
+    spp: u32,
+    /// Vulkan device (part of its name).
+    #[arg(long)]
+    device: Option<String>,
+    /// Also measure the window's half: the copy into an offscreen image of the window's
+    /// size and egui panels painted on it.
+    #[arg(long)]
+    ui: bool,
+    /// Also measure each case with the viewport's denoiser on.
+    #[arg(long)]
+    denoise: bool,
+    /// Instead: edit → first frame showing it, on the default 512 × 256 × 512 scene, for
+    /// live sphere strokes of these radii (comma-separated), and the brush preview's
+    /// update time.
+    #[arg(long, value_delimiter = ',')]
+    edits: Vec<f64>,
+}
+
+/// Checks the arguments, builds the scene (the thesis scene, or the default one for
+/// `--edits`) and its GPU session, and prints the report.
+pub(crate) fn command(mut b: BenchViewport, workers: usize) -> Result<()> {
+    if let Some(s) = b.scales.iter().find(|s| !(**s > 0.0 && **s <= 1.0)) {
+        bail!("internal scale {s} is outside (0, 1]");
+    }
+    if let Some(r) = b.edits.iter().find(|r| !(**r >= 1.0 && **r <= 64.0)) {
+        bail!("--edits radius {r} is outside 1..=64");
+    }
+    let device = b.device.clone().unwrap_or_else(|| "gpu".into());
+    if !b.edits.is_empty() {
+        let scene = with_progress("building the default scene".into(), || {
+            default_scene(SceneSize::Full, workers)
+        })?;
+        let session = {
+            let view = scene.world.read();
+            app::gpu::session(&device, &view)?
+        };
+        return emit(&edits(
+            session,
+            scene,
+            b.size,
+            &b.scales,
+            &b.edits,
+            b.frames.clamp(10, 400),
+        )?);
+    }
+    b.frames = b.frames.max(1);
+    b.spp = b.spp.clamp(1, 16);
+    let mut scene = thesis_scene(workers)?;
+    scene.params.sun.enabled = true;
+    scene.params.settings.max_bounces = 3;
+    let session = {
+        let view = scene.world.read();
+        app::gpu::session_with(&device, &view, b.ui)?
+    };
+    emit(&run(session, &scene.world, &scene.params, &b)?)
 }
 
 fn scaled((w, h): (u32, u32), f: f32) -> (u32, u32) {
@@ -241,12 +297,7 @@ fn latency(
 }
 
 /// Runs the benchmark; returns the report.
-pub fn run(
-    mut vp: Viewport,
-    world: &World,
-    params: &SceneParams,
-    b: &BenchViewport,
-) -> Result<String> {
+fn run(mut vp: Viewport, world: &World, params: &SceneParams, b: &BenchViewport) -> Result<String> {
     let ctx = vp.ctx().clone();
     let mut text = format!(
         "device       {} ({})\nscene        thesis, {} bounces, sun {}; output {}x{}, {} spp per frame\n",
@@ -342,7 +393,7 @@ pub fn run(
 /// apply time, frames and milliseconds from the edit to the first frame showing it finished
 /// on the GPU, GPU time of the frames while the stroke is drawn, and the brush preview's
 /// update time (exactly the voxels a click changes, on the UI thread).
-pub fn edits(
+fn edits(
     mut vp: Viewport,
     scene: app::Scene,
     size: (u32, u32),

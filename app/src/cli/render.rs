@@ -58,7 +58,7 @@ pub(crate) struct RenderArgs {
     pub(crate) slices: Option<u32>,
     /// GPU: the numbers samples are made from, sobol or independent (default: the scene's
     /// setting; the CPU reference always uses independent numbers).
-    #[arg(long, value_parser = super::parse_sequence)]
+    #[arg(long, value_parser = super::args::sequence)]
     pub(crate) sequence: Option<render::Sequence>,
 }
 

@@ -1,12 +1,31 @@
 //! `voxbrick stats` and `info`: a world's size, memory by GPU buffer, a pick ray and the
 //! content hash.
 
-use super::emit;
+use super::{emit, with_progress};
 use anyhow::Result;
+use app::scene::{SceneSize, default_scene};
 use brickmap::{Ray, World};
 use glam::DVec3;
+use std::time::Instant;
 
-pub(crate) fn print_stats(world: &World, seconds: f64) -> Result<()> {
+/// `voxbrick stats`: builds the built-in default scene and prints its statistics.
+#[derive(clap::Args)]
+pub(crate) struct StatsArgs {
+    /// Scene size.
+    #[arg(long, value_enum, default_value = "full")]
+    size: SceneSize,
+}
+
+/// Builds the scene, timed, and prints [`stats_text`].
+pub(crate) fn stats(a: StatsArgs, workers: usize) -> Result<()> {
+    let started = Instant::now();
+    let scene = with_progress("building the default scene".into(), || {
+        default_scene(a.size, workers)
+    })?;
+    print_stats(&scene.world, started.elapsed().as_secs_f64())
+}
+
+fn print_stats(world: &World, seconds: f64) -> Result<()> {
     emit(&stats_text(world, seconds))
 }
 

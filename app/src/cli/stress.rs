@@ -7,15 +7,37 @@ use anyhow::{Result, bail};
 use render::stress::{ImageRow, RayRow, StressConfig};
 use std::path::PathBuf;
 
-/// What `stress` runs.
+/// `voxbrick stress`: what to run.
+#[derive(clap::Args)]
 pub(crate) struct Stress {
-    pub(crate) config: StressConfig,
-    pub(crate) device: String,
-    /// CPU reference images only (no GPU: rays and GPU images are not tried).
-    pub(crate) cpu_only: bool,
-    /// Folder for stress.json and stress.md.
-    pub(crate) out: Option<PathBuf>,
-    pub(crate) validation: bool,
+    /// Rays per class and world (12 classes, 2 worlds).
+    #[arg(long, default_value_t = 250_000)]
+    rays: usize,
+    /// GPU images: width and height.
+    #[arg(long, default_value_t = 128)]
+    size: u32,
+    /// GPU images: one-sample renders per view.
+    #[arg(long, default_value_t = 64)]
+    renders: u32,
+    /// CPU reference images: width and height.
+    #[arg(long, default_value_t = 32)]
+    cpu_size: u32,
+    /// CPU reference images: one-sample renders per view.
+    #[arg(long, default_value_t = 8)]
+    cpu_renders: u32,
+    /// Seed of the rays and samples.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Device name filter ("gpu": the best), or "cpu": only the CPU reference's images (no
+    /// GPU: rays and GPU images are not tried).
+    #[arg(long, default_value = "gpu")]
+    device: String,
+    /// Also count validation-layer errors (each is a failure).
+    #[arg(long)]
+    validation: bool,
+    /// Folder to write stress.json and stress.md into.
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 /// The Markdown tables.
@@ -86,9 +108,21 @@ fn markdown(device: &str, cfg: &StressConfig, rays: &[RayRow], images: &[ImageRo
     t
 }
 
-pub(crate) fn stress(s: Stress) -> Result<String> {
-    let cfg = s.config;
-    let ctx = if s.cpu_only {
+/// Runs the suite and prints the report; any non-zero count is an error.
+pub(crate) fn run(s: Stress) -> Result<()> {
+    super::emit(&stress(s)?)
+}
+
+fn stress(s: Stress) -> Result<String> {
+    let cfg = StressConfig {
+        rays_per_class: s.rays,
+        gpu_size: s.size.clamp(1, 4096),
+        gpu_renders: s.renders,
+        cpu_size: s.cpu_size.clamp(1, 4096),
+        cpu_renders: s.cpu_renders,
+        seed: s.seed,
+    };
+    let ctx = if s.device == "cpu" {
         None
     } else {
         Some(app::gpu::context(&s.device, s.validation)?)

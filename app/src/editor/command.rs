@@ -21,7 +21,8 @@ use super::error::{EditError, Result};
 use super::inverse::{apply_all, with_table};
 use crate::scene::Scene;
 use crate::selection::{self, Clip, SelectOp, Selection, select};
-use brickmap::terrain::{NoiseKind, NoiseTerrain};
+pub use brickmap::terrain::NoiseKind;
+use brickmap::terrain::NoiseTerrain;
 use brickmap::{EditOp, Material, MaterialKind, Mode, Shape};
 use glam::IVec3;
 use render::{Camera, RenderSettings, Sky, Sun};
@@ -42,7 +43,7 @@ pub struct TerrainSpec {
     pub water_level: u32,
     /// Noise function (Perlin when absent).
     #[serde(default)]
-    pub noise: NoiseSpec,
+    pub noise: NoiseKind,
     /// Where each material goes (the thesis scene's bands when absent).
     #[serde(default)]
     pub bands: Bands,
@@ -80,33 +81,8 @@ impl TerrainSpec {
             octaves: 5,
             height_range: (size.1 / 8, size.1 * 5 / 8),
             water_level: size.1 / 4,
-            noise: NoiseSpec::Perlin,
+            noise: NoiseKind::Perlin,
             bands: Bands::default(),
-        }
-    }
-}
-
-/// Noise functions in commands and scripts.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum NoiseSpec {
-    /// Classic gradient noise.
-    #[default]
-    Perlin,
-    /// OpenSimplex (fewer directional artefacts).
-    OpenSimplex,
-    /// SuperSimplex.
-    SuperSimplex,
-    /// Value noise (blockier).
-    Value,
-}
-
-impl From<NoiseSpec> for NoiseKind {
-    fn from(n: NoiseSpec) -> Self {
-        match n {
-            NoiseSpec::Perlin => NoiseKind::Perlin,
-            NoiseSpec::OpenSimplex => NoiseKind::OpenSimplex,
-            NoiseSpec::SuperSimplex => NoiseKind::SuperSimplex,
-            NoiseSpec::Value => NoiseKind::Value,
         }
     }
 }
@@ -470,7 +446,7 @@ impl Command {
                     let mut params =
                         crate::scene::thesis_terrain(materials, world.dims().voxels().y as u32);
                     (params.seed, params.noise, params.scale, params.octaves) =
-                        (t.seed, t.noise.into(), t.scale, t.octaves);
+                        (t.seed, t.noise, t.scale, t.octaves);
                     (params.height_range, params.water_level) = (t.height_range, t.water_level);
                     (params.rock_line, params.snow_line, params.soil_depth) =
                         (t.bands.rock_line, t.bands.snow_line, t.bands.soil_depth);

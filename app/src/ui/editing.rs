@@ -22,7 +22,7 @@ use super::swatch::{DIELECTRIC_BOUNCES, swatch};
 use super::tools::{Brush, MAX_SIZE, Tool};
 use crate::editor::Document;
 use crate::editor::command::{
-    Axis, BrushMode, BrushShape, KindSpec, MaterialSpec, NoiseSpec, TerrainSpec,
+    Axis, BrushMode, BrushShape, KindSpec, MaterialSpec, NoiseKind, TerrainSpec,
 };
 use brickmap::{MaterialKind, MaterialTable};
 
@@ -629,10 +629,10 @@ fn terrain(ui: &mut egui::Ui, spec: &mut TerrainSpec, height: u32, out: &mut Vec
         .selected_text(format!("{:?}", spec.noise))
         .show_ui(ui, |ui| {
             for n in [
-                NoiseSpec::Perlin,
-                NoiseSpec::OpenSimplex,
-                NoiseSpec::SuperSimplex,
-                NoiseSpec::Value,
+                NoiseKind::Perlin,
+                NoiseKind::OpenSimplex,
+                NoiseKind::SuperSimplex,
+                NoiseKind::Value,
             ] {
                 ui.selectable_value(&mut spec.noise, n, format!("{n:?}"));
             }

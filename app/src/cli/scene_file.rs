@@ -1,0 +1,176 @@
+//! `voxbrick new`, `convert` and `info`: scene files created, converted and described.
+
+use super::stats::stats_text;
+use super::{args, emit, with_progress};
+use anyhow::{Context, Result, bail};
+use app::Scene;
+use app::formats::{self, Format};
+use app::scene::{terrain_materials, thesis_scene, thesis_terrain};
+use brickmap::GridDims;
+use brickmap::terrain::{NoiseKind, NoiseTerrain};
+use glam::IVec3;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// `voxbrick new`: a noise terrain or the thesis scene, written to a file.
+#[derive(clap::Args)]
+pub(crate) struct NewArgs {
+    /// A noise terrain with water (the parameters below).
+    #[arg(long, conflicts_with = "thesis")]
+    terrain: bool,
+    /// The thesis benchmark scene: 512×256×512 terrain, water and a metal statue.
+    #[arg(long)]
+    thesis: bool,
+    /// Grid size in voxels, as WxHxD (multiples of 8 are used as they are).
+    #[arg(long, value_parser = args::grid_size, default_value = "512x256x512")]
+    size: IVec3,
+    /// Noise seed.
+    #[arg(long, default_value_t = 2022)]
+    seed: u32,
+    /// Noise function: perlin, open-simplex, super-simplex or value.
+    #[arg(long, value_parser = args::noise, default_value = "perlin")]
+    noise: NoiseKind,
+    /// Wavelength of the first octave, in voxels.
+    #[arg(long)]
+    scale: Option<f64>,
+    /// Octaves of fractal noise (1..=12).
+    #[arg(long, default_value_t = 5)]
+    octaves: u32,
+    /// Lowest surface height in voxels.
+    #[arg(long)]
+    height_min: Option<u32>,
+    /// Highest surface height in voxels.
+    #[arg(long)]
+    height_max: Option<u32>,
+    /// Water level in voxels (0: none).
+    #[arg(long)]
+    water_level: Option<u32>,
+    /// Output file (.ron or .vox).
+    output: PathBuf,
+}
+
+/// Generates the scene and writes it atomically.
+pub(crate) fn new(a: NewArgs, workers: usize) -> Result<()> {
+    if !a.terrain && !a.thesis {
+        bail!("say what to create: --terrain (with its parameters) or --thesis");
+    }
+    Format::of(&a.output)?;
+    let started = Instant::now();
+    let scene = with_progress("generating".into(), || {
+        if a.thesis {
+            return thesis_scene(workers);
+        }
+        let dims = GridDims::from_voxels(a.size.as_uvec3()).context("grid size")?;
+        let scene = Scene::empty(dims, workers)?;
+        let h = dims.voxels().y as u32;
+        let mut params = thesis_terrain(terrain_materials(&scene.world)?, h);
+        params.seed = a.seed;
+        params.noise = a.noise;
+        params.octaves = a.octaves;
+        params.scale = a.scale.unwrap_or(params.scale);
+        params.height_range = (
+            a.height_min.unwrap_or(params.height_range.0),
+            a.height_max.unwrap_or(params.height_range.1),
+        );
+        params.water_level = a.water_level.unwrap_or(params.water_level);
+        scene.world.apply(NoiseTerrain::new(params, dims)?.edit())?;
+        scene.world.take_dirty();
+        Ok(scene)
+    })?;
+    let generated = started.elapsed().as_secs_f64();
+    with_progress(format!("writing {}", a.output.display()), || {
+        Ok(scene.save(&a.output)?)
+    })?;
+    eprintln!(
+        "generated in {generated:.2} s, wrote {} in {:.2} s total",
+        a.output.display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// `voxbrick convert`: between project (.ron) and MagicaVoxel (.vox) files.
+#[derive(clap::Args)]
+pub(crate) struct ConvertArgs {
+    /// Input file (.ron or .vox).
+    input: PathBuf,
+    /// Output file (.ron or .vox); replaced atomically.
+    output: PathBuf,
+    /// Offset added to imported .vox voxels, as X,Y,Z.
+    #[arg(long, value_parser = args::ivec3, default_value = "0,0,0")]
+    offset: IVec3,
+    /// Import nodes on hidden layers too.
+    #[arg(long)]
+    include_hidden: bool,
+}
+
+/// Reads the input (reporting what a .vox import dropped) and writes the output.
+pub(crate) fn convert(a: ConvertArgs, workers: usize) -> Result<()> {
+    let started = Instant::now();
+    let scene = with_progress(
+        format!("reading {}", a.input.display()),
+        || match Format::of(&a.input)? {
+            Format::Project => Ok(formats::project::load(&a.input, workers)?),
+            Format::Vox => {
+                let options = formats::vox::ImportOptions {
+                    offset: a.offset,
+                    include_hidden: a.include_hidden,
+                };
+                let (scene, report) = formats::vox::import_file(&a.input, &options, workers)?;
+                eprintln!(
+                    "imported {} voxels from {} instances of {} models, {} materials",
+                    report.voxels, report.instances, report.models, report.materials
+                );
+                for line in &report.dropped {
+                    eprintln!("  dropped: {line}");
+                }
+                Ok(scene)
+            }
+        },
+    )?;
+    with_progress(format!("writing {}", a.output.display()), || {
+        Ok(scene.save(&a.output)?)
+    })?;
+    eprintln!(
+        "wrote {} in {:.2} s",
+        a.output.display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// `voxbrick info`: a scene file's dimensions, voxel count, materials, memory and view.
+#[derive(clap::Args)]
+pub(crate) struct InfoArgs {
+    /// A .ron or .vox file.
+    file: PathBuf,
+}
+
+/// Prints the file's statistics, camera and render settings.
+pub(crate) fn info(a: InfoArgs, workers: usize) -> Result<()> {
+    let file = a.file;
+    let started = Instant::now();
+    let scene = with_progress(format!("reading {}", file.display()), || {
+        Ok(Scene::load(&file, workers)?)
+    })?;
+    let p = &scene.params;
+    let mut text = format!("file         {}\n", file.display());
+    text += &stats_text(&scene.world, started.elapsed().as_secs_f64());
+    let lens = match p.camera.projection {
+        render::Projection::Perspective => format!("fov {:.1}", p.camera.fov_y_deg),
+        render::Projection::Orthographic { height } => {
+            format!("orthographic {height:.1} voxels tall")
+        }
+    };
+    text += &format!(
+        "camera       at {} yaw {:.1} pitch {:.1} {lens}\nrender       {} spp, {} bounces, {}x{}\n",
+        p.camera.position,
+        p.camera.yaw_deg,
+        p.camera.pitch_deg,
+        p.settings.samples_per_pixel,
+        p.settings.max_bounces,
+        p.settings.internal_resolution.0,
+        p.settings.internal_resolution.1
+    );
+    emit(&text)
+}
