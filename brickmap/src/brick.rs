@@ -128,6 +128,26 @@ impl Brick {
     }
 }
 
+/// The materials of one brick, borrowed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BrickMaterials<'a> {
+    /// Every solid voxel has this material.
+    Uniform(u8),
+    /// One material per solid voxel, in popcount order.
+    PerVoxel(&'a [u8]),
+}
+
+impl BrickMaterials<'_> {
+    /// The material of the brick's `k`-th solid voxel (popcount order).
+    #[inline]
+    pub fn at(&self, k: usize) -> u8 {
+        match self {
+            BrickMaterials::Uniform(m) => *m,
+            BrickMaterials::PerVoxel(v) => v[k],
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

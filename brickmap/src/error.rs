@@ -7,7 +7,7 @@ use glam::IVec3;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum BrickmapError {
     /// A grid dimension was zero or beyond the supported maximum.
-    #[error("grid of {x}×{y}×{z} bricks is not supported (each axis 1..={max_x}, 1..={max_y}, 1..={max_z})", max_x = crate::grid::MAX_BRICKS_X, max_y = crate::grid::MAX_BRICKS_Y, max_z = crate::grid::MAX_BRICKS_Z)]
+    #[error("grid of {x}×{y}×{z} bricks is not supported (each axis 1..={}, 1..={}, 1..={})", max[0], max[1], max[2])]
     GridSize {
         /// Requested bricks along x.
         x: u32,
@@ -15,6 +15,8 @@ pub enum BrickmapError {
         y: u32,
         /// Requested bricks along z.
         z: u32,
+        /// The most bricks along each axis.
+        max: [u32; 3],
     },
     /// A voxel coordinate lies outside the grid.
     #[error("voxel {0} is outside the grid (0,0,0)..{1}")]

@@ -36,7 +36,12 @@ impl GridDims {
             && (1..=MAX_BRICKS_Y).contains(&y)
             && (1..=MAX_BRICKS_Z).contains(&z);
         if !ok {
-            return Err(BrickmapError::GridSize { x, y, z });
+            return Err(BrickmapError::GridSize {
+                x,
+                y,
+                z,
+                max: [MAX_BRICKS_X, MAX_BRICKS_Y, MAX_BRICKS_Z],
+            });
         }
         Ok(Self {
             bricks: UVec3::new(x, y, z),

@@ -22,10 +22,10 @@
 //! the sum of its two children, so the tree is a function of its leaves): an edit costs its
 //! bricks and log C nodes per changed face, never anything proportional to the scene.
 
+use crate::brick::{BrickMaterials, Mask};
 use crate::dirty::DirtyRanges;
 use crate::grid::GridDims;
 use crate::material::{MaterialKind, MaterialTable};
-use crate::world::WorldView;
 use glam::{IVec3, UVec3};
 use std::collections::{HashMap, HashSet};
 use std::ops::Range;
@@ -416,7 +416,7 @@ impl Lights {
 
     /// Checks the structure against the world: every light face present once, in its
     /// brick's slots, with its material's weight; every node the sum of its children.
-    pub fn validate(&self, view: &WorldView<'_>) -> std::result::Result<(), String> {
+    pub fn validate(&self, view: &impl VoxelSource) -> std::result::Result<(), String> {
         let c = self.capacity as usize;
         for i in 1..c {
             if self.nodes[i] != self.nodes[2 * i] + self.nodes[2 * i + 1] {
@@ -425,8 +425,8 @@ impl Lights {
         }
         let mut expected: HashMap<u32, Vec<[u32; 2]>> = HashMap::new();
         let mut lit = HashSet::new();
-        let dims = view.dims();
-        view.for_each_brick(|b, _, _| {
+        let dims = view.grid();
+        view.visit_bricks(&mut |b| {
             let cell = dims.cell_index(b) as u32;
             let lights = brick_lights(view, &self.weights, b);
             if lights.lit {
@@ -474,10 +474,23 @@ impl Lights {
     }
 }
 
+/// What the light index reads of the world: its grid, each brick's voxels and whether a
+/// voxel is solid. The world's view implements it; the index never sees the world itself.
+pub trait VoxelSource {
+    /// The grid.
+    fn grid(&self) -> GridDims;
+    /// Calls `f` with every non-empty brick's coordinate.
+    fn visit_bricks(&self, f: &mut dyn FnMut(UVec3));
+    /// Calls `f` with brick `b`'s occupancy and materials.
+    fn read_brick(&self, b: UVec3, f: &mut dyn FnMut(&Mask, BrickMaterials<'_>));
+    /// Whether voxel `v` (inside the grid) is solid.
+    fn solid(&self, v: IVec3) -> bool;
+}
+
 /// The light faces of brick `b` under `weights`, read from the view (the brick's voxels and,
 /// for faces on its boundary, the neighbouring bricks').
-pub(crate) fn brick_lights(view: &WorldView<'_>, weights: &[f32; 256], b: UVec3) -> BrickLights {
-    let dims: GridDims = view.dims();
+pub(crate) fn brick_lights(view: &impl VoxelSource, weights: &[f32; 256], b: UVec3) -> BrickLights {
+    let dims: GridDims = view.grid();
     let cell = dims.cell_index(b) as u32;
     let none = BrickLights {
         cell,
@@ -485,12 +498,34 @@ pub(crate) fn brick_lights(view: &WorldView<'_>, weights: &[f32; 256], b: UVec3)
         faces: Vec::new(),
     };
     let lit = |m: u8| weights[m as usize] > 0.0;
-    let slab = view.slab_for_brick_x(b.x);
-    let (mask, mats) = slab.read(cell as usize);
-    let n = mask.count() as usize;
-    if n == 0 || !(0..n).any(|k| lit(mats.at(k))) {
+    let mut faces = Vec::new();
+    let mut any_lit = false;
+    view.read_brick(b, &mut |mask, mats| {
+        let n = mask.count() as usize;
+        any_lit = (0..n).any(|k| lit(mats.at(k)));
+        if any_lit {
+            faces = lit_faces(view, dims, b, mask, mats, &lit);
+        }
+    });
+    if !any_lit {
         return none;
     }
+    BrickLights {
+        cell,
+        lit: true,
+        faces,
+    }
+}
+
+/// The uncovered faces of brick `b`'s lit voxels.
+fn lit_faces(
+    view: &impl VoxelSource,
+    dims: GridDims,
+    b: UVec3,
+    mask: &Mask,
+    mats: BrickMaterials<'_>,
+    lit: &impl Fn(u8) -> bool,
+) -> Vec<[u32; 2]> {
     let base = (b * 8).as_ivec3();
     let mut faces = Vec::new();
     for (k, bit) in mask.ones().enumerate() {
@@ -509,7 +544,7 @@ pub(crate) fn brick_lights(view: &WorldView<'_>, weights: &[f32; 256], b: UVec3)
             let covered = if l.cmpge(IVec3::ZERO).all() && l.cmplt(IVec3::splat(8)).all() {
                 mask.get(crate::brick::voxel_bit(l.x, l.y, l.z))
             } else {
-                view.solid_at(nb)
+                view.solid(nb)
             };
             if !covered {
                 faces.push(
@@ -523,21 +558,17 @@ pub(crate) fn brick_lights(view: &WorldView<'_>, weights: &[f32; 256], b: UVec3)
             }
         }
     }
-    BrickLights {
-        cell,
-        lit: true,
-        faces,
-    }
+    faces
 }
 
 /// The lights of the bricks an edit changed and of their face neighbours that hold lit
 /// voxels (their boundary faces may have been covered or uncovered).
 pub(crate) fn recompute(
-    view: &WorldView<'_>,
+    view: &impl VoxelSource,
     lights: &Lights,
     changed: &[UVec3],
 ) -> Vec<BrickLights> {
-    let dims = view.dims();
+    let dims = view.grid();
     let grid = dims.bricks().as_ivec3();
     let mut cells: Vec<UVec3> = Vec::with_capacity(changed.len());
     let mut seen = HashSet::with_capacity(changed.len() * 2);
@@ -564,9 +595,9 @@ pub(crate) fn recompute(
 
 /// Every brick's lights (a full rescan: loading, or a material becoming a light or ceasing
 /// to be one).
-pub(crate) fn rescan(view: &WorldView<'_>, weights: &[f32; 256]) -> Vec<BrickLights> {
+pub(crate) fn rescan(view: &impl VoxelSource, weights: &[f32; 256]) -> Vec<BrickLights> {
     let mut out = Vec::new();
-    view.for_each_brick(|b, _, _| {
+    view.visit_bricks(&mut |b| {
         let l = brick_lights(view, weights, b);
         if l.lit {
             out.push(l);

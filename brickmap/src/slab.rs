@@ -4,7 +4,7 @@
 //! index, the coarse grid, the buckets and the dirty ranges consistent, and allocates before it
 //! frees, so a failed allocation leaves the brick exactly as it was.
 
-use crate::brick::{Brick, Mask, UNIFORM_FLAG};
+use crate::brick::{Brick, BrickMaterials, Mask, UNIFORM_FLAG};
 use crate::dirty::DirtyRanges;
 use crate::edit::{BrickUndo, ColumnSource, Mode, PriorMaterials, VoxelEdit, VoxelOp};
 use crate::error::Result;
@@ -65,6 +65,13 @@ impl Mats {
         match self {
             Mats::Uniform(m) => *m,
             Mats::Bytes { buf, .. } => buf[k],
+        }
+    }
+    /// The copy as borrowed materials.
+    pub(crate) fn borrowed(&self) -> BrickMaterials<'_> {
+        match self {
+            Mats::Uniform(m) => BrickMaterials::Uniform(*m),
+            Mats::Bytes { buf, len } => BrickMaterials::PerVoxel(&buf[..*len]),
         }
     }
 }
@@ -216,8 +223,7 @@ impl Slab {
             .map(|i| (i + self.cell_base, self.cell(i + self.cell_base)))
     }
     /// Calls `f(cell, mask, materials)` for every non-empty cell, in cell order.
-    pub(crate) fn visit(&self, f: &mut dyn FnMut(usize, &Mask, crate::world::BrickMaterials<'_>)) {
-        use crate::world::BrickMaterials;
+    pub(crate) fn visit(&self, f: &mut dyn FnMut(usize, &Mask, BrickMaterials<'_>)) {
         for (cell, state) in self.cells() {
             match state {
                 CellState::Empty => {}

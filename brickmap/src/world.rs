@@ -17,6 +17,7 @@
 //! material a light or stops it being one rescans the bricks.
 
 use crate::brick::Brick;
+pub use crate::brick::BrickMaterials;
 use crate::dirty::DirtyRanges;
 use crate::edit::{EditInverse, EditOp, EditOutcome, Mode, PriorMaterials, VoxelEdit};
 use crate::error::{BrickmapError, Result};
@@ -114,15 +115,6 @@ impl DirtySet {
     pub fn bytes(&self) -> u64 {
         self.ranges.iter().flatten().map(|r| r.end - r.start).sum()
     }
-}
-
-/// The materials of one brick, borrowed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BrickMaterials<'a> {
-    /// Every solid voxel has this material.
-    Uniform(u8),
-    /// One material per solid voxel, in popcount order.
-    PerVoxel(&'a [u8]),
 }
 
 /// Bytes by buffer.

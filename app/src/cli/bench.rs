@@ -9,6 +9,7 @@
 
 use super::bench_viewport::edit_request;
 use super::plot::{Series, line_plot};
+use super::table::Table;
 use super::{args, emit};
 use anyhow::{Context, Result, bail};
 use app::camera_path::CameraPath;
@@ -490,11 +491,9 @@ fn edit_run(
     })
 }
 
-fn row(s: &Summary) -> String {
-    format!(
-        "{:.3} | {:.3} | {:.3} | {:.3} | {:.3}",
-        s.min, s.median, s.p99, s.max, s.mean
-    )
+/// A summary's five cells: min, median, p99, max, mean.
+fn summary_cells(s: &Summary) -> [String; 5] {
+    [s.min, s.median, s.p99, s.max, s.mean].map(|x| format!("{x:.3}"))
 }
 
 /// Runs the benchmark, writes the report files and prints the Markdown.
@@ -622,56 +621,92 @@ fn bench(b: Bench, workers: usize) -> Result<String> {
         b.repeat,
         path.sun_deg_per_s
     );
-    md += "| preset | internal | min ms | median ms | p99 ms | max ms | mean ms | Mrays/s primary | secondary | shadow | all | rays/pixel | caps hit |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    let mut table = Table::new(&[
+        "preset",
+        "internal",
+        "min ms",
+        "median ms",
+        "p99 ms",
+        "max ms",
+        "mean ms",
+        "Mrays/s primary",
+        "secondary",
+        "shadow",
+        "all",
+        "rays/pixel",
+        "caps hit",
+    ]);
     for g in &gpu {
-        md += &format!(
-            "| {} | {}x{} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.2} | {} |\n",
-            g.preset.name,
-            g.width,
-            g.height,
-            row(&g.summary),
-            g.mrays_per_s.primary,
-            g.mrays_per_s.secondary,
-            g.mrays_per_s.shadow,
-            g.mrays_per_s.all,
-            g.rays_per_pixel.all,
-            g.traversal_caps_hit
+        let r = &g.mrays_per_s;
+        table.row_of(
+            [
+                g.preset.name.to_string(),
+                format!("{}x{}", g.width, g.height),
+            ]
+            .into_iter()
+            .chain(summary_cells(&g.summary))
+            .chain([r.primary, r.secondary, r.shadow, r.all].map(|x| format!("{x:.1}")))
+            .chain([
+                format!("{:.2}", g.rays_per_pixel.all),
+                g.traversal_caps_hit.to_string(),
+            ]),
         );
     }
+    md += &table.finish();
     if !cpu.is_empty() {
-        md += &format!(
-            "\nCPU reference ({threads} threads, wall clock):\n\n| preset | size | min ms | median ms | p99 ms | max ms | mean ms | Msamples/s |\n| --- | --- | --- | --- | --- | --- | --- | --- |\n"
-        );
+        md += &format!("\nCPU reference ({threads} threads, wall clock):\n\n");
+        let mut table = Table::new(&[
+            "preset",
+            "size",
+            "min ms",
+            "median ms",
+            "p99 ms",
+            "max ms",
+            "mean ms",
+            "Msamples/s",
+        ]);
         for c in &cpu {
-            md += &format!(
-                "| {} | {}x{} | {} | {:.3} |\n",
-                c.preset.name,
-                c.width,
-                c.height,
-                row(&c.summary),
-                c.msamples_per_s
+            table.row_of(
+                [
+                    c.preset.name.to_string(),
+                    format!("{}x{}", c.width, c.height),
+                ]
+                .into_iter()
+                .chain(summary_cells(&c.summary))
+                .chain([format!("{:.3}", c.msamples_per_s)]),
             );
         }
+        md += &table.finish();
     }
     if !edits.is_empty() {
-        md += "\nSculpting while the path plays (complexity 3, 1 spp per frame; one sphere per edit; median / p99 / max):\n\n| radius | internal | edits | apply ms | uploaded bytes per frame | per edit | GPU frame ms | latency frames | latency ms |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+        md += "\nSculpting while the path plays (complexity 3, 1 spp per frame; one sphere per edit; median / p99 / max):\n\n";
+        let mut table = Table::new(&[
+            "radius",
+            "internal",
+            "edits",
+            "apply ms",
+            "uploaded bytes per frame",
+            "per edit",
+            "GPU frame ms",
+            "latency frames",
+            "latency ms",
+        ]);
         for e in &edits {
             let m =
                 |s: &Summary, d: usize| format!("{:.d$} / {:.d$} / {:.d$}", s.median, s.p99, s.max);
-            md += &format!(
-                "| {} | {}x{} | {} | {} | {} | {} | {} | {} | {} |\n",
-                e.radius,
-                e.width,
-                e.height,
-                e.edits,
-                m(&e.apply_ms, 2),
-                m(&e.uploaded_bytes_per_frame, 0),
-                m(&e.uploaded_bytes_per_edit, 0),
-                m(&e.frame_ms, 3),
-                m(&e.latency_frames, 0),
-                m(&e.latency_ms, 2)
-            );
+            table.row(&[
+                &e.radius,
+                &format!("{}x{}", e.width, e.height),
+                &e.edits,
+                &m(&e.apply_ms, 2),
+                &m(&e.uploaded_bytes_per_frame, 0),
+                &m(&e.uploaded_bytes_per_edit, 0),
+                &m(&e.frame_ms, 3),
+                &m(&e.latency_frames, 0),
+                &m(&e.latency_ms, 2),
+            ]);
         }
+        md += &table.finish();
     }
     app::atomic::write_atomic(&b.out.join("bench.md"), |w| w.write_all(md.as_bytes()))?;
 

@@ -9,6 +9,7 @@
 //! frame at the editor's moving scale and at full size). Writes skips.md and skips.json.
 
 use super::bench::{PRESETS, params_at};
+use super::table::Table;
 use super::{args, emit};
 use anyhow::{Context, Result, bail};
 use app::camera_path::CameraPath;
@@ -538,24 +539,33 @@ fn figure(x: f64) -> String {
 
 fn report(b: &BenchSkips, ctx: &render::vulkan::GpuContext, rows: &[Row]) -> Result<String> {
     let mut md = format!(
-        "# What each skip buys\n\n{} ({}), {}x{} internal ({}x{} window for the moving case); GPU times are medians of {} rounds of {ROUND} back-to-back dispatches after two rounds of warm-up, with and without in turn. Gain = without / with (> 1: the skip pays).\n\n| skip | scene | measure | with | without | gain | same image (relMSE) | note |\n|---|---|---|---|---|---|---|---|\n",
+        "# What each skip buys\n\n{} ({}), {}x{} internal ({}x{} window for the moving case); GPU times are medians of {} rounds of {ROUND} back-to-back dispatches after two rounds of warm-up, with and without in turn. Gain = without / with (> 1: the skip pays).\n\n",
         ctx.name, ctx.driver, b.size.0, b.size.1, b.window.0, b.window.1, b.rounds
     );
+    let mut table = Table::new(&[
+        "skip",
+        "scene",
+        "measure",
+        "with",
+        "without",
+        "gain",
+        "same image (relMSE)",
+        "note",
+    ]);
     for r in rows {
-        let _ = writeln!(
-            md,
-            "| {} | {} | {} | {} | {} | {:.2} | {} | {} |",
-            r.name,
-            r.scene,
-            r.measure,
-            figure(r.with),
-            figure(r.without),
-            r.gain,
-            r.same_image_rel_mse
+        table.row(&[
+            &r.name,
+            &r.scene,
+            &r.measure,
+            &figure(r.with),
+            &figure(r.without),
+            &format!("{:.2}", r.gain),
+            &r.same_image_rel_mse
                 .map_or("–".into(), |s| format!("{s:.1e}")),
-            r.note
-        );
+            &r.note,
+        ]);
     }
+    md += &table.finish();
     let json = serde_json::json!({
         "device": ctx.name, "driver": ctx.driver, "clocks": super::bench::clocks(),
         "size": [b.size.0, b.size.1], "window": [b.window.0, b.window.1], "rows": rows,

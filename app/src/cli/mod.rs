@@ -22,6 +22,7 @@ pub mod scene_file;
 pub mod soak;
 pub mod stats;
 pub mod stress;
+pub mod table;
 
 use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};

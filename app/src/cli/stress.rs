@@ -3,6 +3,7 @@
 //! energy, as Markdown on stdout and JSON / Markdown files; exits non-zero on any non-zero
 //! count.
 
+use super::table::{Table, bold};
 use anyhow::{Result, bail};
 use render::stress::{ImageRow, RayRow, StressConfig};
 use std::path::PathBuf;
@@ -53,23 +54,34 @@ fn markdown(device: &str, cfg: &StressConfig, rays: &[RayRow], images: &[ImageRo
     );
     if !rays.is_empty() {
         t += "Rays: GPU traversal (f32) against the exact CPU cast (f64) of the same ray; tolerance 4 f32 ulps at the largest coordinate (origin, hit point, grid corner), on |Δt|·max|dᵢ| and on distances to voxel boxes.\n\n";
-        t += "| world | rays | tried | CPU hits | exact | edge faces | f32 ties | mismatches | caps hit | CPU errors |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+        let mut table = Table::new(&[
+            "world",
+            "rays",
+            "tried",
+            "CPU hits",
+            "exact",
+            "edge faces",
+            "f32 ties",
+            "mismatches",
+            "caps hit",
+            "CPU errors",
+        ]);
         for r in rays {
             let x = &r.tally;
-            t += &format!(
-                "| {} | {} | {} | {} | {} | {} | {} | **{}** | **{}** | **{}** |\n",
-                r.world,
-                r.class,
-                x.tried,
-                x.hits,
-                x.exact,
-                x.edge_faces,
-                x.f32_ties,
-                x.mismatches,
-                x.caps_hit,
-                x.cpu_errors
-            );
+            table.row(&[
+                &r.world,
+                &r.class,
+                &x.tried,
+                &x.hits,
+                &x.exact,
+                &x.edge_faces,
+                &x.f32_ties,
+                &bold(x.mismatches),
+                &bold(x.caps_hit),
+                &bold(x.cpu_errors),
+            ]);
         }
+        t += &table.finish();
         let total: u64 = rays.iter().map(|r| r.tally.tried).sum();
         let ties: u64 = rays.iter().map(|r| r.tally.f32_ties).sum();
         let edges: u64 = rays.iter().map(|r| r.tally.edge_faces).sum();
@@ -85,27 +97,37 @@ fn markdown(device: &str, cfg: &StressConfig, rays: &[RayRow], images: &[ImageRo
         t += "\n";
     }
     t += "Images: every sample counted (one-sample renders); furnaces: relative energy lost, 1 − mean/expected (± standard error).\n\n";
-    t += "| scene | renderer | samples | NaN | inf | negative | caps hit | mean ch. 0 | energy lost | verdict |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    let mut table = Table::new(&[
+        "scene",
+        "renderer",
+        "samples",
+        "NaN",
+        "inf",
+        "negative",
+        "caps hit",
+        "mean ch. 0",
+        "energy lost",
+        "verdict",
+    ]);
     for r in images {
         let lost = match (r.energy_lost, r.expected) {
             (Some(l), Some(e)) => format!("{:+.2e} ± {:.1e}", l, r.standard_error / e),
             _ => "—".into(),
         };
-        t += &format!(
-            "| {} | {} | {} | **{}** | **{}** | **{}** | {} | {:.4} | {} | {} |\n",
-            r.scene,
-            r.renderer,
-            r.samples,
-            r.nan,
-            r.inf,
-            r.negative,
-            r.caps_hit.map_or("—".into(), |c| format!("**{c}**")),
-            r.mean,
-            lost,
-            if r.clean() { "ok" } else { "FAIL" }
-        );
+        table.row(&[
+            &r.scene,
+            &r.renderer,
+            &r.samples,
+            &bold(r.nan),
+            &bold(r.inf),
+            &bold(r.negative),
+            &r.caps_hit.map_or("—".into(), bold),
+            &format!("{:.4}", r.mean),
+            &lost,
+            &if r.clean() { "ok" } else { "FAIL" },
+        ]);
     }
-    t
+    t + &table.finish()
 }
 
 /// Runs the suite and prints the report; any non-zero count is an error.

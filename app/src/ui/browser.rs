@@ -6,7 +6,7 @@
 //! a save over an existing file asks first; nothing is written until the user confirms a
 //! path they can see.
 
-use super::files::Purpose;
+use super::purpose::Purpose;
 use std::path::{Path, PathBuf};
 
 /// The browser's state while it is open.
@@ -39,36 +39,6 @@ pub enum Answer {
     Cancelled,
     /// This path, confirmed.
     Chosen(PathBuf),
-}
-
-/// The extensions a purpose's files have, and their description.
-pub fn filter(purpose: Purpose) -> (&'static str, &'static [&'static str]) {
-    match purpose {
-        Purpose::Open => ("Scenes", &["ron", "vox"]),
-        Purpose::SaveAs => ("voxbrick project", &["ron"]),
-        Purpose::Import | Purpose::Export => ("MagicaVoxel", &["vox"]),
-        Purpose::LoadPalette => ("Palette", &["png", "vox"]),
-        Purpose::SavePalette => ("PNG palette strip", &["png"]),
-    }
-}
-
-/// Whether the purpose writes a file (the name may be new; an existing one is replaced).
-pub fn saves(purpose: Purpose) -> bool {
-    matches!(
-        purpose,
-        Purpose::SaveAs | Purpose::Export | Purpose::SavePalette
-    )
-}
-
-fn title(purpose: Purpose) -> &'static str {
-    match purpose {
-        Purpose::Open => "Open a scene",
-        Purpose::SaveAs => "Save the scene as",
-        Purpose::Import => "Import a .vox",
-        Purpose::Export => "Export as .vox",
-        Purpose::LoadPalette => "Load a palette",
-        Purpose::SavePalette => "Save the palette as",
-    }
 }
 
 impl Browser {
@@ -107,7 +77,7 @@ impl Browser {
     }
 
     fn read_folder(&mut self) {
-        let (_, exts) = filter(self.purpose);
+        let (_, exts) = self.purpose.filter();
         self.entries.clear();
         self.error = None;
         let read = match std::fs::read_dir(&self.folder) {
@@ -141,8 +111,8 @@ impl Browser {
     /// for a save without an extension, the purpose's first one.
     pub fn target(&self) -> Option<PathBuf> {
         let path = self.typed()?;
-        let (_, exts) = filter(self.purpose);
-        Some(if saves(self.purpose) && path.extension().is_none() {
+        let (_, exts) = self.purpose.filter();
+        Some(if self.purpose.saves() && path.extension().is_none() {
             path.with_extension(exts[0])
         } else {
             path
@@ -174,7 +144,7 @@ impl Browser {
         let Some(path) = self.target() else {
             return Answer::Open;
         };
-        if saves(self.purpose) {
+        if self.purpose.saves() {
             if path.exists() && self.confirm.as_ref() != Some(&path) {
                 self.confirm = Some(path);
                 return Answer::Open;
@@ -205,8 +175,8 @@ impl Browser {
     ) -> Answer {
         let mut answer = Answer::Open;
         let mut open = true;
-        let (what, exts) = filter(self.purpose);
-        egui::Window::new(title(self.purpose))
+        let (what, exts) = self.purpose.filter();
+        egui::Window::new(self.purpose.title())
             .id(egui::Id::new("file browser"))
             .open(&mut open)
             .collapsible(false)
@@ -321,7 +291,7 @@ impl Browser {
                     );
                 }
                 ui.horizontal(|ui| {
-                    let verb = match (saves(self.purpose), self.confirm.is_some()) {
+                    let verb = match (self.purpose.saves(), self.confirm.is_some()) {
                         (true, true) => "Replace",
                         (true, false) => "Save",
                         (false, _) => "Open",

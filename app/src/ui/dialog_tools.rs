@@ -1,7 +1,7 @@
 //! The native dialogs besides the portal: zenity (GTK) and kdialog (KDE), run as programs
 //! where one is installed. Many Linux desktops have one of them and no xdg-desktop-portal.
 
-use super::files::Purpose;
+use super::purpose::Purpose;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
@@ -30,13 +30,13 @@ fn start_path(folder: Option<&Path>, name: Option<&str>) -> String {
 
 /// zenity's arguments for a purpose.
 pub fn zenity_args(purpose: Purpose, start: &str) -> (&'static str, Vec<String>) {
-    let (what, exts) = super::browser::filter(purpose);
+    let (what, exts) = purpose.filter();
     let patterns: Vec<String> = exts.iter().map(|e| format!("*.{e}")).collect();
     let mut args = vec![
         "--file-selection".to_string(),
         format!("--file-filter={what} | {}", patterns.join(" ")),
     ];
-    if super::browser::saves(purpose) {
+    if purpose.saves() {
         args.extend(["--save".into(), "--confirm-overwrite".into()]);
     }
     if !start.is_empty() {
@@ -47,9 +47,9 @@ pub fn zenity_args(purpose: Purpose, start: &str) -> (&'static str, Vec<String>)
 
 /// kdialog's arguments for a purpose.
 pub fn kdialog_args(purpose: Purpose, start: &str) -> (&'static str, Vec<String>) {
-    let (what, exts) = super::browser::filter(purpose);
+    let (what, exts) = purpose.filter();
     let patterns: Vec<String> = exts.iter().map(|e| format!("*.{e}")).collect();
-    let verb = if super::browser::saves(purpose) {
+    let verb = if purpose.saves() {
         "--getsavefilename"
     } else {
         "--getopenfilename"

@@ -15,9 +15,7 @@
 //! tools' (the user's choice returns when it is wide again). The Terrain window floats over the
 //! viewport.
 
-use super::input::Action;
-use super::panels::{UiEvent, window};
-use super::selecting::Nudge;
+use super::intent::{Action, Nudge, UiEvent};
 use super::swatch::{DIELECTRIC_BOUNCES, swatch};
 use super::tools::{Brush, MAX_SIZE, Tool};
 use crate::editor::Document;
@@ -660,4 +658,12 @@ fn terrain(ui: &mut egui::Ui, spec: &mut TerrainSpec, height: u32, out: &mut Vec
     if ui.button("Generate").clicked() {
         out.push(UiEvent::Generate(spec.clone()));
     }
+}
+
+/// A window kept inside `area` (the viewport between the panels), scrolling when taller.
+pub(super) fn window(area: egui::Rect, title: &str) -> egui::Window<'_> {
+    egui::Window::new(title)
+        .constrain_to(area)
+        .max_height(area.height() - 40.0)
+        .vscroll(true)
 }

@@ -4,6 +4,7 @@
 //! drawing (edits wait for the save); every write is atomic (temp file + rename), so a
 //! failure leaves the file on disk, the scene and the history as they were.
 
+use super::purpose::Purpose;
 use crate::Scene;
 use crate::editor::Document;
 use anyhow::{Context, Result};
@@ -139,23 +140,6 @@ impl ConfigDir {
 /// for edits; a save reads it on the worker.
 pub type SharedDocument = Arc<RwLock<Document>>;
 
-/// Why a file was asked for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Purpose {
-    /// Replace the document.
-    Open,
-    /// Write the project here and make it the document's file.
-    SaveAs,
-    /// Add a .vox to the scene (undoable command).
-    Import,
-    /// Write a .vox.
-    Export,
-    /// Read a palette (.png strip or .vox).
-    LoadPalette,
-    /// Write the palette as a PNG strip.
-    SavePalette,
-}
-
 /// A finished piece of background work.
 pub enum Done {
     /// A file dialog closed (None: cancelled).
@@ -237,7 +221,7 @@ impl FileWorker {
             if !dialogs {
                 return no_dialog(folder, name);
             }
-            let (what, exts) = super::browser::filter(purpose);
+            let (what, exts) = purpose.filter();
             let mut d = rfd::FileDialog::new().add_filter(what, exts);
             if let Some(f) = &folder {
                 d = d.set_directory(f);
@@ -246,7 +230,7 @@ impl FileWorker {
                 d = d.set_file_name(n);
             }
             let started = std::time::Instant::now();
-            let saves = super::browser::saves(purpose);
+            let saves = purpose.saves();
             let picked = if saves { d.save_file() } else { d.pick_file() };
             // rfd answers "cancelled" at once when no dialog can be shown (no
             // xdg-desktop-portal); nobody cancels a dialog that fast. Then zenity or

@@ -2,84 +2,10 @@
 //! buttons that move the view. Pure functions of keys and modifiers, so they are tested
 //! without a window.
 
-use crate::editor::command::{BrushMode, BrushShape};
+pub use super::intent::{Action, Mods};
 use glam::DVec3;
 use winit::event::MouseButton;
 use winit::keyboard::KeyCode;
-
-/// Modifier keys held.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Mods {
-    /// Control (Command on macOS).
-    pub ctrl: bool,
-    /// Shift.
-    pub shift: bool,
-    /// Alt.
-    pub alt: bool,
-}
-
-/// What a shortcut does.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum Action {
-    /// Undo the latest step.
-    Undo,
-    /// Redo the latest undone step.
-    Redo,
-    /// New scene.
-    New,
-    /// Open a file.
-    Open,
-    /// Save (Save As when the document has no project file).
-    Save,
-    /// Save under a new name.
-    SaveAs,
-    /// Import a .vox into the scene.
-    Import,
-    /// Export as .vox.
-    Export,
-    /// Frame the scene's content.
-    Frame,
-    /// Switch between perspective and orthographic.
-    ToggleProjection,
-    /// Brush one voxel smaller.
-    BrushSmaller,
-    /// Brush one voxel larger.
-    BrushLarger,
-    /// Brush mode.
-    Mode(BrushMode),
-    /// Brush shape.
-    Shape(BrushShape),
-    /// Store the view in camera slot n (1..=9).
-    StoreView(u8),
-    /// Recall camera slot n.
-    RecallView(u8),
-    /// Drop the materials no voxel uses.
-    RemoveUnusedMaterials,
-    /// The selection tool.
-    SelectTool,
-    /// Select the whole grid.
-    SelectAll,
-    /// Select nothing.
-    SelectNone,
-    /// Empty the selected voxels.
-    DeleteSelection,
-    /// Fill the selection with the current material.
-    FillSelection,
-    /// Paint the selection's solid voxels with the current material.
-    PaintSelection,
-    /// Copy the selection's solid voxels.
-    Copy,
-    /// Copy, then delete.
-    Cut,
-    /// Place the copy: it follows the cursor until a click.
-    Paste,
-    /// Move the selection a voxel (Shift: a brick).
-    Nudge(super::selecting::Nudge),
-    /// Show or hide the shortcut list.
-    Help,
-    /// Quit (asks about unsaved changes).
-    Quit,
-}
 
 /// The shortcut for a key pressed with modifiers, in the default key map (the editor uses
 /// the user's, see `keymap`).

@@ -176,7 +176,7 @@ fn run(doc: &SharedDocument, edit: Edit) -> Edited {
     match edit {
         Edit::Command(c) => {
             let label = c.label();
-            let landing = super::selecting::Landing::of(&c);
+            let landing = Landing::of(&c);
             let result = d.execute(c);
             let said = landing
                 .zip(result.as_ref().ok())
@@ -197,6 +197,57 @@ fn run(doc: &SharedDocument, edit: Edit) -> Edited {
                 result,
                 camera_changed: d.scene.params.camera != camera,
             }
+        }
+    }
+}
+
+/// What a selection operation is said to have done on the status line, so that each one
+/// visibly lands (a select all, a copy or a fill shows nothing else happening).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Landing {
+    /// The selection changed: how many voxels it holds.
+    Selected,
+    /// The clipboard took a copy: how many voxels.
+    Copied,
+    /// Voxels changed (a delete, fill, paint, cut, move or paste): how many.
+    Changed,
+}
+
+impl Landing {
+    /// The landing of a command that is a selection operation.
+    pub fn of(c: &Command) -> Option<Self> {
+        match c {
+            Command::Select(_) => Some(Landing::Selected),
+            Command::Copy => Some(Landing::Copied),
+            Command::DeleteSelection
+            | Command::FillSelection(_)
+            | Command::PaintSelection(_)
+            | Command::MoveSelection(_)
+            | Command::Cut
+            | Command::Paste { .. } => Some(Landing::Changed),
+            _ => None,
+        }
+    }
+
+    /// The status line's text after the command `label` ran on `doc` and did `done`.
+    pub fn say(self, label: &str, doc: &Document, done: &Executed) -> String {
+        let voxels = |n: u64| {
+            if n == 1 {
+                "1 voxel".to_string()
+            } else {
+                format!("{n} voxels")
+            }
+        };
+        match self {
+            Landing::Selected => match &doc.scene.selection {
+                Some(s) => format!("{label}: {} selected", voxels(s.voxels.count())),
+                None => format!("{label}: nothing selected"),
+            },
+            Landing::Copied => match &doc.scene.clipboard {
+                Some(c) => format!("Copied {} to the clipboard", voxels(c.voxels)),
+                None => format!("{label}: nothing copied"),
+            },
+            Landing::Changed => format!("{label}: {} changed", voxels(done.changed_voxels)),
         }
     }
 }

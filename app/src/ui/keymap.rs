@@ -7,7 +7,7 @@
 //! and the file is left as it is. Flying (W A S D, Q / E, held) is not an action and not
 //! remapped.
 
-use super::input::{Action, Mods};
+use super::intent::{Action, Mods, Nudge};
 use crate::editor::command::{BrushMode, BrushShape};
 use serde::{Deserialize, Serialize};
 use winit::keyboard::KeyCode;
@@ -139,7 +139,6 @@ pub fn default_bindings() -> Vec<Binding> {
     .into_iter()
     .map(|(k, a)| (k.to_string(), a))
     .collect();
-    use super::selecting::Nudge;
     for (key, n) in [
         ("ArrowLeft", Nudge::Left),
         ("ArrowRight", Nudge::Right),

@@ -11,9 +11,12 @@
 //! statistics, shortcuts, new scene, the unsaved-changes and recovery questions, errors.
 //! Returns `UiEvent`s the loop applies.
 
-use super::input::{Action, SHORTCUTS};
+use super::editing::window;
+use super::input::SHORTCUTS;
+use super::intent::Action;
+pub use super::intent::{UiEvent, UnsavedAnswer};
 use crate::editor::Document;
-use render::{RenderSettings, Sky, Sun};
+use render::Sky;
 use std::path::PathBuf;
 
 /// View settings: not part of the scene, not in the history; kept in the config folder.
@@ -49,95 +52,6 @@ impl Default for ViewSettings {
             brush: Default::default(),
         }
     }
-}
-
-/// What the user asked for through the panels.
-#[derive(Clone, Debug)]
-pub enum UiEvent {
-    /// A shortcut's action (menus name the same actions).
-    Action(Action),
-    /// Open a recent file.
-    OpenRecent(PathBuf),
-    /// The sun changed (one undo step per drag: commands coalesce).
-    SetSun(Sun),
-    /// The sky changed.
-    SetSky(Sky),
-    /// Scene render settings changed (bounces).
-    SetSettings(RenderSettings),
-    /// Import a .vox at an offset (undoable).
-    Import {
-        /// The file.
-        path: PathBuf,
-        /// Added to its voxels after the shift into the grid.
-        offset: [i32; 3],
-    },
-    /// Make the current view the scene's camera (undoable).
-    UseViewAsSceneCamera,
-    /// A colour of the table changed (one step per drag).
-    SetColour {
-        /// Colour index.
-        index: u8,
-        /// sRGB.
-        rgb: [u8; 3],
-    },
-    /// A material changed.
-    SetMaterial {
-        /// Its index.
-        index: u8,
-        /// The new value.
-        material: crate::editor::command::MaterialSpec,
-    },
-    /// Load (false: ask for a .png or .vox) or save (true: as a PNG strip) the palette.
-    PaletteFile {
-        /// Save rather than load.
-        save: bool,
-    },
-    /// A material was added.
-    AddMaterial(crate::editor::command::MaterialSpec),
-    /// A parameter-table value changed (roughness, IOR, strength).
-    SetParam {
-        /// Which table.
-        kind: crate::editor::command::KindSpec,
-        /// Slot 0..64.
-        index: u8,
-        /// The value.
-        value: f32,
-    },
-    /// Replace the scene's voxels by generated terrain (undoable).
-    Generate(crate::editor::command::TerrainSpec),
-    /// Go back (undo) or forward (redo) this many steps in the history.
-    Jump {
-        /// Steps to undo.
-        undo: usize,
-        /// Steps to redo.
-        redo: usize,
-    },
-    /// The unsaved-changes question was answered.
-    Unsaved(UnsavedAnswer),
-    /// The in-app file browser confirmed a path for this purpose.
-    Picked(super::files::Purpose, PathBuf),
-    /// The in-app file browser was closed without a choice.
-    PickCancelled,
-    /// The recovery offer was answered (true: recover).
-    Recover(bool),
-    /// New scene of this size in voxels, terrain or empty.
-    NewScene {
-        /// Voxels per axis.
-        size: (u32, u32, u32),
-        /// Generate noise terrain.
-        terrain: bool,
-    },
-}
-
-/// Answers to "save changes?".
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum UnsavedAnswer {
-    /// Save first, then go on.
-    Save,
-    /// Go on without saving.
-    Discard,
-    /// Stay.
-    Cancel,
 }
 
 /// What the panels show besides the document.
@@ -628,14 +542,6 @@ fn sun_and_sky(ui: &mut egui::Ui, doc: &Document, out: &mut Vec<UiEvent>) {
     if sky_changed && sky.validate().is_ok() {
         out.push(UiEvent::SetSky(sky));
     }
-}
-
-/// A window kept inside `area` (the viewport between the panels), scrolling when taller.
-pub(super) fn window(area: egui::Rect, title: &str) -> egui::Window<'_> {
-    egui::Window::new(title)
-        .constrain_to(area)
-        .max_height(area.height() - 40.0)
-        .vscroll(true)
 }
 
 /// What the render settings call a sample sequence.

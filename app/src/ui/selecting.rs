@@ -8,14 +8,13 @@
 
 use super::Editor;
 use super::camera::ViewCamera;
-use super::input::Mods;
+use super::intent::{Mods, Nudge};
 use super::jobs::Edit;
 use super::tools::{self, Layer};
+use crate::editor::Document;
 use crate::editor::command::{BrushMode, Command};
-use crate::editor::{Document, Executed};
 use crate::selection::{SelectOp, Selection};
 use glam::{DVec3, IVec3};
-use serde::{Deserialize, Serialize};
 
 /// How a drag changes the selection (by the modifiers held when it starts).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,23 +78,6 @@ pub fn drag_box(
     (lo, hi)
 }
 
-/// A move of the selection by a key.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Nudge {
-    /// Towards the screen's left.
-    Left,
-    /// Towards the screen's right.
-    Right,
-    /// Away from the camera (horizontally).
-    Away,
-    /// Towards the camera (horizontally).
-    Towards,
-    /// Up.
-    Up,
-    /// Down.
-    Down,
-}
-
 /// The grid step of a nudge for a camera looking along `forward`: the horizontal axis
 /// closest to the screen's right (or to the view direction), with its sign.
 pub fn nudge_offset(n: Nudge, forward: DVec3) -> IVec3 {
@@ -127,57 +109,6 @@ pub fn nudge_offset(n: Nudge, forward: DVec3) -> IVec3 {
 /// face: its bottom centre there.
 pub fn paste_at(v: IVec3, size: IVec3) -> IVec3 {
     v - IVec3::new(size.x / 2, 0, size.z / 2)
-}
-
-/// What a selection operation is said to have done on the status line, so that each one
-/// visibly lands (a select all, a copy or a fill shows nothing else happening).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Landing {
-    /// The selection changed: how many voxels it holds.
-    Selected,
-    /// The clipboard took a copy: how many voxels.
-    Copied,
-    /// Voxels changed (a delete, fill, paint, cut, move or paste): how many.
-    Changed,
-}
-
-impl Landing {
-    /// The landing of a command that is a selection operation.
-    pub fn of(c: &Command) -> Option<Self> {
-        match c {
-            Command::Select(_) => Some(Landing::Selected),
-            Command::Copy => Some(Landing::Copied),
-            Command::DeleteSelection
-            | Command::FillSelection(_)
-            | Command::PaintSelection(_)
-            | Command::MoveSelection(_)
-            | Command::Cut
-            | Command::Paste { .. } => Some(Landing::Changed),
-            _ => None,
-        }
-    }
-
-    /// The status line's text after the command `label` ran on `doc` and did `done`.
-    pub fn say(self, label: &str, doc: &Document, done: &Executed) -> String {
-        let voxels = |n: u64| {
-            if n == 1 {
-                "1 voxel".to_string()
-            } else {
-                format!("{n} voxels")
-            }
-        };
-        match self {
-            Landing::Selected => match &doc.scene.selection {
-                Some(s) => format!("{label}: {} selected", voxels(s.voxels.count())),
-                None => format!("{label}: nothing selected"),
-            },
-            Landing::Copied => match &doc.scene.clipboard {
-                Some(c) => format!("Copied {} to the clipboard", voxels(c.voxels)),
-                None => format!("{label}: nothing copied"),
-            },
-            Landing::Changed => format!("{label}: {} changed", voxels(done.changed_voxels)),
-        }
-    }
 }
 
 impl Editor {

@@ -294,3 +294,20 @@ impl WorldView<'_> {
         out
     }
 }
+
+impl crate::lights::VoxelSource for WorldView<'_> {
+    fn grid(&self) -> GridDims {
+        self.dims()
+    }
+    fn visit_bricks(&self, f: &mut dyn FnMut(UVec3)) {
+        self.for_each_brick(|b, _, _| f(b));
+    }
+    fn read_brick(&self, b: UVec3, f: &mut dyn FnMut(&crate::Mask, BrickMaterials<'_>)) {
+        let cell = self.world.dims.cell_index(b);
+        let (mask, mats) = self.slab_for_brick_x(b.x).read(cell);
+        f(&mask, mats.borrowed());
+    }
+    fn solid(&self, v: IVec3) -> bool {
+        self.solid_at(v)
+    }
+}

@@ -1,0 +1,190 @@
+//! What the user asks for, as the editor's parts hand it on: key-map actions with the
+//! modifier keys held and the selection's nudges, and the panels' events. Vocabulary only:
+//! the key map, the input handlers, the panels and the tools all speak it, and it imports
+//! none of them.
+
+use super::purpose::Purpose;
+use crate::editor::command::{BrushMode, BrushShape};
+use render::{RenderSettings, Sky, Sun};
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// Modifier keys held.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Mods {
+    /// Control (Command on macOS).
+    pub ctrl: bool,
+    /// Shift.
+    pub shift: bool,
+    /// Alt.
+    pub alt: bool,
+}
+
+/// What a shortcut does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Action {
+    /// Undo the latest step.
+    Undo,
+    /// Redo the latest undone step.
+    Redo,
+    /// New scene.
+    New,
+    /// Open a file.
+    Open,
+    /// Save (Save As when the document has no project file).
+    Save,
+    /// Save under a new name.
+    SaveAs,
+    /// Import a .vox into the scene.
+    Import,
+    /// Export as .vox.
+    Export,
+    /// Frame the scene's content.
+    Frame,
+    /// Switch between perspective and orthographic.
+    ToggleProjection,
+    /// Brush one voxel smaller.
+    BrushSmaller,
+    /// Brush one voxel larger.
+    BrushLarger,
+    /// Brush mode.
+    Mode(BrushMode),
+    /// Brush shape.
+    Shape(BrushShape),
+    /// Store the view in camera slot n (1..=9).
+    StoreView(u8),
+    /// Recall camera slot n.
+    RecallView(u8),
+    /// Drop the materials no voxel uses.
+    RemoveUnusedMaterials,
+    /// The selection tool.
+    SelectTool,
+    /// Select the whole grid.
+    SelectAll,
+    /// Select nothing.
+    SelectNone,
+    /// Empty the selected voxels.
+    DeleteSelection,
+    /// Fill the selection with the current material.
+    FillSelection,
+    /// Paint the selection's solid voxels with the current material.
+    PaintSelection,
+    /// Copy the selection's solid voxels.
+    Copy,
+    /// Copy, then delete.
+    Cut,
+    /// Place the copy: it follows the cursor until a click.
+    Paste,
+    /// Move the selection a voxel (Shift: a brick).
+    Nudge(Nudge),
+    /// Show or hide the shortcut list.
+    Help,
+    /// Quit (asks about unsaved changes).
+    Quit,
+}
+
+/// A move of the selection by a key.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Nudge {
+    /// Towards the screen's left.
+    Left,
+    /// Towards the screen's right.
+    Right,
+    /// Away from the camera (horizontally).
+    Away,
+    /// Towards the camera (horizontally).
+    Towards,
+    /// Up.
+    Up,
+    /// Down.
+    Down,
+}
+
+/// What the user asked for through the panels.
+#[derive(Clone, Debug)]
+pub enum UiEvent {
+    /// A shortcut's action (menus name the same actions).
+    Action(Action),
+    /// Open a recent file.
+    OpenRecent(PathBuf),
+    /// The sun changed (one undo step per drag: commands coalesce).
+    SetSun(Sun),
+    /// The sky changed.
+    SetSky(Sky),
+    /// Scene render settings changed (bounces).
+    SetSettings(RenderSettings),
+    /// Import a .vox at an offset (undoable).
+    Import {
+        /// The file.
+        path: PathBuf,
+        /// Added to its voxels after the shift into the grid.
+        offset: [i32; 3],
+    },
+    /// Make the current view the scene's camera (undoable).
+    UseViewAsSceneCamera,
+    /// A colour of the table changed (one step per drag).
+    SetColour {
+        /// Colour index.
+        index: u8,
+        /// sRGB.
+        rgb: [u8; 3],
+    },
+    /// A material changed.
+    SetMaterial {
+        /// Its index.
+        index: u8,
+        /// The new value.
+        material: crate::editor::command::MaterialSpec,
+    },
+    /// Load (false: ask for a .png or .vox) or save (true: as a PNG strip) the palette.
+    PaletteFile {
+        /// Save rather than load.
+        save: bool,
+    },
+    /// A material was added.
+    AddMaterial(crate::editor::command::MaterialSpec),
+    /// A parameter-table value changed (roughness, IOR, strength).
+    SetParam {
+        /// Which table.
+        kind: crate::editor::command::KindSpec,
+        /// Slot 0..64.
+        index: u8,
+        /// The value.
+        value: f32,
+    },
+    /// Replace the scene's voxels by generated terrain (undoable).
+    Generate(crate::editor::command::TerrainSpec),
+    /// Go back (undo) or forward (redo) this many steps in the history.
+    Jump {
+        /// Steps to undo.
+        undo: usize,
+        /// Steps to redo.
+        redo: usize,
+    },
+    /// The unsaved-changes question was answered.
+    Unsaved(UnsavedAnswer),
+    /// The in-app file browser confirmed a path for this purpose.
+    Picked(Purpose, PathBuf),
+    /// The in-app file browser was closed without a choice.
+    PickCancelled,
+    /// The recovery offer was answered (true: recover).
+    Recover(bool),
+    /// New scene of this size in voxels, terrain or empty.
+    NewScene {
+        /// Voxels per axis.
+        size: (u32, u32, u32),
+        /// Generate noise terrain.
+        terrain: bool,
+    },
+}
+
+/// Answers to "save changes?".
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnsavedAnswer {
+    /// Save first, then go on.
+    Save,
+    /// Go on without saving.
+    Discard,
+    /// Stay.
+    Cancel,
+}

@@ -1,0 +1,52 @@
+//! What a file dialog is for: its title, the files it shows, whether it writes. The native
+//! dialogs (`files.rs`, `dialog_tools.rs`) and the in-app browser (`browser.rs`) share it.
+
+/// Why a file was asked for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Purpose {
+    /// Replace the document.
+    Open,
+    /// Write the project here and make it the document's file.
+    SaveAs,
+    /// Add a .vox to the scene (undoable command).
+    Import,
+    /// Write a .vox.
+    Export,
+    /// Read a palette (.png strip or .vox).
+    LoadPalette,
+    /// Write the palette as a PNG strip.
+    SavePalette,
+}
+
+impl Purpose {
+    /// The extensions this purpose's files have, and their description.
+    pub fn filter(self) -> (&'static str, &'static [&'static str]) {
+        match self {
+            Purpose::Open => ("Scenes", &["ron", "vox"]),
+            Purpose::SaveAs => ("voxbrick project", &["ron"]),
+            Purpose::Import | Purpose::Export => ("MagicaVoxel", &["vox"]),
+            Purpose::LoadPalette => ("Palette", &["png", "vox"]),
+            Purpose::SavePalette => ("PNG palette strip", &["png"]),
+        }
+    }
+
+    /// Whether the purpose writes a file (the name may be new; an existing one is replaced).
+    pub fn saves(self) -> bool {
+        matches!(
+            self,
+            Purpose::SaveAs | Purpose::Export | Purpose::SavePalette
+        )
+    }
+
+    /// The dialog's title.
+    pub fn title(self) -> &'static str {
+        match self {
+            Purpose::Open => "Open a scene",
+            Purpose::SaveAs => "Save the scene as",
+            Purpose::Import => "Import a .vox",
+            Purpose::Export => "Export as .vox",
+            Purpose::LoadPalette => "Load a palette",
+            Purpose::SavePalette => "Save the palette as",
+        }
+    }
+}
