@@ -1,0 +1,102 @@
+//! `TraceParams`: the path tracer's per-dispatch parameters, laid out as `Params` in
+//! shaders/trace.comp (std430) and filled from the scene's camera, sun, sky and settings.
+
+use super::*;
+
+/// Keep in sync with `Params` in shaders/trace.comp (std430: eleven vec4, three uvec4).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable, Default)]
+pub struct TraceParams {
+    cam_pos: [f32; 4],
+    cam_forward: [f32; 4],
+    cam_right: [f32; 4],
+    cam_up: [f32; 4],
+    sun_centre: [f32; 4],
+    sun_normal: [f32; 4],
+    sun_e1: [f32; 4],
+    sun_e2: [f32; 4],
+    sun_radiance: [f32; 4],
+    sky_horizon: [f32; 4],
+    sky_zenith: [f32; 4],
+    grid: [u32; 4],
+    pub(super) image: [u32; 4],
+    pub(super) seed: [u32; 4],
+}
+const _: () = assert!(std::mem::size_of::<TraceParams>() == 224);
+
+fn v4(v: DVec3, w: f32) -> [f32; 4] {
+    [v.x as f32, v.y as f32, v.z as f32, w]
+}
+
+impl TraceParams {
+    /// The parameters of a render, derived exactly as `CpuScene::new` derives them.
+    pub fn new(view: &WorldView<'_>, params: &SceneParams, job: &RenderJob) -> Self {
+        let c = &params.camera;
+        let (forward, right, up) = c.basis(job.width as f64 / job.height as f64);
+        let dims = view.dims();
+        let centre = dims.voxels().as_dvec3() * 0.5;
+        let mut p = TraceParams {
+            // w: 1 for an orthographic camera (rays from the image plane; trace.comp then
+            // finds each ray's medium itself).
+            cam_pos: v4(c.position, if c.is_orthographic() { 1.0 } else { 0.0 }),
+            cam_forward: v4(forward, 0.0),
+            cam_right: v4(right, 0.0),
+            cam_up: v4(up, 0.0),
+            grid: [
+                dims.bricks().x,
+                dims.bricks().y,
+                dims.bricks().z,
+                dims.coarse_words_per_column() as u32,
+            ],
+            image: [job.width, job.height, job.spp, params.settings.max_bounces],
+            ..Default::default()
+        };
+        if let Some(sun) = params.sun.disc(centre) {
+            p.sun_centre = v4(sun.centre, sun.radius as f32);
+            p.sun_normal = v4(sun.normal, 1.0);
+            p.sun_e1 = v4(sun.e1, 0.0);
+            p.sun_e2 = v4(sun.e2, 0.0);
+            p.sun_radiance = v4(sun.radiance, 0.0);
+        }
+        match &params.sky {
+            Sky::Uniform { colour } => p.sky_horizon = [colour[0], colour[1], colour[2], 0.0],
+            Sky::Gradient { horizon, zenith } => {
+                p.sky_horizon = [horizon[0], horizon[1], horizon[2], 0.0];
+                p.sky_zenith = [zenith[0], zenith[1], zenith[2], 1.0];
+            }
+        }
+        let medium = (!c.is_orthographic())
+            .then(|| view.voxel(c.position.floor().as_ivec3()).ok().flatten())
+            .flatten()
+            .filter(|&m| {
+                view.materials()
+                    .get(m)
+                    .is_ok_and(|mat| mat.kind == MaterialKind::Dielectric)
+            });
+        p.seed = [
+            job.seed as u32 ^ (job.seed >> 32) as u32,
+            medium.map_or(0, |m| m as u32 + 1),
+            0,
+            0,
+        ];
+        p
+    }
+
+    /// The same parameters with `samples` samples per pixel starting at sample `first`,
+    /// added to the accumulation when `add`.
+    pub fn batch(mut self, samples: u32, first: u32, add: bool) -> Self {
+        self.image[2] = samples;
+        self.seed[2] = first;
+        self.seed[3] = u32::from(add);
+        self
+    }
+
+    /// Everything that changes the converged image (not the seed, the batch or the sample
+    /// index), as bytes: two renders with equal keys converge to the same image.
+    pub fn image_key(&self) -> Vec<u8> {
+        let mut k = *self;
+        k.seed = [0, self.seed[1], 0, 0];
+        k.image[2] = 0;
+        bytemuck::bytes_of(&k).to_vec()
+    }
+}
