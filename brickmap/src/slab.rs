@@ -89,7 +89,8 @@ pub(crate) enum WorkItem {
     Restore(Vec<BrickUndo>),
     /// Generated columns (every column of the slab).
     Generate(Arc<dyn ColumnSource>),
-    /// Panics (see `World::inject_worker_panic`).
+    /// Panics (see `World::inject_worker_panic`; tests only).
+    #[cfg(feature = "test-hooks")]
     Panic,
 }
 

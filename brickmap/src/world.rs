@@ -384,6 +384,7 @@ impl World {
     /// Makes worker `w` panic inside its next job (for testing that a panic surfaces as an
     /// error); its slab is marked poisoned and every later edit touching it fails.
     #[doc(hidden)]
+    #[cfg(feature = "test-hooks")]
     pub fn inject_worker_panic(&self, w: usize) -> Result<Ticket<'_>> {
         let (reply, rx) = crossbeam_channel::unbounded();
         self.senders

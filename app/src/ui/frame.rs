@@ -141,6 +141,7 @@ impl Editor {
 
     pub(super) fn draw(&mut self, gfx: &mut Gfx) -> Result<()> {
         self.frames += 1;
+        #[cfg(feature = "test-hooks")]
         if self.fail_at_frame == Some(self.frames) {
             return Err(render::vulkan::GpuError::Vk {
                 call: "vkQueueSubmit (simulated: VOXBRICK_TEST_GPU_FAILURE_AT_FRAME)",

@@ -262,6 +262,7 @@ pub struct Editor {
     report: report::Report,
     /// Tests only: the frame that fails as if the device were lost
     /// (`VOXBRICK_TEST_GPU_FAILURE_AT_FRAME`), to check nothing is lost when the GPU fails.
+    #[cfg(feature = "test-hooks")]
     fail_at_frame: Option<u64>,
     /// No window: frames are drawn offscreen, no native dialog is shown, fly keys move the
     /// camera a fixed 1/60 s per frame (a headless session is a function of its input).
@@ -380,6 +381,7 @@ impl Editor {
             selecting: None,
             pasting: false,
             report: report::Report::from_env(),
+            #[cfg(feature = "test-hooks")]
             fail_at_frame: std::env::var("VOXBRICK_TEST_GPU_FAILURE_AT_FRAME")
                 .ok()
                 .and_then(|v| v.parse().ok()),

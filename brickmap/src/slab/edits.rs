@@ -15,6 +15,7 @@ impl Slab {
             WorkItem::Voxels(list) => self.run_voxels(&list, &mut undo),
             WorkItem::Restore(list) => self.run_restore(&list, &mut undo),
             WorkItem::Generate(source) => self.run_generate(source.as_ref(), &mut undo),
+            #[cfg(feature = "test-hooks")]
             WorkItem::Panic => panic!("injected worker panic"),
         };
         match result {
