@@ -249,10 +249,8 @@ impl Presenter {
                 crate::vulkan::barrier::barrier(
                     &ctx,
                     cmd,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::AccessFlags::TRANSFER_WRITE,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::AccessFlags::TRANSFER_WRITE,
+                    crate::vulkan::barrier::Scope::TRANSFER_WRITE,
+                    crate::vulkan::barrier::Scope::TRANSFER_WRITE,
                 );
             }
             let mut copy = whole_image(area.extent);
@@ -342,10 +340,8 @@ impl Presenter {
                 crate::vulkan::barrier::barrier(
                     &ctx,
                     cmd,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::AccessFlags::TRANSFER_WRITE,
-                    vk::PipelineStageFlags::HOST,
-                    vk::AccessFlags::HOST_READ,
+                    crate::vulkan::barrier::Scope::TRANSFER_WRITE,
+                    crate::vulkan::barrier::Scope::HOST_READ,
                 );
                 image_barrier(
                     d,

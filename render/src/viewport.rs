@@ -12,15 +12,16 @@
 use crate::cpu::RenderJob;
 use crate::image::Image;
 use crate::params::SceneParams;
-use crate::vulkan::barrier::{after_earlier_passes, barrier, between_passes};
+use crate::vulkan::barrier::{Scope, after_earlier_passes, barrier, between_passes};
 use crate::vulkan::buffer::{Binding, HostBuffer, read_device};
 use crate::vulkan::denoise::Denoiser;
 use crate::vulkan::frame::{FRAMES_IN_FLIGHT, FrameSlot};
 use crate::vulkan::pass::{SetCache, run_batch};
 use crate::vulkan::primary::{GpuHit, PrimaryTracer};
 use crate::vulkan::progressive::Progressive;
+pub use crate::vulkan::progressive::{RenderHow, Rendered};
 use crate::vulkan::tonemap::ToneMapper;
-use crate::vulkan::trace::{PathTracer, RayCounts, TraceParams, Variant};
+use crate::vulkan::trace::{PathTracer, TraceParams, Variant};
 use crate::vulkan::world::{GpuWorld, UploadReport};
 use crate::vulkan::{GpuContext, GpuError};
 use ash::vk;
@@ -186,40 +187,17 @@ impl Viewport {
         &mut self.tracer
     }
 
-    /// Renders `job` with the scene's variant and waits: the linear image and GPU time.
+    /// Renders `job` as `how` says on this session's world and waits
+    /// ([`PathTracer::render`]).
     pub fn render(
         &mut self,
         view: &WorldView<'_>,
         params: &SceneParams,
         job: &RenderJob,
-    ) -> Result<(Image, Option<f64>), GpuError> {
+        how: RenderHow,
+    ) -> Result<Rendered, GpuError> {
         self.tracer
-            .render(&self.ctx, &self.world, view, params, job)
-    }
-
-    /// [`Viewport::render`] with a chosen variant (benchmarks compare sampling choices).
-    pub fn render_variant(
-        &mut self,
-        view: &WorldView<'_>,
-        params: &SceneParams,
-        job: &RenderJob,
-        variant: Variant,
-    ) -> Result<(Image, Option<f64>), GpuError> {
-        self.tracer
-            .render_variant(&self.ctx, &self.world, view, params, job, variant)
-    }
-
-    /// [`Viewport::render`] counting rays by kind.
-    pub fn render_counted(
-        &mut self,
-        view: &WorldView<'_>,
-        params: &SceneParams,
-        job: &RenderJob,
-        variant: Option<Variant>,
-    ) -> Result<(Image, Option<f64>, RayCounts), GpuError> {
-        let variant = variant.unwrap_or_else(|| Variant::for_scene(view, params));
-        self.tracer
-            .render_counted_variant(&self.ctx, &self.world, view, params, job, variant)
+            .render(&self.ctx, &self.world, view, params, job, how)
     }
 
     /// Renders `job` with `variant` as the viewport does with its denoiser on, one batch per
@@ -560,14 +538,7 @@ impl Viewport {
         )?;
         // SAFETY: recording: the display output is read by transfers (copy to an image).
         unsafe {
-            barrier(
-                &ctx,
-                frame.cmd,
-                vk::PipelineStageFlags::COMPUTE_SHADER,
-                vk::AccessFlags::SHADER_WRITE,
-                vk::PipelineStageFlags::TRANSFER,
-                vk::AccessFlags::TRANSFER_READ,
-            );
+            barrier(&ctx, frame.cmd, Scope::SHADER_WRITE, Scope::TRANSFER_READ);
         }
         Ok(FrameStatus {
             samples: live.samples(),
@@ -603,6 +574,32 @@ impl Viewport {
             s.wait(&self.ctx)?;
         }
         Ok(())
+    }
+
+    /// A whole frame without a window, if a slot is free: traces `world` as `req` asks and
+    /// submits. `None`: both slots are in flight (the window's loop would handle events
+    /// meanwhile).
+    pub fn try_draw(
+        &mut self,
+        world: &World,
+        req: &FrameRequest<'_>,
+    ) -> Result<Option<FrameStatus>, GpuError> {
+        let Some(frame) = self.begin_frame()? else {
+            return Ok(None);
+        };
+        let status = self.trace_frame(&frame, world, req)?;
+        self.submit_frame(frame, &[], &[])?;
+        Ok(Some(status))
+    }
+
+    /// [`Viewport::try_draw`], waiting (yielding the thread) until a slot is free.
+    pub fn draw(&mut self, world: &World, req: &FrameRequest<'_>) -> Result<FrameStatus, GpuError> {
+        loop {
+            if let Some(status) = self.try_draw(world, req)? {
+                return Ok(status);
+            }
+            std::thread::yield_now();
+        }
     }
 }
 

@@ -10,7 +10,7 @@ mod common;
 use render::Image;
 use render::convergence::rel_mse;
 use render::cpu::RenderJob;
-use render::viewport::{FrameRequest, Viewport};
+use render::viewport::{FrameRequest, RenderHow, Viewport};
 use render::vulkan::DeviceChoice;
 use render::vulkan::trace::Variant;
 use std::sync::Arc;
@@ -49,9 +49,14 @@ fn denoising_cuts_the_error_and_its_bias_falls_with_samples() {
     let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
     let size = (64, 40);
     let reference = vp
-        .render(&world.read(), &params, &RenderJob::sized(size, 1024, 99))
+        .render(
+            &world.read(),
+            &params,
+            &RenderJob::sized(size, 1024, 99),
+            RenderHow::SCENE,
+        )
         .unwrap()
-        .0;
+        .image;
     // One sample per dispatch: a batch per sample, as a viewport adding one per frame.
     vp.tracer().set_samples_per_dispatch(Some(1));
     vp.tracer().set_sample_slices(Some(1));
@@ -119,9 +124,14 @@ fn interactive_frames_display_the_denoised_image_when_asked() {
     let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
     let size = (48, 32);
     let reference = vp
-        .render(&world.read(), &params, &RenderJob::sized(size, 512, 5))
+        .render(
+            &world.read(),
+            &params,
+            &RenderJob::sized(size, 512, 5),
+            RenderHow::SCENE,
+        )
         .unwrap()
-        .0;
+        .image;
     let mut req = FrameRequest {
         params: &params,
         internal: size,
@@ -134,13 +144,7 @@ fn interactive_frames_display_the_denoised_image_when_asked() {
     };
     let run = |vp: &mut Viewport, req: &FrameRequest<'_>, n: usize| {
         for _ in 0..n {
-            loop {
-                if let Some(frame) = vp.begin_frame().unwrap() {
-                    vp.trace_frame(&frame, &world, req).unwrap();
-                    vp.submit_frame(frame, &[], &[]).unwrap();
-                    break;
-                }
-            }
+            vp.draw(&world, req).unwrap();
         }
     };
     run(&mut vp, &req, 6);

@@ -10,7 +10,7 @@ mod common;
 
 use brickmap::GpuBuffer;
 use render::Image;
-use render::viewport::{FrameRequest, IMAGE_BYTES_PER_PIXEL, Viewport};
+use render::viewport::{FrameRequest, IMAGE_BYTES_PER_PIXEL, RenderHow, Viewport};
 use render::vulkan::trace::{PathTracer, Variant, queue_fit};
 use render::vulkan::{ContextOptions, DeviceChoice, GpuContext, GpuError};
 use std::sync::Arc;
@@ -114,7 +114,7 @@ fn what_cannot_fit_is_refused_and_the_viewport_traces_a_smaller_image() {
         seed: 1,
     };
     let err = tracer
-        .render(&ctx, &gpu_world, &view, &params, &job)
+        .render(&ctx, &gpu_world, &view, &params, &job, RenderHow::SCENE)
         .map(|_| ())
         .unwrap_err();
     assert!(
@@ -146,12 +146,8 @@ fn what_cannot_fit_is_refused_and_the_viewport_traces_a_smaller_image() {
         if vp.samples() >= 4 {
             break;
         }
-        match vp.begin_frame().unwrap() {
-            Some(frame) => {
-                vp.trace_frame(&frame, &world, &req).unwrap();
-                vp.submit_frame(frame, &[], &[]).unwrap();
-            }
-            None => std::thread::sleep(std::time::Duration::from_millis(1)),
+        if vp.try_draw(&world, &req).unwrap().is_none() {
+            std::thread::sleep(std::time::Duration::from_millis(1));
         }
     }
     vp.wait_idle().unwrap();

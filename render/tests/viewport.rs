@@ -7,7 +7,7 @@ mod common;
 use brickmap::{EditOp, Mode, Shape};
 use glam::DVec3;
 use render::cpu::RenderJob;
-use render::viewport::{FrameRequest, Viewport};
+use render::viewport::{FrameRequest, RenderHow, Viewport};
 use render::vulkan::{DeviceChoice, GpuContext};
 use std::sync::Arc;
 
@@ -29,11 +29,8 @@ fn frames(
         if done(vp) || out.len() >= limit {
             break;
         }
-        match vp.begin_frame().unwrap() {
-            Some(frame) => {
-                out.push(vp.trace_frame(&frame, world, req).unwrap());
-                vp.submit_frame(frame, &[], &[]).unwrap();
-            }
+        match vp.try_draw(world, req).unwrap() {
+            Some(status) => out.push(status),
             None => std::thread::sleep(std::time::Duration::from_millis(1)),
         }
     }
@@ -77,7 +74,7 @@ fn interactive_frames_accumulate_the_one_shot_renders_samples() {
         "{idle:?}"
     );
     let live = vp.live_hdr().unwrap().unwrap();
-    let (once, _) = vp
+    let once = vp
         .render(
             &world.read(),
             &params,
@@ -87,8 +84,10 @@ fn interactive_frames_accumulate_the_one_shot_renders_samples() {
                 spp: 16,
                 seed: 1,
             },
+            RenderHow::SCENE,
         )
-        .unwrap();
+        .unwrap()
+        .image;
     let worst = live
         .pixels
         .iter()
@@ -135,7 +134,7 @@ fn an_edit_or_a_camera_move_restarts_and_the_edit_is_visible_the_next_frame() {
         .unwrap();
     let after_edit = run(&mut vp, &params, 1);
     assert!(after_edit[0].restarted && after_edit[0].upload.uploaded_bytes > 0);
-    let (edited, _) = vp
+    let edited = vp
         .render(
             &world.read(),
             &params,
@@ -145,8 +144,10 @@ fn an_edit_or_a_camera_move_restarts_and_the_edit_is_visible_the_next_frame() {
                 spp: 2,
                 seed: 1,
             },
+            RenderHow::SCENE,
         )
-        .unwrap();
+        .unwrap()
+        .image;
     let live = vp.live_hdr().unwrap().unwrap();
     let diff: f32 = live
         .pixels
@@ -247,13 +248,9 @@ fn a_larger_shadow_queue_keeps_the_frame_in_flight_valid() {
         if drawn >= 6 {
             break;
         }
-        match vp.begin_frame().unwrap() {
-            Some(frame) => {
-                let req = if drawn < 2 { &small } else { &more };
-                vp.trace_frame(&frame, &world, req).unwrap();
-                vp.submit_frame(frame, &[], &[]).unwrap();
-                drawn += 1;
-            }
+        let req = if drawn < 2 { &small } else { &more };
+        match vp.try_draw(&world, req).unwrap() {
+            Some(_) => drawn += 1,
             None => std::thread::sleep(std::time::Duration::from_micros(200)),
         }
     }

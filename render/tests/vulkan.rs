@@ -5,6 +5,7 @@
 mod common;
 
 use render::Image;
+use render::viewport::RenderHow;
 use render::vulkan::tonemap::ToneMapper;
 use render::vulkan::{ContextOptions, DeviceChoice, GpuContext, GpuError};
 
@@ -480,7 +481,10 @@ mod trace {
                 spp: 4,
                 seed: i as u64,
             };
-            let (img, _) = tracer.render(&ctx, &world, &view, p, &job).unwrap();
+            let img = tracer
+                .render(&ctx, &world, &view, p, &job, RenderHow::SCENE)
+                .unwrap()
+                .image;
             common::assert_finite_and_nonnegative(&img, &format!("camera {i}"));
         }
         // The centre rays of the cameras looking at geometry hit what the exact f64 cast of
@@ -595,12 +599,13 @@ mod trace {
             tracer.set_samples_per_dispatch(Some(per));
             tracer.set_sample_slices(Some(slices));
             assert_eq!(tracer.sample_slices(384), slices);
-            tracer
-                .render_counted(&ctx, &world, &view, &p, &job)
-                .unwrap()
+            let r = tracer
+                .render(&ctx, &world, &view, &p, &job, RenderHow::SCENE.counted())
+                .unwrap();
+            (r.image, r.rays.unwrap())
         };
-        let (whole, _, rays) = render(4, 1);
-        let (sliced, _, sliced_rays) = render(2, 3);
+        let (whole, rays) = render(4, 1);
+        let (sliced, sliced_rays) = render(2, 3);
         assert_eq!(sliced_rays, rays);
         assert!(rays.primary == 24 * 16 * 13, "{rays:?}");
         assert_same_up_to_rounding(&sliced, &whole, "sliced");
@@ -637,10 +642,10 @@ mod trace {
         let mut render = |deferred: bool, limit: u64| {
             tracer.set_deferred_shadows(&ctx, deferred);
             tracer.set_queue_limit(limit);
-            let (img, _, rays) = tracer
-                .render_counted(&ctx, &world, &view, &p, &job)
+            let r = tracer
+                .render(&ctx, &world, &view, &p, &job, RenderHow::SCENE.counted())
                 .unwrap();
-            (img, rays)
+            (r.image, r.rays.unwrap())
         };
         let (in_place, rays) = render(false, u64::MAX);
         // The limit of 100 rays makes the queue overflow: the rest are traced in place.
@@ -950,7 +955,7 @@ mod progressive {
         let accumulated = acc.hdr(&ctx).unwrap();
         let mut one = PathTracer::new(&ctx).unwrap();
         one.set_samples_per_dispatch(Some(3));
-        let (direct, _) = one
+        let direct = one
             .render(
                 &ctx,
                 &gpu,
@@ -962,8 +967,10 @@ mod progressive {
                     spp: 16,
                     seed: 7,
                 },
+                RenderHow::SCENE,
             )
-            .unwrap();
+            .unwrap()
+            .image;
         for (a, b) in accumulated.pixels.iter().zip(&direct.pixels) {
             for k in 0..3 {
                 assert!(
@@ -1069,12 +1076,21 @@ mod progressive {
             spp: 8,
             seed: 3,
         };
-        let (a, _) = tracer
-            .render_variant(&ctx, &gpu, &view, &p, &job, v)
-            .unwrap();
-        let (b, _) = tracer
-            .render_variant(&ctx, &gpu, &view, &p, &job, Variant::everything(3))
-            .unwrap();
+        let a = tracer
+            .render(&ctx, &gpu, &view, &p, &job, RenderHow::variant(v))
+            .unwrap()
+            .image;
+        let b = tracer
+            .render(
+                &ctx,
+                &gpu,
+                &view,
+                &p,
+                &job,
+                RenderHow::variant(Variant::everything(3)),
+            )
+            .unwrap()
+            .image;
         assert_eq!(tracer.variants(), 2);
         // Compilers may contract arithmetic differently per variant, so allow a few pixels
         // whose paths took another branch; the rest agree to float precision.
@@ -1140,7 +1156,10 @@ mod progressive {
             spp: 2,
             seed: 3,
         };
-        let (direct, _) = tracer.render(&ctx, &gpu, &w.read(), &p, &job).unwrap();
+        let direct = tracer
+            .render(&ctx, &gpu, &w.read(), &p, &job, RenderHow::SCENE)
+            .unwrap()
+            .image;
         // Equal up to the order of the shadow pass's float atomic adds.
         for (a, b) in repeated.pixels.iter().zip(&direct.pixels) {
             for k in 0..3 {

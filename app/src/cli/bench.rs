@@ -19,7 +19,7 @@ use brickmap::{EditOp, Mode, Shape};
 use glam::DVec3;
 use render::SceneParams;
 use render::cpu::{CpuScene, RenderJob};
-use render::viewport::{FrameRequest, Viewport};
+use render::viewport::{FrameRequest, RenderHow, Viewport};
 use render::vulkan::trace::Variant;
 use runs::{cpu_run, edit_run, gpu_run};
 use serde::Serialize;
@@ -326,7 +326,7 @@ fn bench(b: Bench, workers: usize) -> Result<String> {
         for k in &path.keyframes {
             let p = params_at(&scene.params, &path, &PRESETS[2], k.time_s, centre);
             let job = RenderJob::sized(b.view_size, b.view_spp, 1);
-            let (img, _) = session.render(&view, &p, &job)?;
+            let img = session.render(&view, &p, &job, RenderHow::SCENE)?.image;
             let file = b.out.join("views").join(format!("t{:04.1}s.png", k.time_s));
             app::atomic::write_atomic(&file, |w| img.write_png(w, p.settings.exposure))?;
         }

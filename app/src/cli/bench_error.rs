@@ -25,7 +25,7 @@ use app::camera_path::CameraPath;
 use render::Sequence;
 use render::convergence::{log_log_fit, reference_noise, rel_mse, time_at_error};
 use render::cpu::RenderJob;
-use render::viewport::Viewport;
+use render::viewport::{RenderHow, Viewport};
 use render::vulkan::trace::Variant;
 use render::{Image, SceneParams};
 use serde::Serialize;
@@ -338,7 +338,8 @@ fn measure(
                 filter_times.push(f * 1e3);
                 (r.denoised, r.trace_seconds.map(|t| t + f))
             } else {
-                session.render_variant(view, params, &job, variant)?
+                let r = session.render(view, params, &job, RenderHow::variant(variant))?;
+                (r.image, r.gpu_ms)
             };
             times.push(t.context("this queue cannot take timestamps")? * 1e3);
             errors.push(rel_mse(&image, reference).context("image sizes differ")? - noise);
@@ -557,8 +558,15 @@ fn bench_error(b: BenchError, workers: usize) -> Result<String> {
                 spp: b.reference_spp / 2,
                 seed,
             };
-            let (a, ta) = session.render_variant(&view, &params, &half(1), v)?;
-            let (c, tc) = session.render_variant(&view, &params, &half(2), v)?;
+            let how = RenderHow::variant(v);
+            let (a, ta) = {
+                let r = session.render(&view, &params, &half(1), how)?;
+                (r.image, r.gpu_ms)
+            };
+            let (c, tc) = {
+                let r = session.render(&view, &params, &half(2), how)?;
+                (r.image, r.gpu_ms)
+            };
             let noise = reference_noise(&a, &c).context("image sizes differ")?;
             let reference = average(&a, &c);
             let reference_srgb = srgb(&reference, exposure);
@@ -596,9 +604,13 @@ fn bench_error(b: BenchError, workers: usize) -> Result<String> {
                     spp: 4,
                     seed: 100,
                 };
-                let (mine, _) = session.render_variant(&view, &params, &job, v)?;
+                let mine = session
+                    .render(&view, &params, &job, RenderHow::variant(v))?
+                    .image;
                 let v0 = Choice::Default.apply(session, scene_variant);
-                let (theirs, _) = session.render_variant(&view, &params, &job, v0)?;
+                let theirs = session
+                    .render(&view, &params, &job, RenderHow::variant(v0))?
+                    .image;
                 let same = rel_mse(&mine, &theirs).context("image sizes differ")?;
                 if same > SAME_IMAGE {
                     bail!(

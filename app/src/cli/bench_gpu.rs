@@ -4,6 +4,7 @@
 use super::{emit, with_progress};
 use anyhow::{Context, Result, bail};
 use app::scene::thesis_scene;
+use render::viewport::RenderHow;
 
 /// `voxbrick bench-gpu`: what to measure.
 #[derive(clap::Args)]
@@ -142,7 +143,7 @@ pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
             text += &format!("{label}: this queue cannot take timestamps\n");
             continue;
         }
-        let rays = match session.render_counted(
+        let rays = match session.render(
             &view,
             &params,
             &render::cpu::RenderJob {
@@ -151,9 +152,9 @@ pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
                 spp,
                 seed: 0,
             },
-            Some(scene_variant),
+            RenderHow::variant(scene_variant).counted(),
         ) {
-            Ok((_, _, rays)) => rays,
+            Ok(r) => r.rays.expect("counted"),
             Err(e) => {
                 failure = Some(e);
                 break;
@@ -221,7 +222,10 @@ pub(crate) fn convergence_table(
     };
     let (reference, reference_time) = with_progress(
         format!("reference: {width}x{height} at {reference_spp} spp"),
-        || Ok(session.render(view, params, &job(reference_spp, 1))?),
+        || {
+            let r = session.render(view, params, &job(reference_spp, 1), RenderHow::SCENE)?;
+            Ok((r.image, r.gpu_ms))
+        },
     )?;
     let Some(reference_time) = reference_time else {
         bail!("this queue cannot take timestamps");
@@ -231,9 +235,9 @@ pub(crate) fn convergence_table(
     for spp in (0..9).map(|k| 1u32 << k) {
         let (mut times, mut mse) = (Vec::new(), 0.0);
         for seed in 2..5 {
-            let (image, time) = session.render(view, params, &job(spp, seed))?;
-            times.push(time.unwrap_or(f64::NAN));
-            mse += image.mse(&reference).context("image sizes differ")? / 3.0;
+            let r = session.render(view, params, &job(spp, seed), RenderHow::SCENE)?;
+            times.push(r.gpu_ms.unwrap_or(f64::NAN));
+            mse += r.image.mse(&reference).context("image sizes differ")? / 3.0;
         }
         times.sort_by(f64::total_cmp);
         measurements.push(Measurement {

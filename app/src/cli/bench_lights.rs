@@ -12,6 +12,7 @@ use app::scene::thesis_scene;
 use brickmap::{EditOp, GpuBuffer, GridDims, MaterialKind, Mode, Shape};
 use glam::{DVec3, IVec3};
 use render::cpu::RenderJob;
+use render::viewport::RenderHow;
 use render::vulkan::trace::Variant;
 use render::{Camera, Image, Sky};
 use std::time::Instant;
@@ -160,10 +161,12 @@ pub(crate) fn bench_lights(
             spp,
             seed,
         };
-        let (reference, _) =
-            with_progress(format!("{name}: reference at {reference_spp} spp"), || {
-                Ok(session.render_variant(&view, params, &job(reference_spp, 1), on)?)
-            })?;
+        let reference = with_progress(format!("{name}: reference at {reference_spp} spp"), || {
+            let how = RenderHow::variant(on);
+            Ok(session
+                .render(&view, params, &job(reference_spp, 1), how)?
+                .image)
+        })?;
         text += &format!(
             "{name}: {} light faces, {width}x{height}, reference {reference_spp} spp with light sampling\n  \
              spp   light sampling: GPU ms  relMSE     efficiency   | BSDF only: GPU ms  relMSE     efficiency  | ratio\n",
@@ -177,9 +180,10 @@ pub(crate) fn bench_lights(
             for (i, v) in [on, off].into_iter().enumerate() {
                 let (mut times, mut err) = (Vec::new(), 0.0);
                 for seed in 2..5 {
-                    let (image, t) = session.render_variant(&view, params, &job(spp, seed), v)?;
-                    times.push(t.context("this queue cannot take timestamps")?);
-                    err += rel_mse(&image, &reference) / 3.0;
+                    let r =
+                        session.render(&view, params, &job(spp, seed), RenderHow::variant(v))?;
+                    times.push(r.gpu_ms.context("this queue cannot take timestamps")?);
+                    err += rel_mse(&r.image, &reference) / 3.0;
                 }
                 times.sort_by(f64::total_cmp);
                 row[i] = (times[1], err);

@@ -19,7 +19,7 @@ use brickmap::{
 use glam::{DVec3, IVec3};
 use render::convergence::rel_mse;
 use render::cpu::RenderJob;
-use render::viewport::Viewport;
+use render::viewport::{RenderHow, Viewport};
 use render::vulkan::trace::Variant;
 use render::{Camera, SceneParams, Sky};
 use serde::Serialize;
@@ -183,14 +183,13 @@ fn traversal_row(
         },
         None => everything(with),
     };
-    let (a, _) =
-        session.render_variant(&view, &case.params, &RenderJob::sized(size, spp, 5), with)?;
-    let (b, _) = session.render_variant(
-        &view,
-        &case.params,
-        &RenderJob::sized(size, spp, 5),
-        without,
-    )?;
+    let job = RenderJob::sized(size, spp, 5);
+    let a = session
+        .render(&view, &case.params, &job, RenderHow::variant(with))?
+        .image;
+    let b = session
+        .render(&view, &case.params, &job, RenderHow::variant(without))?
+        .image;
     let same = rel_mse(&b, &a).context("image sizes differ")?;
     if same > SAME_IMAGE {
         bail!(
@@ -237,23 +236,19 @@ fn accumulation_row(
     seconds: u32,
 ) -> Result<Row> {
     let view = case.world.read();
-    let reference = session
-        .render(
-            &view,
-            &case.params,
-            &RenderJob::sized(size, seconds * SECOND * spp, 1),
-        )?
-        .0;
-    let one = session
-        .render(&view, &case.params, &RenderJob::sized(size, spp, 2))?
-        .0;
-    let second = session
-        .render(
-            &view,
-            &case.params,
-            &RenderJob::sized(size, SECOND * spp, 3),
-        )?
-        .0;
+    let mut render = |spp: u32, seed: u64| {
+        session
+            .render(
+                &view,
+                &case.params,
+                &RenderJob::sized(size, spp, seed),
+                RenderHow::SCENE,
+            )
+            .map(|r| r.image)
+    };
+    let reference = render(seconds * SECOND * spp, 1)?;
+    let one = render(spp, 2)?;
+    let second = render(SECOND * spp, 3)?;
     let (e1, e60) = (
         rel_mse(&one, &reference).context("sizes")?,
         rel_mse(&second, &reference).context("sizes")?,

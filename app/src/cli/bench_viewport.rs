@@ -268,24 +268,16 @@ fn latency(
     let (mut frames, mut ms) = (Vec::new(), Vec::new());
     for _ in 0..moves {
         // A frame already in flight, as in the window's loop.
-        if let Some(f) = vp.begin_frame()? {
-            let r = FrameRequest { params: &p, ..req };
-            vp.trace_frame(&f, world, &r)?;
-            vp.submit_frame(f, &[], &[])?;
-        }
+        vp.try_draw(world, &FrameRequest { params: &p, ..req })?;
         p.camera.pitch_deg = (p.camera.pitch_deg - 0.5).max(-80.0);
         let event = Instant::now();
         let mut n = 0;
         loop {
-            let Some(f) = vp.begin_frame()? else {
-                std::thread::yield_now();
-                continue;
-            };
             n += 1;
-            let r = FrameRequest { params: &p, ..req };
-            let status = vp.trace_frame(&f, world, &r)?;
-            vp.submit_frame(f, &[], &[])?;
-            if status.restarted {
+            if vp
+                .draw(world, &FrameRequest { params: &p, ..req })?
+                .restarted
+            {
                 break;
             }
         }
@@ -425,10 +417,7 @@ fn edits(
             let req = edit_request(&params, size, scale);
             // Warm-up frames (pipelines, clocks).
             for _ in 0..WARM_UP {
-                if let Some(f) = vp.begin_frame()? {
-                    vp.trace_frame(&f, &doc.scene.world, &req)?;
-                    vp.submit_frame(f, &[], &[])?;
-                }
+                vp.try_draw(&doc.scene.world, &req)?;
             }
             vp.wait_idle()?;
             let step = (r * 0.5).max(1.0);
@@ -463,10 +452,7 @@ fn edits(
                     prev.push(started.elapsed().as_secs_f64() * 1e3);
                 }
                 // A frame in flight, as in the window's loop.
-                if let Some(f) = vp.begin_frame()? {
-                    vp.trace_frame(&f, &doc.scene.world, &req)?;
-                    vp.submit_frame(f, &[], &[])?;
-                }
+                vp.try_draw(&doc.scene.world, &req)?;
                 let event = Instant::now();
                 if k == 0 {
                     doc.begin_stroke(stroke(0))?;
@@ -532,21 +518,11 @@ fn first_clicks(
         let mut ms = Vec::new();
         for k in 0..CLICKS {
             for _ in 0..4 {
-                if let Some(f) = vp.begin_frame()? {
-                    vp.trace_frame(&f, &doc.scene.world, &full)?;
-                    vp.submit_frame(f, &[], &[])?;
-                }
+                vp.try_draw(&doc.scene.world, &full)?;
             }
             // One frame in flight (as in the stroke cases), then the click.
             vp.wait_idle()?;
-            let f = loop {
-                if let Some(f) = vp.begin_frame()? {
-                    break f;
-                }
-                std::thread::yield_now();
-            };
-            vp.trace_frame(&f, &doc.scene.world, &full)?;
-            vp.submit_frame(f, &[], &[])?;
+            vp.draw(&doc.scene.world, &full)?;
             let event = Instant::now();
             let at = glam::DVec3::new(dims.x * (0.2 + 0.03 * k as f64), dims.y * 0.3, dims.z * 0.5);
             doc.execute(Command::Stroke(Stroke {
@@ -600,13 +576,8 @@ fn frames_until_shown(
     let mut restarted = false;
     let mut bytes = 0;
     loop {
-        let Some(f) = vp.begin_frame()? else {
-            std::thread::yield_now();
-            continue;
-        };
         n += 1;
-        let status = vp.trace_frame(&f, world, req)?;
-        vp.submit_frame(f, &[], &[])?;
+        let status = vp.draw(world, req)?;
         restarted |= status.restarted;
         bytes += status.upload.uploaded_bytes;
         if restarted && status.upload.deferred_bytes == 0 {

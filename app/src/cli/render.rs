@@ -4,6 +4,7 @@ use super::{emit, with_progress};
 use anyhow::{Context, Result, bail};
 use app::Scene;
 use glam::DVec3;
+use render::viewport::RenderHow;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -198,9 +199,13 @@ pub(crate) fn render_on(
                 "rendering {}x{} at {} spp on {name}",
                 job.width, job.height, job.spp
             ),
-            || Ok(session.render_counted(view, params, job, None)?),
+            || Ok(session.render(view, params, job, RenderHow::SCENE.counted())?),
+        )?;
+        let (image, gpu, rays) = (
+            rendered.image,
+            rendered.gpu_ms,
+            rendered.rays.expect("counted"),
         );
-        let (image, gpu, rays) = rendered?;
         let timing = match gpu {
             Some(t) => format!(
                 "gpu time     {:.3} ms (timestamp queries)\nrays         {} ({:.1} Mrays/s: {} primary, {} secondary, {} shadow)\n",

@@ -31,6 +31,7 @@ use anyhow::{Context, Result, ensure};
 use brickmap::GridDims;
 use glam::{IVec3, UVec3};
 use render::Camera;
+use render::viewport::RenderHow;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -450,8 +451,8 @@ fn render_step(
     } else {
         let mut session = crate::gpu::session(&options.device, &view)
             .context("no GPU for render steps (replay with --device cpu for the CPU reference)")?;
-        let rendered = session.render(&view, &params, &job(r.seed))?;
-        (rendered.0, session.ctx().name.clone())
+        let rendered = session.render(&view, &params, &job(r.seed), RenderHow::SCENE)?;
+        (rendered.image, session.ctx().name.clone())
     };
     ensure!(image.all_finite(), "the image has NaN or infinite pixels");
     let mean = image.mean();

@@ -495,9 +495,7 @@ impl Session {
         let mut drawn = false;
         let waiting = std::time::Instant::now();
         while waiting.elapsed() < Duration::from_secs(300) {
-            if let Some(frame) = vp.begin_frame()? {
-                vp.trace_frame(&frame, &d.scene.world, &req)?;
-                vp.submit_frame(frame, &[], &[])?;
+            if vp.try_draw(&d.scene.world, &req)?.is_some() {
                 drawn = true;
                 break;
             }

@@ -9,7 +9,7 @@ pub mod scenes;
 
 use crate::cpu::{CpuScene, RenderJob};
 use crate::image::Image;
-use crate::viewport::Viewport;
+use crate::viewport::{RenderHow, Viewport};
 use crate::vulkan::{GpuContext, GpuError};
 use glam::IVec3;
 use rays::{RayClass, RayTally};
@@ -247,9 +247,9 @@ pub fn image_suite(
                         spp: 1,
                         seed: cfg.seed + 1000 * v as u64 + k as u64,
                     };
-                    let (img, _, rc) = session.render_counted(&view, p, &job, None)?;
-                    counts.add(&img);
-                    caps += rc.capped;
+                    let r = session.render(&view, p, &job, RenderHow::SCENE.counted())?;
+                    counts.add(&r.image);
+                    caps += r.rays.expect("counted").capped;
                 }
             }
             let row = counts.row(scene.name, "GPU", Some(caps), scene.expected);

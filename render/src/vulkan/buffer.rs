@@ -1,7 +1,7 @@
 //! Storage buffers (host-visible ones the CPU writes and reads back, device-local ones that
 //! copies fill), bindings of buffer ranges, and reading a device-local range back.
 
-use super::barrier::{barrier, before_transfer};
+use super::barrier::{Scope, barrier, before_transfer};
 use super::{GpuContext, GpuError, vk_call};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -154,14 +154,7 @@ pub fn read_device(ctx: &GpuContext, src: Binding) -> Result<Vec<u8>, GpuError> 
                     }],
                 );
             }
-            barrier(
-                ctx,
-                cmd,
-                vk::PipelineStageFlags::TRANSFER,
-                vk::AccessFlags::TRANSFER_WRITE,
-                vk::PipelineStageFlags::HOST,
-                vk::AccessFlags::HOST_READ,
-            );
+            barrier(ctx, cmd, Scope::TRANSFER_WRITE, Scope::HOST_READ);
         }
     });
     let bytes = copied.map(|_| out.read()[..src.range as usize].to_vec());

@@ -198,10 +198,8 @@ impl FrameSlot {
                 super::barrier::barrier(
                     ctx,
                     self.cmd,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::AccessFlags::TRANSFER_WRITE,
-                    vk::PipelineStageFlags::HOST,
-                    vk::AccessFlags::HOST_READ,
+                    crate::vulkan::barrier::Scope::TRANSFER_WRITE,
+                    crate::vulkan::barrier::Scope::HOST_READ,
                 );
                 self.timed = true;
             }

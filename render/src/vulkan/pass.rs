@@ -11,7 +11,7 @@
 //! copies. Benchmarks repeat frames so the GPU never idles (an idle-looking GPU drops its
 //! clocks). `statistics()`.
 
-use super::barrier::{after_earlier_passes, barrier};
+use super::barrier::{Scope, after_earlier_passes, barrier};
 use super::buffer::Binding;
 use super::{GpuContext, GpuError, vk_call};
 use ash::vk;
@@ -78,20 +78,7 @@ pub fn run_batch(
                 }
             }
             // Results are visible to the host and to later passes and copies.
-            barrier(
-                ctx,
-                cmd,
-                vk::PipelineStageFlags::COMPUTE_SHADER,
-                vk::AccessFlags::SHADER_WRITE,
-                vk::PipelineStageFlags::HOST
-                    | vk::PipelineStageFlags::COMPUTE_SHADER
-                    | vk::PipelineStageFlags::TRANSFER,
-                vk::AccessFlags::HOST_READ
-                    | vk::AccessFlags::SHADER_READ
-                    | vk::AccessFlags::SHADER_WRITE
-                    | vk::AccessFlags::TRANSFER_READ
-                    | vk::AccessFlags::TRANSFER_WRITE,
-            );
+            barrier(ctx, cmd, Scope::SHADER_WRITE, Scope::RESULTS_READ);
         });
         let mut elapsed = Vec::new();
         if let Some(q) = queries {

@@ -380,16 +380,62 @@ impl Progressive {
     }
 }
 
+/// How a one-shot render runs: the scene's pipeline variant or a chosen one (benchmarks
+/// compare variants; a variant lacking something the scene has renders it wrongly), and
+/// whether rays are counted by kind (the same image, plus one atomic add per pixel and
+/// dispatch).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RenderHow {
+    /// The variant (None: `Variant::for_scene`).
+    pub variant: Option<Variant>,
+    /// Count the rays traced, by kind.
+    pub count_rays: bool,
+}
+
+impl RenderHow {
+    /// The scene's variant, no counting.
+    pub const SCENE: RenderHow = RenderHow {
+        variant: None,
+        count_rays: false,
+    };
+
+    /// A chosen variant, no counting.
+    pub fn variant(v: Variant) -> Self {
+        Self {
+            variant: Some(v),
+            count_rays: false,
+        }
+    }
+
+    /// The same, counting rays.
+    pub fn counted(self) -> Self {
+        Self {
+            count_rays: true,
+            ..self
+        }
+    }
+}
+
+/// What a one-shot render gives back.
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    /// The linear image.
+    pub image: Image,
+    /// GPU time spent, ms (timestamp queries summed over the dispatches; None when the
+    /// queue cannot time).
+    pub gpu_ms: Option<f64>,
+    /// Rays traced by kind, when counted.
+    pub rays: Option<RayCounts>,
+}
+
 /// One-shot renders (CLI, scripts, tests): an accumulation of the image's size, filled and
 /// read back. Here rather than in trace.rs so the tracer does not depend on the accumulation.
 impl PathTracer {
-    /// Renders `job.spp` samples per pixel with the scene's variant; returns the linear image
-    /// and the GPU time spent (timestamp queries summed over the dispatches; None when the
-    /// queue cannot time). Samples accumulate on the GPU in batches of
-    /// [`PathTracer::samples_per_dispatch`], at most [`MAX_SAMPLES_PER_DISPATCH`]:
-    /// long-running invocations lose samples on lavapipe (measured: 256 samples per invocation
-    /// came out 9% dark there, exact on the H100), and short dispatches are what a viewport
-    /// does anyway.
+    /// Renders `job.spp` samples per pixel as `how` says and waits. Samples accumulate on the
+    /// GPU in batches of [`PathTracer::samples_per_dispatch`], at most
+    /// [`MAX_SAMPLES_PER_DISPATCH`]: long-running invocations lose samples on lavapipe
+    /// (measured: 256 samples per invocation came out 9% dark there, exact on the H100), and
+    /// short dispatches are what a viewport does anyway.
     pub fn render(
         &mut self,
         ctx: &GpuContext,
@@ -397,62 +443,29 @@ impl PathTracer {
         view: &WorldView<'_>,
         params: &SceneParams,
         job: &RenderJob,
-    ) -> Result<(Image, Option<f64>), GpuError> {
-        let variant = Variant::for_scene(view, params);
-        self.render_variant(ctx, world, view, params, job, variant)
-    }
-
-    /// [`PathTracer::render`] with a chosen variant (benchmarks compare variants; a variant
-    /// lacking something the scene has renders it wrongly).
-    pub fn render_variant(
-        &mut self,
-        ctx: &GpuContext,
-        world: &GpuWorld,
-        view: &WorldView<'_>,
-        params: &SceneParams,
-        job: &RenderJob,
-        variant: Variant,
-    ) -> Result<(Image, Option<f64>), GpuError> {
+        how: RenderHow,
+    ) -> Result<Rendered, GpuError> {
+        let variant = Variant {
+            count_rays: how.count_rays,
+            ..how
+                .variant
+                .unwrap_or_else(|| Variant::for_scene(view, params))
+        };
+        if how.count_rays {
+            self.reset_counters();
+        }
         let size = (job.width, job.height);
         let mut acc = Progressive::new(ctx, size, size, job.seed)?;
         let result = acc
             .accumulate(ctx, self, world, view, params, variant, job.spp)
             .and_then(|(gpu, _)| acc.hdr(ctx).map(|img| (img, gpu)));
         acc.destroy(ctx);
-        result
-    }
-
-    /// [`PathTracer::render`] with a counting variant of the scene's (the same image, plus
-    /// one atomic add per pixel and dispatch): also returns the rays traced, by kind.
-    pub fn render_counted(
-        &mut self,
-        ctx: &GpuContext,
-        world: &GpuWorld,
-        view: &WorldView<'_>,
-        params: &SceneParams,
-        job: &RenderJob,
-    ) -> Result<(Image, Option<f64>, RayCounts), GpuError> {
-        let variant = Variant::for_scene(view, params);
-        self.render_counted_variant(ctx, world, view, params, job, variant)
-    }
-
-    /// [`PathTracer::render_counted`] with a chosen variant.
-    pub fn render_counted_variant(
-        &mut self,
-        ctx: &GpuContext,
-        world: &GpuWorld,
-        view: &WorldView<'_>,
-        params: &SceneParams,
-        job: &RenderJob,
-        variant: Variant,
-    ) -> Result<(Image, Option<f64>, RayCounts), GpuError> {
-        let variant = Variant {
-            count_rays: true,
-            ..variant
-        };
-        self.reset_counters();
-        let (image, gpu) = self.render_variant(ctx, world, view, params, job, variant)?;
-        Ok((image, gpu, self.read_counters()))
+        let (image, gpu_ms) = result?;
+        Ok(Rendered {
+            image,
+            gpu_ms,
+            rays: how.count_rays.then(|| self.read_counters()),
+        })
     }
 }
 

@@ -5,7 +5,7 @@
 //! uploads own their bytes (copied when they were queued), so a deferred upload never reads
 //! world data that may have changed since.
 
-use super::barrier::{after_transfer, barrier, before_transfer};
+use super::barrier::{Scope, after_transfer, barrier, before_transfer};
 use super::buffer::HostBuffer;
 use super::{GpuContext, GpuError, vk_call};
 use ash::vk;
@@ -190,14 +190,7 @@ impl StagingRing {
             before_transfer(ctx, slot.cmd);
             for (i, (dst, copies)) in commands.iter().enumerate() {
                 if i > 0 {
-                    barrier(
-                        ctx,
-                        slot.cmd,
-                        vk::PipelineStageFlags::TRANSFER,
-                        vk::AccessFlags::TRANSFER_WRITE,
-                        vk::PipelineStageFlags::TRANSFER,
-                        vk::AccessFlags::TRANSFER_WRITE,
-                    );
+                    barrier(ctx, slot.cmd, Scope::TRANSFER_WRITE, Scope::TRANSFER_WRITE);
                 }
                 d.cmd_copy_buffer(slot.cmd, src, *dst, copies);
             }

@@ -34,7 +34,7 @@
 //! replaces the old one only after a device wait (the other frame in flight may still trace
 //! with it).
 
-use super::barrier::barrier;
+use super::barrier::{Scope, barrier};
 use super::buffer::{Binding, HostBuffer};
 use super::pass::{ComputePass, Dispatch, SetCache, run_batch};
 use super::world::GpuWorld;
@@ -534,30 +534,14 @@ impl PathTracer {
                 );
             }
             if plan.zero.is_some() || plan.header.is_some() {
-                barrier(
-                    ctx,
-                    cmd,
-                    vk::PipelineStageFlags::TRANSFER,
-                    vk::AccessFlags::TRANSFER_WRITE,
-                    vk::PipelineStageFlags::COMPUTE_SHADER,
-                    vk::AccessFlags::SHADER_READ | vk::AccessFlags::SHADER_WRITE,
-                );
+                barrier(ctx, cmd, Scope::TRANSFER_WRITE, Scope::SHADER_RW);
             }
         }
         trace.record(ctx, cmd, trace_set, &[], plan.groups);
         if let (Some(h), Some(shadow), Some(set)) = (plan.header, shadow, shadow_set) {
             // SAFETY: recording.
             unsafe {
-                barrier(
-                    ctx,
-                    cmd,
-                    vk::PipelineStageFlags::COMPUTE_SHADER,
-                    vk::AccessFlags::SHADER_WRITE,
-                    vk::PipelineStageFlags::COMPUTE_SHADER | vk::PipelineStageFlags::DRAW_INDIRECT,
-                    vk::AccessFlags::SHADER_READ
-                        | vk::AccessFlags::SHADER_WRITE
-                        | vk::AccessFlags::INDIRECT_COMMAND_READ,
-                );
+                barrier(ctx, cmd, Scope::SHADER_WRITE, Scope::SHADER_RW_INDIRECT);
             }
             shadow.record(ctx, cmd, set, &[], Dispatch::Indirect(h.buffer, h.offset));
         }

@@ -693,9 +693,16 @@ pub fn gpu_render_with(
         seed,
     };
     let image = tracer
-        .render_variant(ctx, &world, &view, p, &job, v)
+        .render(
+            ctx,
+            &world,
+            &view,
+            p,
+            &job,
+            render::viewport::RenderHow::variant(v),
+        )
         .unwrap()
-        .0;
+        .image;
     tracer.destroy(ctx);
     world.destroy(ctx);
     image

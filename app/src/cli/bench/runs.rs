@@ -61,7 +61,8 @@ pub(super) fn gpu_run(
                 spp: preset.spp,
                 seed: i as u64,
             };
-            let (_, _, c) = session.render_counted(&view, &p, &job, Some(variant))?;
+            let how = RenderHow::variant(variant).counted();
+            let c = session.render(&view, &p, &job, how)?.rays.expect("counted");
             rays.primary += c.primary;
             rays.secondary += c.secondary;
             rays.shadow += c.shadow;
@@ -197,13 +198,8 @@ pub(super) fn edit_run(
         apply.push(started.elapsed().as_secs_f64() * 1e3);
         let (mut n, mut bytes, mut restarted) = (0u32, 0u64, false);
         loop {
-            let Some(f) = session.begin_frame()? else {
-                std::thread::yield_now();
-                continue;
-            };
             n += 1;
-            let status = session.trace_frame(&f, &scene.world, &req)?;
-            session.submit_frame(f, &[], &[])?;
+            let status = session.draw(&scene.world, &req)?;
             if let Some(g) = session.last_gpu_seconds() {
                 gpu.push(g * 1e3);
             }
