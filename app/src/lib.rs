@@ -8,6 +8,8 @@ pub mod editor;
 pub mod formats;
 pub mod gpu;
 pub mod scene;
+#[cfg(any(test, feature = "test-hooks"))]
+pub mod scratch;
 pub mod selection;
 pub mod soak;
 pub mod ui;

@@ -1,7 +1,7 @@
 //! The `voxbrick` binary end to end: the main job's statistics, conversions, new terrain,
 //! info, and one-line errors that leave files alone.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 fn voxbrick(args: &[&str]) -> std::process::Output {
@@ -54,11 +54,9 @@ fn field<'a>(out: &'a str, name: &str) -> &'a str {
         .unwrap_or_else(|| panic!("no {name} in:\n{out}"))
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("voxbrick-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A scratch folder for this test, removed when it passes.
+fn scratch(name: &str) -> app::scratch::Scratch {
+    app::scratch::Scratch::new(&format!("cli-{name}"))
 }
 
 fn s(p: &Path) -> &str {

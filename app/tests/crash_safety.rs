@@ -30,9 +30,7 @@ fn new_project(seed: &str, out: &Path) -> Command {
 
 #[test]
 fn saves_killed_at_random_moments_leave_the_old_file_or_the_complete_new_one() {
-    let dir = std::env::temp_dir().join(format!("voxbrick-kills-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = app::scratch::Scratch::new("kills");
     // The two complete contents.
     let (a, b) = (dir.join("a.ron"), dir.join("b.ron"));
     assert!(new_project("1", &a).status().unwrap().success());

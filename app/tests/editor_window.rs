@@ -268,11 +268,12 @@ fn the_default_scene_in_a_full_hd_window_stays_within_the_device_limits() {
 
 #[test]
 fn without_a_display_the_editor_says_so_in_one_line() {
+    let config = scratch("nodisplay");
     let out = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
         .args(["--window", "160x96"])
         .env_remove("DISPLAY")
         .env_remove("WAYLAND_DISPLAY")
-        .env("VOXBRICK_CONFIG_DIR", scratch("nodisplay"))
+        .env("VOXBRICK_CONFIG_DIR", config.path())
         .output()
         .unwrap();
     assert!(!out.status.success());

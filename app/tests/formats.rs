@@ -10,11 +10,9 @@ use brickmap::{EditOp, GridDims, Material, MaterialKind, Mode, Shape, VoxelEdit,
 use glam::{DVec3, IVec3};
 use std::path::{Path, PathBuf};
 
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("voxbrick-formats-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A scratch folder for this test, removed when it passes.
+fn scratch(name: &str) -> app::scratch::Scratch {
+    app::scratch::Scratch::new(&format!("formats-{name}"))
 }
 
 fn assets() -> PathBuf {
@@ -565,8 +563,7 @@ fn matl_materials_map_to_voxbrick_materials() {
 #[test]
 fn hostile_vox_files_are_refused_and_nothing_left_out_silently() {
     let seeds = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/vox_import");
-    let dir = std::env::temp_dir().join(format!("voxbrick-hostile-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("hostile");
     for (file, want) in [
         (
             "huge_model_empty_xyzi.vox",

@@ -23,6 +23,7 @@ fn no_device(f: &SoakFailure) -> bool {
 
 #[test]
 fn a_short_soak_through_the_editors_window_handlers_is_clean() {
+    let out = window::scratch("soak-editor");
     let opts = SoakOptions {
         seed: 32,
         through: Through::Editor,
@@ -31,7 +32,7 @@ fn a_short_soak_through_the_editors_window_handlers_is_clean() {
         size: glam::UVec3::new(48, 24, 48),
         window: (320, 200),
         frame_every: 6,
-        out_dir: window::scratch("soak-editor"),
+        out_dir: out.to_path_buf(),
         ..SoakOptions::default()
     };
     match soak(&opts) {
@@ -63,12 +64,13 @@ fn a_short_soak_through_the_editors_window_handlers_is_clean() {
 
 #[test]
 fn a_short_soak_through_the_edit_thread_with_viewport_frames_is_clean() {
+    let out = window::scratch("soak-short");
     let opts = SoakOptions {
         seed: 26,
         through: Through::Edits,
         events: 2000,
         check_every: 500,
-        out_dir: window::scratch("soak-short"),
+        out_dir: out.to_path_buf(),
         ..SoakOptions::default()
     };
     match soak(&opts) {
@@ -109,7 +111,7 @@ fn a_failure_names_the_seed_and_its_shortest_failing_prefix_as_a_replay_script()
         check_every: 100,
         device: None,
         fail_at: Some(137),
-        out_dir: dir.clone(),
+        out_dir: dir.to_path_buf(),
         ..SoakOptions::default()
     };
     let f = soak(&opts).expect_err("event 137 fails on purpose");

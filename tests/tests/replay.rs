@@ -20,10 +20,9 @@ fn scripts() -> Vec<PathBuf> {
     all
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("voxbrick-replay-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+/// A scratch folder for this test, removed when it passes.
+fn scratch(name: &str) -> app::scratch::Scratch {
+    app::scratch::Scratch::new(&format!("replay-{name}"))
 }
 
 fn options(workers: usize, out: &Path) -> ReplayOptions {

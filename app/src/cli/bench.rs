@@ -365,10 +365,7 @@ fn bench(b: Bench, workers: usize) -> Result<String> {
         "editing": edits,
     });
     std::fs::create_dir_all(&b.out).with_context(|| format!("creating {}", b.out.display()))?;
-    let json_text = serde_json::to_string_pretty(&json)?;
-    app::atomic::write_atomic(&b.out.join("bench.json"), |w| {
-        w.write_all(json_text.as_bytes())
-    })?;
+    super::write_json(&b.out.join("bench.json"), &json)?;
 
     // Markdown.
     let scene_line = format!(
@@ -480,7 +477,7 @@ fn bench(b: Bench, workers: usize) -> Result<String> {
         }
         md += &table.finish();
     }
-    app::atomic::write_atomic(&b.out.join("bench.md"), |w| w.write_all(md.as_bytes()))?;
+    super::write_report(&b.out.join("bench.md"), &md)?;
 
     // Plots: frame time along the path, one per resolution (and the CPU's).
     for &size in &b.sizes {

@@ -565,13 +565,7 @@ fn report(b: &BenchSkips, ctx: &render::vulkan::GpuContext, rows: &[Row]) -> Res
         "device": ctx.name, "driver": ctx.driver, "clocks": super::bench::clocks(),
         "size": [b.size.0, b.size.1], "window": [b.window.0, b.window.1], "rows": rows,
     });
-    app::atomic::write_atomic(&b.out.join("skips.json"), |f| {
-        f.write_all(
-            serde_json::to_string_pretty(&json)
-                .map_err(std::io::Error::other)?
-                .as_bytes(),
-        )
-    })?;
-    app::atomic::write_atomic(&b.out.join("skips.md"), |f| f.write_all(md.as_bytes()))?;
+    super::write_json(&b.out.join("skips.json"), &json)?;
+    super::write_report(&b.out.join("skips.md"), &md)?;
     Ok(md)
 }

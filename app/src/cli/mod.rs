@@ -41,6 +41,18 @@ pub(crate) fn with_progress<T>(message: String, work: impl FnOnce() -> Result<T>
     out
 }
 
+/// Writes a report file (Markdown, CSV) atomically.
+pub(crate) fn write_report(path: &std::path::Path, text: &str) -> Result<()> {
+    Ok(app::atomic::write_atomic(path, |w| {
+        w.write_all(text.as_bytes())
+    })?)
+}
+
+/// Writes a report's JSON, pretty-printed, atomically.
+pub(crate) fn write_json(path: &std::path::Path, value: &serde_json::Value) -> Result<()> {
+    write_report(path, &serde_json::to_string_pretty(value)?)
+}
+
 /// Writes to stdout; a reader that went away (`voxbrick info f | head`) ends output quietly.
 pub(crate) fn emit(text: &str) -> Result<()> {
     use std::io::Write;

@@ -86,11 +86,8 @@ pub fn save_png(colours: &[[u8; 3]], path: &Path) -> Result<(), FormatError> {
 mod tests {
     use super::*;
 
-    fn temp(name: &str) -> std::path::PathBuf {
-        let d =
-            std::env::temp_dir().join(format!("voxbrick-palette-{}-{name}", std::process::id()));
-        std::fs::create_dir_all(&d).unwrap();
-        d
+    fn temp(name: &str) -> crate::scratch::Scratch {
+        crate::scratch::Scratch::new(&format!("palette-{name}"))
     }
 
     #[test]

@@ -348,9 +348,8 @@ pub fn places(document_folder: Option<&Path>, recent: &[PathBuf]) -> Vec<(String
 mod tests {
     use super::*;
 
-    fn folder(tag: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("voxbrick-browser-{}-{tag}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
+    fn folder(tag: &str) -> crate::scratch::Scratch {
+        let d = crate::scratch::Scratch::new(&format!("browser-{tag}"));
         std::fs::create_dir_all(d.join("sub")).unwrap();
         for f in ["b.ron", "a.vox", "notes.txt", ".hidden.ron"] {
             std::fs::write(d.join(f), "x").unwrap();
@@ -361,13 +360,13 @@ mod tests {
     #[test]
     fn a_folder_lists_subfolders_then_the_purposes_files() {
         let d = folder("list");
-        let mut b = Browser::new(Purpose::Open, Some(d.clone()), None);
+        let mut b = Browser::new(Purpose::Open, Some(d.to_path_buf()), None);
         let names: Vec<&str> = b.entries.iter().map(|(n, _)| n.as_str()).collect();
         assert_eq!(names, ["sub", "a.vox", "b.ron"]);
         b.all_files = true;
         b.read_folder();
         assert_eq!(b.entries.len(), 4, "notes.txt too, never the hidden file");
-        let b = Browser::new(Purpose::Import, Some(d), None);
+        let b = Browser::new(Purpose::Import, Some(d.to_path_buf()), None);
         let names: Vec<&str> = b.entries.iter().map(|(n, _)| n.as_str()).collect();
         assert_eq!(names, ["sub", "a.vox"]);
     }
@@ -375,7 +374,7 @@ mod tests {
     #[test]
     fn the_name_field_takes_a_name_a_path_or_a_folder() {
         let d = folder("name");
-        let mut b = Browser::new(Purpose::SaveAs, Some(d.clone()), Some("new".into()));
+        let mut b = Browser::new(Purpose::SaveAs, Some(d.to_path_buf()), Some("new".into()));
         assert_eq!(
             b.target(),
             Some(d.join("new.ron")),
@@ -398,7 +397,11 @@ mod tests {
         assert_eq!(b.confirm_name(), Answer::Open);
         assert!(b.error.as_deref().is_some_and(|e| e.contains("no folder")));
         // Opening needs an existing file.
-        let mut o = Browser::new(Purpose::Open, Some(d.clone()), Some("missing.ron".into()));
+        let mut o = Browser::new(
+            Purpose::Open,
+            Some(d.to_path_buf()),
+            Some("missing.ron".into()),
+        );
         assert_eq!(o.confirm_name(), Answer::Open);
         o.name = "b.ron".into();
         assert_eq!(o.confirm_name(), Answer::Chosen(d.join("b.ron")));

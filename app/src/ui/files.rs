@@ -357,11 +357,8 @@ mod tests {
     use crate::editor::history::History;
     use brickmap::GridDims;
 
-    fn temp(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("voxbrick-ui-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        d
+    fn temp(name: &str) -> crate::scratch::Scratch {
+        crate::scratch::Scratch::new(&format!("ui-{name}"))
     }
 
     fn doc() -> SharedDocument {
@@ -383,7 +380,8 @@ mod tests {
 
     #[test]
     fn recent_files_are_newest_first_without_duplicates() {
-        let dir = ConfigDir(temp("recent"));
+        let scratch = temp("recent");
+        let dir = ConfigDir(scratch.to_path_buf());
         assert!(dir.recent().is_empty());
         for n in ["a.ron", "b.ron", "a.ron"] {
             dir.add_recent(&dir.0.join(n)).unwrap();
@@ -399,7 +397,8 @@ mod tests {
     #[test]
     fn view_settings_round_trip_and_a_broken_file_is_an_error_not_a_reset() {
         use crate::ui::panels::ViewSettings;
-        let dir = ConfigDir(temp("settings").join("config"));
+        let scratch = temp("settings");
+        let dir = ConfigDir(scratch.join("config"));
         assert_eq!(
             dir.settings::<ViewSettings>().unwrap(),
             ViewSettings::default()
@@ -443,7 +442,8 @@ mod tests {
 
     #[test]
     fn recovery_is_written_offered_and_removed_and_a_save_cleans_the_document() {
-        let dir = ConfigDir(temp("recovery").join("config"));
+        let scratch = temp("recovery");
+        let dir = ConfigDir(scratch.join("config"));
         let d = doc();
         d.write().unwrap().execute(Command::Clear).unwrap();
         let mut w = FileWorker::new(Arc::new(|| {}));

@@ -362,8 +362,7 @@ mod tests {
         assert_eq!(hash(), before);
         assert_eq!(d.read().unwrap().history.undo_len(), 0);
         assert!(!d.read().unwrap().dirty);
-        let dir = std::env::temp_dir().join(format!("voxbrick-jobs-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::scratch::Scratch::new("jobs");
         let vox = dir.join("one.vox");
         let mut scene = Scene::empty(GridDims::new(1, 1, 1).unwrap(), 1).unwrap();
         sphere(2.0).apply(&mut scene, &dir).unwrap();

@@ -100,11 +100,9 @@ impl Drop for Xvfb {
     }
 }
 
-pub fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("voxbrick-window-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A scratch folder for this test, removed when it passes.
+pub fn scratch(name: &str) -> app::scratch::Scratch {
+    app::scratch::Scratch::new(&format!("window-{name}"))
 }
 
 pub fn read_png(path: &Path) -> (u32, u32, Vec<u8>) {

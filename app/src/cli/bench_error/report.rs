@@ -202,15 +202,9 @@ pub(super) fn report(
         "rel_mse_epsilon": render::convergence::REL_MSE_EPSILON, "z_max": Z_MAX,
         "cases": runs,
     });
-    app::atomic::write_atomic(&b.out.join("error.json"), |f| {
-        f.write_all(
-            serde_json::to_string_pretty(&json)
-                .map_err(std::io::Error::other)?
-                .as_bytes(),
-        )
-    })?;
-    app::atomic::write_atomic(&b.out.join("error.csv"), |f| f.write_all(csv.as_bytes()))?;
-    app::atomic::write_atomic(&b.out.join("error.md"), |f| f.write_all(md.as_bytes()))?;
+    crate::cli::write_json(&b.out.join("error.json"), &json)?;
+    crate::cli::write_report(&b.out.join("error.csv"), &csv)?;
+    crate::cli::write_report(&b.out.join("error.md"), &md)?;
     if !failed.is_empty() {
         bail!(
             "{} check(s) failed (a bias; report in {}): {}",
