@@ -408,7 +408,7 @@ impl Editor {
         // (Refinement that waits for the UI is not: the end of the wait wakes the loop.)
         let busy = (gfx.viewport.samples() < self.settings.target_spp && !ui_first)
             || moving
-            || !self.flying.is_empty()
+            || self.flight.is_flying()
             || self.script.is_some()
             || !self.files.running.is_empty()
             || self.edits.busy()

@@ -102,10 +102,10 @@ impl Editor {
 
     fn key(&mut self, code: KeyCode, pressed: bool, repeat: bool, consumed: bool) {
         if !pressed {
-            if self.flying.contains(&code) {
+            if self.flight.holds(code) {
                 // The flight lasts until the release, not until the last frame before it.
                 self.tick_fly();
-                self.flying.remove(&code);
+                self.flight.release(code);
             }
             return;
         }
@@ -126,14 +126,11 @@ impl Editor {
                 self.action(a);
             }
         } else if !self.mods.ctrl && input::fly_axis(code).is_some() {
-            // Keys already held fly until now in their old direction; a first key starts
-            // the clock.
-            if self.flying.is_empty() {
-                self.last_tick = Instant::now();
-            } else {
+            // Keys already held fly until now in their old direction.
+            if self.flight.is_flying() {
                 self.tick_fly();
             }
-            self.flying.insert(code);
+            self.flight.press(code);
             self.moved();
         }
     }
@@ -332,23 +329,13 @@ impl Editor {
         self.moved();
     }
 
-    /// Held movement keys move the camera by the time since the last tick (a key's press,
-    /// a frame, a release): the same distance per second at any frame rate. A headless
-    /// editor moves 1/60 s per tick, so that its session is a function of its input.
+    /// Held movement keys move the camera by the time since the last tick ([`flight`]):
+    /// half the view distance per second (Shift: twice it), at least 8 voxels' worth.
     pub(super) fn tick_fly(&mut self) {
-        let now = Instant::now();
-        let dt = if self.headless && !self.fly_real_time {
-            1.0 / 60.0
-        } else {
-            (now - self.last_tick).as_secs_f64()
-        };
-        self.last_tick = now;
-        if self.flying.is_empty() {
-            return;
-        }
-        let dir: DVec3 = self.flying.iter().filter_map(|k| input::fly_axis(*k)).sum();
         let speed = self.view.distance.max(8.0) * if self.mods.shift { 2.0 } else { 0.5 };
-        self.view.fly(dir * speed * dt);
-        self.moved();
+        if let Some(step) = self.flight.step(speed) {
+            self.view.fly(step);
+            self.moved();
+        }
     }
 }

@@ -224,7 +224,7 @@ impl Editor {
 
     /// Fly keys move by the time that passed, as in a window (not 1/60 s per tick).
     pub fn fly_in_real_time(&mut self) {
-        self.fly_real_time = true;
+        self.flight.in_real_time();
     }
 
     /// The view camera.

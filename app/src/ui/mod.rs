@@ -24,6 +24,7 @@ mod document;
 mod editing;
 pub mod event;
 pub mod files;
+mod flight;
 mod frame;
 mod handle;
 mod headless;
@@ -60,7 +61,6 @@ use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use render::present::{EguiFrame, Presented, Presenter};
 use render::viewport::{FrameRequest, Viewport};
 use render::vulkan::{ContextOptions, GpuContext, WindowHandles};
-use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, RwLock};
 use std::time::{Duration, Instant};
@@ -217,8 +217,8 @@ pub struct Editor {
     /// When pointer or key input last went to the UI (a panel, a menu, a window): for
     /// [`frame::UI_FIRST`] after it, refinement waits and frames are the UI's.
     ui_touched: Option<Instant>,
-    flying: HashSet<KeyCode>,
-    last_tick: Instant,
+    /// Fly keys held and their clock.
+    flight: flight::Flight,
     moving_until: Instant,
     /// Samples per frame and the traced resolution's scale, from the GPU time per frame.
     budget: budget::FrameBudget,
@@ -267,8 +267,6 @@ pub struct Editor {
     /// No window: frames are drawn offscreen, no native dialog is shown, fly keys move the
     /// camera a fixed 1/60 s per frame (a headless session is a function of its input).
     headless: bool,
-    /// Fly keys move by the time that passed even without a window (tests of the fly speed).
-    fly_real_time: bool,
     /// The editor asked to stop (the window loop exits; a headless driver is told).
     exit: bool,
     /// Files opened since the recording started (each copied beside it).
@@ -356,8 +354,7 @@ impl Editor {
             drag: None,
             cursor: (0.0, 0.0),
             ui_touched: None,
-            flying: HashSet::new(),
-            last_tick: Instant::now(),
+            flight: flight::Flight::new(headless),
             moving_until: Instant::now(),
             budget: Default::default(),
             last_added: 0,
@@ -388,7 +385,6 @@ impl Editor {
             script: script_run,
             options,
             headless,
-            fly_real_time: false,
             exit: false,
             recorded_opens: 0,
             ended_recording: None,
