@@ -190,7 +190,7 @@ impl Editor {
                 ""
             },
             gfx.viewport.ctx().name,
-            self.latency.map_or_else(String::new, |l| format!(
+            self.motion.latency().map_or_else(String::new, |l| format!(
                 " · input to photon {:.1} ms",
                 l.as_secs_f64() * 1e3
             )),
@@ -311,7 +311,7 @@ impl Editor {
         let primitives = egui_ctx.tessellate(shapes, pixels_per_point);
         // While the camera moves and while a stroke is drawn: the moving scale, so each
         // change shows in the next, cheaper frame.
-        let moving = Instant::now() < self.moving_until || self.drawing.is_some();
+        let moving = self.motion.is_moving() || self.drawing.is_some();
         let still = internal;
         let internal = if moving {
             self.budgeted(scaled(
@@ -375,9 +375,7 @@ impl Editor {
                     self.frames,
                     gfx.viewport.samples()
                 ));
-                if let Some(t) = self.move_event.take() {
-                    self.latency = Some(t.elapsed());
-                }
+                self.motion.shown();
                 // The budget reasons about the still image: a moving frame's time is scaled
                 // by the pixels it left out.
                 let ratio = (f64::from(still.0) * f64::from(still.1))

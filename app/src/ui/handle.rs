@@ -172,7 +172,7 @@ impl Editor {
                 self.drawing = None;
                 self.edits.submit(&self.doc, Edit::StrokeEnd);
                 // Back to the full internal size shortly after, as after a move.
-                self.moving_until = Instant::now() + Duration::from_millis(150);
+                self.motion.settling();
             }
             (false, MouseButton::Left) if self.selecting.is_some() => self.select_release(),
             (true, _) if free => {

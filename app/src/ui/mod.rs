@@ -33,6 +33,7 @@ pub mod input;
 mod intent;
 pub mod jobs;
 pub mod keymap;
+mod motion;
 pub mod panels;
 mod preview;
 pub mod purpose;
@@ -219,7 +220,8 @@ pub struct Editor {
     ui_touched: Option<Instant>,
     /// Fly keys held and their clock.
     flight: flight::Flight,
-    moving_until: Instant,
+    /// The view in motion (the moving scale) and input to photon.
+    motion: motion::Motion,
     /// Samples per frame and the traced resolution's scale, from the GPU time per frame.
     budget: budget::FrameBudget,
     /// Samples per pixel the last shown frame added (0 once converged).
@@ -237,10 +239,6 @@ pub struct Editor {
     recovering: bool,
     quitting: bool,
     outcome: Result<()>,
-    /// Input event time of the latest camera move not yet on screen (input-to-photon).
-    move_event: Option<Instant>,
-    /// Frames and time of the latest move's first frame (for the status line).
-    latency: Option<Duration>,
     /// Frames drawn.
     frames: u64,
     /// Which keys do what (keys.ron).
@@ -355,7 +353,7 @@ impl Editor {
             cursor: (0.0, 0.0),
             ui_touched: None,
             flight: flight::Flight::new(headless),
-            moving_until: Instant::now(),
+            motion: motion::Motion::new(),
             budget: Default::default(),
             last_added: 0,
             pending: None,
@@ -367,8 +365,6 @@ impl Editor {
             recovering: false,
             quitting: false,
             outcome: Ok(()),
-            move_event: None,
-            latency: None,
             frames: 0,
             keymap: Default::default(),
             window_size: (16, 9),
@@ -430,8 +426,7 @@ impl Editor {
     }
 
     fn moved(&mut self) {
-        self.moving_until = Instant::now() + Duration::from_millis(150);
-        self.move_event.get_or_insert_with(Instant::now);
+        self.motion.moved();
         self.request_redraw();
     }
 
