@@ -13,7 +13,7 @@ impl Editor {
     /// Ctrl+S saves the undone scene).
     pub(super) fn save_to(&mut self, path: PathBuf, autosave: bool) {
         if self.edits.busy() {
-            self.saves_waiting.push((path, autosave));
+            self.saves.defer(path, autosave);
         } else {
             self.files.save(&self.doc, path, autosave);
         }
@@ -22,17 +22,7 @@ impl Editor {
     /// Applies finished saves' bookkeeping (file, clean flag) to the document, unless
     /// another save is reading it right now (then next frame: the UI never waits).
     pub(super) fn mark_saved(&mut self) {
-        if self.saved.is_empty() {
-            return;
-        }
-        let mut d = match self.doc.try_write() {
-            Ok(d) => d,
-            Err(std::sync::TryLockError::Poisoned(p)) => p.into_inner(),
-            Err(std::sync::TryLockError::WouldBlock) => return,
-        };
-        for (path, revision) in self.saved.drain(..) {
-            d.mark_saved(&path, revision);
-        }
+        self.saves.mark_saved(&self.doc);
     }
 
     /// Queues a command on the edit thread (the UI never waits for the world's workers).
@@ -358,7 +348,7 @@ impl Editor {
                 Ok(()) => {
                     self.report.line(format_args!("saved {}", path.display()));
                     self.panels.notify(format!("Saved {}", path.display()));
-                    self.saved.push((path.clone(), revision));
+                    self.saves.finished(path.clone(), revision);
                     self.mark_saved();
                     let _ = self.config.add_recent(&path);
                     self.panels.recent = self.config.recent();
@@ -375,14 +365,9 @@ impl Editor {
     }
 
     pub(super) fn autosave(&mut self) {
-        let secs = self.settings.autosave_secs;
-        if secs == 0
-            || self.script.is_some()
-            || self.last_autosave.elapsed() < Duration::from_secs(secs)
-        {
+        if self.script.is_some() || !self.saves.autosave_due(self.settings.autosave_secs) {
             return;
         }
-        self.last_autosave = Instant::now();
         if self.read().dirty {
             let recovery = self.config.recovery_file();
             self.save_to(recovery, true);

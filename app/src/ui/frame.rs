@@ -129,7 +129,7 @@ impl Editor {
             self.edited(edited);
         }
         if !self.edits.busy() {
-            for (path, autosave) in std::mem::take(&mut self.saves_waiting) {
+            for (path, autosave) in self.saves.take_waiting() {
                 self.files.save(&self.doc, path, autosave);
             }
         }
@@ -410,8 +410,7 @@ impl Editor {
             || self.script.is_some()
             || !self.files.running.is_empty()
             || self.edits.busy()
-            || !self.saves_waiting.is_empty()
-            || !self.saved.is_empty()
+            || !self.saves.settled()
             || viewport_output.values().any(|v| v.repaint_delay.is_zero());
         if busy {
             gfx.host.request_redraw();

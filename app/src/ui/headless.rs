@@ -93,8 +93,7 @@ impl Editor {
     pub fn settled(&self) -> bool {
         !self.edits.busy()
             && self.files.running.is_empty()
-            && self.saves_waiting.is_empty()
-            && self.saved.is_empty()
+            && self.saves.settled()
             && self.backlog.is_empty()
     }
 

@@ -38,6 +38,7 @@ pub mod panels;
 mod preview;
 pub mod purpose;
 pub mod report;
+mod saves;
 mod selecting;
 mod swatch;
 pub mod tools;
@@ -204,10 +205,8 @@ pub struct Editor {
     /// Input that arrived while an edit held the frame gate (and whether egui kept it),
     /// handled in order once it is free: a keystroke during a long undo is late, never lost.
     backlog: Vec<(Input, bool)>,
-    /// Saves asked for while edits were queued: they start once those are applied.
-    saves_waiting: Vec<(PathBuf, bool)>,
-    /// Finished saves (file, revision written) whose bookkeeping is not yet on the document.
-    saved: Vec<(PathBuf, u64)>,
+    /// Saves waiting for queued edits, finished saves to record, the autosave clock.
+    saves: saves::Saves,
     view: ViewCamera,
     slots: [Option<ViewCamera>; 9],
     settings: ViewSettings,
@@ -228,7 +227,6 @@ pub struct Editor {
     last_added: u32,
     pending: Option<Pending>,
     save_then: Option<Pending>,
-    last_autosave: Instant,
     script: Option<LiveScript>,
     /// A built scene (the default one, or New) is on its way: a `Loaded` without a path replaces
     /// the document only then.
@@ -344,8 +342,7 @@ impl Editor {
             files,
             edits,
             backlog: Vec::new(),
-            saves_waiting: Vec::new(),
-            saved: Vec::new(),
+            saves: saves::Saves::new(),
             view,
             slots: Default::default(),
             mods: Mods::default(),
@@ -358,7 +355,6 @@ impl Editor {
             last_added: 0,
             pending: None,
             save_then: None,
-            last_autosave: Instant::now(),
             awaiting_built_scene: false,
             pending_textures: Default::default(),
             title: String::new(),
@@ -560,8 +556,8 @@ impl ApplicationHandler<Wake> for Editor {
             return;
         }
         let mut wake: Option<Instant> = None;
-        if self.settings.autosave_secs > 0 && self.script.is_none() {
-            wake = Some(self.last_autosave + Duration::from_secs(self.settings.autosave_secs));
+        if self.script.is_none() {
+            wake = self.saves.next_autosave(self.settings.autosave_secs);
         }
         // Refinement resumes when the UI has been left alone for `UI_FIRST`.
         if let Some(t) = self.ui_touched {
