@@ -28,14 +28,17 @@ pub(crate) fn resolution(s: &str) -> Result<(u32, u32), String> {
     }
 }
 
-/// An integer offset, X,Y,Z.
-pub(crate) fn ivec3(s: &str) -> Result<IVec3, String> {
-    let v: Vec<i32> = s
-        .split(',')
+/// The integers of `s` between `sep`s.
+fn ints(s: &str, sep: char) -> Result<Vec<i32>, String> {
+    s.split(sep)
         .map(|p| p.trim().parse::<i32>())
         .collect::<Result<_, _>>()
-        .map_err(|e| format!("{s:?}: {e}"))?;
-    match v[..] {
+        .map_err(|e| format!("{s:?}: {e}"))
+}
+
+/// An integer offset, X,Y,Z.
+pub(crate) fn ivec3(s: &str) -> Result<IVec3, String> {
+    match ints(s, ',')?[..] {
         [x, y, z] => Ok(IVec3::new(x, y, z)),
         _ => Err(format!("{s:?}: expected three integers X,Y,Z")),
     }
@@ -43,12 +46,7 @@ pub(crate) fn ivec3(s: &str) -> Result<IVec3, String> {
 
 /// A grid size in voxels, WxHxD, each positive.
 pub(crate) fn grid_size(s: &str) -> Result<IVec3, String> {
-    let v: Vec<i32> = s
-        .split('x')
-        .map(|p| p.trim().parse::<i32>())
-        .collect::<Result<_, _>>()
-        .map_err(|e| format!("{s:?}: {e}"))?;
-    match v[..] {
+    match ints(s, 'x')?[..] {
         [x, y, z] if x > 0 && y > 0 && z > 0 => Ok(IVec3::new(x, y, z)),
         _ => Err(format!("{s:?}: expected three positive integers WxHxD")),
     }
