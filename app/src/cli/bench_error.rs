@@ -339,7 +339,7 @@ fn measure(
                 (r.denoised, r.trace_seconds.map(|t| t + f))
             } else {
                 let r = session.render(view, params, &job, RenderHow::variant(variant))?;
-                (r.image, r.gpu_ms)
+                (r.image, r.gpu_seconds)
             };
             times.push(t.context("this queue cannot take timestamps")? * 1e3);
             errors.push(rel_mse(&image, reference).context("image sizes differ")? - noise);
@@ -561,11 +561,11 @@ fn bench_error(b: BenchError, workers: usize) -> Result<String> {
             let how = RenderHow::variant(v);
             let (a, ta) = {
                 let r = session.render(&view, &params, &half(1), how)?;
-                (r.image, r.gpu_ms)
+                (r.image, r.gpu_seconds)
             };
             let (c, tc) = {
                 let r = session.render(&view, &params, &half(2), how)?;
-                (r.image, r.gpu_ms)
+                (r.image, r.gpu_seconds)
             };
             let noise = reference_noise(&a, &c).context("image sizes differ")?;
             let reference = average(&a, &c);

@@ -224,7 +224,7 @@ pub(crate) fn convergence_table(
         format!("reference: {width}x{height} at {reference_spp} spp"),
         || {
             let r = session.render(view, params, &job(reference_spp, 1), RenderHow::SCENE)?;
-            Ok((r.image, r.gpu_ms))
+            Ok((r.image, r.gpu_seconds))
         },
     )?;
     let Some(reference_time) = reference_time else {
@@ -236,7 +236,7 @@ pub(crate) fn convergence_table(
         let (mut times, mut mse) = (Vec::new(), 0.0);
         for seed in 2..5 {
             let r = session.render(view, params, &job(spp, seed), RenderHow::SCENE)?;
-            times.push(r.gpu_ms.unwrap_or(f64::NAN));
+            times.push(r.gpu_seconds.unwrap_or(f64::NAN));
             mse += r.image.mse(&reference).context("image sizes differ")? / 3.0;
         }
         times.sort_by(f64::total_cmp);

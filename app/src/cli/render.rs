@@ -203,7 +203,7 @@ pub(crate) fn render_on(
         )?;
         let (image, gpu, rays) = (
             rendered.image,
-            rendered.gpu_ms,
+            rendered.gpu_seconds,
             rendered.rays.expect("counted"),
         );
         let timing = match gpu {

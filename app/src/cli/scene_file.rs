@@ -78,15 +78,20 @@ pub(crate) fn new(a: NewArgs, workers: usize) -> Result<()> {
         Ok(scene)
     })?;
     let generated = started.elapsed().as_secs_f64();
-    with_progress(format!("writing {}", a.output.display()), || {
-        Ok(scene.save(&a.output)?)
-    })?;
+    save(&scene, &a.output)?;
     eprintln!(
         "generated in {generated:.2} s, wrote {} in {:.2} s total",
         a.output.display(),
         started.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// Writes `scene` to `path` (atomically, as every save), with a spinner.
+fn save(scene: &Scene, path: &std::path::Path) -> Result<()> {
+    with_progress(format!("writing {}", path.display()), || {
+        Ok(scene.save(path)?)
+    })
 }
 
 /// `voxbrick convert`: between project (.ron) and MagicaVoxel (.vox) files.
@@ -128,9 +133,7 @@ pub(crate) fn convert(a: ConvertArgs, workers: usize) -> Result<()> {
             }
         },
     )?;
-    with_progress(format!("writing {}", a.output.display()), || {
-        Ok(scene.save(&a.output)?)
-    })?;
+    save(&scene, &a.output)?;
     eprintln!(
         "wrote {} in {:.2} s",
         a.output.display(),

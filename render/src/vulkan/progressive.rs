@@ -10,8 +10,8 @@
 //! asked) and restarts when the image key (every trace parameter + variant) changes or the
 //! world changed; `record_batch` is the interactive frame's one dispatch (never past the
 //! target); `display` = mean → bilinear upscale to the output resolution → exposure → ACES →
-//! sRGB (exposure does not restart); `hdr` reads the mean. The one-shot `PathTracer::render*`
-//! live here too, so trace.rs does not import the accumulation.
+//! sRGB (exposure does not restart); `hdr` reads the mean. The one-shot `PathTracer::render`
+//! (as `RenderHow` says) lives here too, so trace.rs does not import the accumulation.
 
 use super::buffer::{Binding, HostBuffer, read_device};
 use super::pass::SetCache;
@@ -421,9 +421,9 @@ impl RenderHow {
 pub struct Rendered {
     /// The linear image.
     pub image: Image,
-    /// GPU time spent, ms (timestamp queries summed over the dispatches; None when the
-    /// queue cannot time).
-    pub gpu_ms: Option<f64>,
+    /// GPU time spent, seconds (timestamp queries summed over the dispatches; None when
+    /// the queue cannot time).
+    pub gpu_seconds: Option<f64>,
     /// Rays traced by kind, when counted.
     pub rays: Option<RayCounts>,
 }
@@ -460,10 +460,10 @@ impl PathTracer {
             .accumulate(ctx, self, world, view, params, variant, job.spp)
             .and_then(|(gpu, _)| acc.hdr(ctx).map(|img| (img, gpu)));
         acc.destroy(ctx);
-        let (image, gpu_ms) = result?;
+        let (image, gpu_seconds) = result?;
         Ok(Rendered {
             image,
-            gpu_ms,
+            gpu_seconds,
             rays: how.count_rays.then(|| self.read_counters()),
         })
     }

@@ -9,7 +9,7 @@
 //! material kinds from the table, sun, gradient sky, bounce count, ray counting, experiments,
 //! `lights`: light sampling of emissive voxels, on when the world has light faces; `Variant {
 //! lights: false, .. }` is the BSDF-only estimator) with a per-tracer pipeline cache (the
-//! one-shot `PathTracer::render*` are in `progressive.rs`). A dispatch runs `image[2]` samples
+//! one-shot `PathTracer::render` is in `progressive.rs`). A dispatch runs `image[2]` samples
 //! per invocation in `slices` invocations per pixel (workgroup z): an image below
 //! `FULL_DISPATCH` (1.2 Mpixel) is split up to `MAX_SLICES` = 8 ways with `SLICED_SAMPLES` = 4
 //! each, by trace.comp's second module (`SAMPLE_SLICES` defined by build.rs: its invocations
