@@ -61,7 +61,7 @@ impl Editor {
             Action::Cut => self.execute(Command::Cut),
             // The copy is on the document once queued edits (a copy just asked for) ran;
             // until then the placement shows nothing and a click pastes nothing.
-            Action::Paste => self.pasting = true,
+            Action::Paste => self.pointer.pasting = true,
             Action::Nudge(n) => self.nudge(n),
             Action::Help => self.panels.help_open = !self.panels.help_open,
             Action::Quit => self.guard_unsaved(Pending::Quit),
@@ -112,17 +112,17 @@ impl Editor {
                 self.guard_unsaved(Pending::New { size, terrain })
             }
             UiEvent::Picked(purpose, path) => self.picked(purpose, path),
-            UiEvent::PickCancelled => self.save_then = None,
+            UiEvent::PickCancelled => self.waits.save_abandoned(),
             UiEvent::Unsaved(answer) => {
                 self.panels.asking_unsaved = false;
-                let Some(then) = self.pending.take() else {
+                let Some(then) = self.waits.answered() else {
                     return;
                 };
                 match answer {
                     UnsavedAnswer::Cancel => {}
                     UnsavedAnswer::Discard => self.proceed(then),
                     UnsavedAnswer::Save => {
-                        self.save_then = Some(then);
+                        self.waits.after_save(then);
                         self.save(false);
                     }
                 }
@@ -130,9 +130,8 @@ impl Editor {
             UiEvent::Recover(yes) => {
                 if let Some(p) = self.panels.recovery.take() {
                     if yes {
-                        self.awaiting_built_scene = false;
+                        self.waits.recovering();
                         self.files.load(p, self.options.workers);
-                        self.recovering = true;
                     } else {
                         self.config.remove_recovery();
                     }

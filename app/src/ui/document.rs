@@ -65,7 +65,7 @@ impl Editor {
             Edited::Stroke(Err(e)) => {
                 self.report.line(format_args!("edited stroke: error {e}"));
                 // The stroke is undone and closed: stop sending it segments.
-                self.drawing = None;
+                self.pointer.drawing = None;
                 self.panels.errors.push(format!("stroke: {e}"));
             }
             Edited::ScriptStep {
@@ -116,8 +116,7 @@ impl Editor {
     pub(super) fn replace_document(&mut self, mut scene: Scene, path: Option<PathBuf>) {
         // The clipboard outlives the document: copy in one scene, paste in the next.
         scene.clipboard = self.read().scene.clipboard.clone();
-        self.pasting = false;
-        self.selecting = None;
+        self.pointer.cancel_placing();
         let mut doc = Document::new(scene, History::with_budget(DEFAULT_BUDGET));
         doc.folder = path
             .as_ref()
@@ -131,7 +130,7 @@ impl Editor {
             let _ = self.config.add_recent(p);
             self.panels.recent = self.config.recent();
         }
-        if self.options.record.is_some() {
+        if self.recording.on() {
             doc.recorder = self.carry_recording(path.as_deref());
         }
         doc.path = path.filter(|_| is_project);
@@ -142,55 +141,29 @@ impl Editor {
         self.refresh_stats();
     }
 
-    /// The recording for the next document: new for the first (it starts from the file the
-    /// recording was asked for); for a file opened later, the session's recording goes on
-    /// with an `Open` step of a copy made beside it now (later saves may overwrite the
-    /// file); a built scene has no step that replays it, so the recording ends there (and is
-    /// what is written at exit).
+    /// The recorder for the next document (see [`recording::Recording::carry`]).
     fn carry_recording(&mut self, path: Option<&Path>) -> Option<script::Recorder> {
-        if self.generation == 0 {
-            return Some(script::Recorder::default());
-        }
-        let mut recorder = self
-            .doc
-            .write()
-            .unwrap_or_else(|p| p.into_inner())
-            .recorder
-            .take()?;
-        let (Some(path), Some(out)) = (path, self.options.record.clone()) else {
-            self.ended_recording = Some(recorder);
-            return None;
-        };
-        self.recorded_opens += 1;
-        let copy = recording_copy(&out, path, &format!("open-{}", self.recorded_opens));
-        if let Err(e) = std::fs::copy(path, &copy) {
-            self.panels.errors.push(format!(
-                "--record: copying {} to {}: {e}; the recording ends here",
-                path.display(),
-                copy.display()
-            ));
-            self.ended_recording = Some(recorder);
-            return None;
-        }
-        let name = copy.file_name().map(|n| n.to_string_lossy().into_owned());
-        recorder.record(script::Step::Open(name.unwrap_or_default()));
-        Some(recorder)
+        let previous = (self.generation > 0).then(|| {
+            let mut doc = self.doc.write().unwrap_or_else(|p| p.into_inner());
+            doc.recorder.take()
+        });
+        self.recording
+            .carry(previous, path)
+            .unwrap_or_else(|message| {
+                self.panels.errors.push(message);
+                None
+            })
     }
 
     /// The session's recording so far (the document's, or the one a built scene ended).
     pub(super) fn recording_text(&self) -> Option<String> {
-        let (out, file) = (self.options.record.as_ref()?, self.options.file.as_ref()?);
-        let doc = self.read();
-        let recorder = doc.recorder.as_ref().or(self.ended_recording.as_ref())?;
-        let start = recording_copy(out, file, "start");
-        let name = start.file_name().map(|n| n.to_string_lossy().into_owned());
-        Some(recorder.to_ron(script::Start::File(name.unwrap_or_default()), None))
+        self.recording.text(self.read().recorder.as_ref())
     }
 
     /// Runs `then` now, or asks about unsaved changes first.
     pub(super) fn guard_unsaved(&mut self, then: Pending) {
         if self.read().dirty && self.script.is_none() {
-            self.pending = Some(then);
+            self.waits.ask(then);
             self.panels.asking_unsaved = true;
         } else {
             self.proceed(then);
@@ -208,7 +181,7 @@ impl Editor {
 
     pub(super) fn new_scene(&mut self, size: (u32, u32, u32), terrain: bool) {
         // Built on a worker; it replaces the document like a default-scene build.
-        self.awaiting_built_scene = true;
+        self.waits.building();
         self.files.build_new(size, terrain, self.options.workers);
     }
 
@@ -282,7 +255,7 @@ impl Editor {
                 .panels
                 .errors
                 .push(format!("writing {}: {e:#}", path.display())),
-            Done::Picked(_, None) => self.save_then = None,
+            Done::Picked(_, None) => self.waits.save_abandoned(),
             // No native dialog: the in-app browser asks (nothing is written meanwhile).
             Done::NoDialog {
                 purpose,
@@ -303,15 +276,10 @@ impl Editor {
             }
             Done::Loaded(path, loaded) => match *loaded {
                 Ok(scene) => {
-                    if self.awaiting_built_scene && path.is_some() {
-                        // A file opened while the default scene was building wins.
-                        self.awaiting_built_scene = false;
-                    }
-                    if path.is_none() && !self.awaiting_built_scene {
+                    // A file opened while the default scene was building wins.
+                    let Some(recovered) = self.waits.arrived(path.is_some()) else {
                         return;
-                    }
-                    self.awaiting_built_scene = false;
-                    let recovered = std::mem::take(&mut self.recovering);
+                    };
                     if self.report.on() {
                         let what = match (&path, recovered) {
                             (Some(_), true) => "recovery".to_string(),
@@ -331,7 +299,7 @@ impl Editor {
                     }
                 }
                 Err(e) => {
-                    self.awaiting_built_scene = false;
+                    self.waits.load_failed();
                     self.panels.errors.push(format!("{e:#}"));
                 }
             },
@@ -352,12 +320,12 @@ impl Editor {
                     self.mark_saved();
                     let _ = self.config.add_recent(&path);
                     self.panels.recent = self.config.recent();
-                    if let Some(then) = self.save_then.take() {
+                    if let Some(then) = self.waits.saved() {
                         self.proceed(then);
                     }
                 }
                 Err(e) => {
-                    self.save_then = None;
+                    self.waits.save_abandoned();
                     self.panels.errors.push(format!("{e:#}"));
                 }
             },
@@ -436,17 +404,7 @@ impl Editor {
 
     /// With `--record`: the session's script, starting from the file opened (atomic write).
     pub(super) fn write_recording(&mut self) -> Result<()> {
-        let Some(out) = self.options.record.clone() else {
-            return Ok(());
-        };
-        if self.options.file.is_none() {
-            return Ok(());
-        }
-        let Some(text) = self.recording_text() else {
-            anyhow::bail!("--record: the file was not opened, so nothing was recorded");
-        };
-        crate::atomic::write_atomic(&out, |w| w.write_all(text.as_bytes()))
-            .with_context(|| format!("writing the recording {}", out.display()))
+        self.recording.write(self.read().recorder.as_ref())
     }
 }
 

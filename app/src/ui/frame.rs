@@ -17,6 +17,37 @@
 
 use super::*;
 
+/// The frames' own state.
+pub(super) struct Frames {
+    /// Frames drawn.
+    pub(super) count: u64,
+    /// Samples per pixel the last shown frame added (0 once converged).
+    pub(super) last_added: u32,
+    /// Samples per frame and the traced resolution's scale, from the GPU time per frame.
+    pub(super) budget: budget::FrameBudget,
+    /// egui's texture changes, kept until a frame with the UI applies them.
+    pub(super) textures: egui::TexturesDelta,
+    /// Tests only: the frame that fails as if the device were lost
+    /// (`VOXBRICK_TEST_GPU_FAILURE_AT_FRAME`), to check nothing is lost when the GPU fails.
+    #[cfg(feature = "test-hooks")]
+    pub(super) fail_at: Option<u64>,
+}
+
+impl Frames {
+    pub(super) fn new() -> Self {
+        Self {
+            count: 0,
+            last_added: 0,
+            budget: Default::default(),
+            textures: Default::default(),
+            #[cfg(feature = "test-hooks")]
+            fail_at: std::env::var("VOXBRICK_TEST_GPU_FAILURE_AT_FRAME")
+                .ok()
+                .and_then(|v| v.parse().ok()),
+        }
+    }
+}
+
 /// How long after pointer or key input on the UI refinement waits (frames are the UI's).
 pub(super) const UI_FIRST: Duration = Duration::from_millis(350);
 
@@ -81,11 +112,12 @@ impl Editor {
             let view = doc.scene.world.read();
             Viewport::new(ctx, &view)?
         };
-        self.gpu_generation = self.generation;
         self.gfx = Some(Gfx {
             presenter,
             viewport,
             host,
+            generation: self.generation,
+            title: String::new(),
         });
         self.refresh_stats();
         Ok(())
@@ -99,11 +131,7 @@ impl Editor {
             // No frame can be drawn while an edit holds the document; a long one (terrain)
             // shows its progress in the title, refreshed by `about_to_wait`'s timer.
             if let (Some(f), Some(g)) = (self.progress.fraction(), &mut self.gfx) {
-                let title = format!("voxbrick — generating terrain {:.0} %", f * 100.0);
-                if title != self.title {
-                    g.host.set_title(&title);
-                    self.title = title;
-                }
+                g.set_title(format!("voxbrick — generating terrain {:.0} %", f * 100.0));
             }
             return Ok(());
         };
@@ -140,16 +168,16 @@ impl Editor {
     }
 
     pub(super) fn draw(&mut self, gfx: &mut Gfx) -> Result<()> {
-        self.frames += 1;
+        self.frames.count += 1;
         #[cfg(feature = "test-hooks")]
-        if self.fail_at_frame == Some(self.frames) {
+        if self.frames.fail_at == Some(self.frames.count) {
             return Err(render::vulkan::GpuError::Vk {
                 call: "vkQueueSubmit (simulated: VOXBRICK_TEST_GPU_FAILURE_AT_FRAME)",
                 result: ash::vk::Result::ERROR_DEVICE_LOST,
             }
             .into());
         }
-        if self.gpu_generation != self.generation {
+        if gfx.generation != self.generation {
             // A new document: a new GPU world on the same device (the old one goes first).
             let ctx = gfx.viewport.ctx().clone();
             let next = {
@@ -158,7 +186,7 @@ impl Editor {
                 Viewport::new(ctx, &view)?
             };
             gfx.viewport = next;
-            self.gpu_generation = self.generation;
+            gfx.generation = self.generation;
         }
         let capture_now = self
             .script
@@ -173,7 +201,7 @@ impl Editor {
         let size = gfx.host.inner_size();
         let shown = (self.view_area.2, self.view_area.3);
         let internal = gfx.viewport.fit_internal(self.internal_size(shown));
-        let paths = internal.0 as f64 * internal.1 as f64 * self.last_added as f64;
+        let paths = internal.0 as f64 * internal.1 as f64 * self.frames.last_added as f64;
         self.panels.status = format!(
             "{samples}/{} spp · GPU {gpu_ms:.2} ms/frame · {:.1} Mpaths/s · internal {}x{}{} · {}{}",
             self.settings.target_spp,
@@ -195,12 +223,7 @@ impl Editor {
                 l.as_secs_f64() * 1e3
             )),
         );
-        // The title only when it changes (each set is a round trip to the window system).
-        let title = files::title(&self.read());
-        if title != self.title {
-            gfx.host.set_title(&title);
-            self.title = title;
-        }
+        gfx.set_title(files::title(&self.read()));
         let raw = gfx.host.take_egui_input();
         let egui_ctx = self.egui.clone();
         let mut events = Vec::new();
@@ -215,19 +238,25 @@ impl Editor {
                     .update(&self.doc, stroke.as_ref(), doc.revision);
             }
             let paste = self.paste_target(&doc);
-            self.preview
-                .set_paste(doc.scene.clipboard.as_ref().filter(|_| self.pasting));
+            self.preview.set_paste(
+                doc.scene
+                    .clipboard
+                    .as_ref()
+                    .filter(|_| self.pointer.pasting),
+            );
             let view_area = self.view_area;
             let brush = &self.settings.brush;
             let keeps_layer = brush.shape == crate::editor::command::BrushShape::Box
                 || (brush.mode == crate::editor::command::BrushMode::Attach
                     && !brush.follow_surface);
             let layer = self
+                .pointer
                 .drawing
                 .as_ref()
                 .filter(|_| keeps_layer)
                 .map(|d| d.layer);
             let drawn_box = self
+                .pointer
                 .drawing
                 .as_ref()
                 .filter(|_| brush.shape == crate::editor::command::BrushShape::Box)
@@ -263,7 +292,10 @@ impl Editor {
                     preview::paint_layer(&painter, &self.view, rect, layer, dims);
                 }
                 // A box being dragged says its size beside the cursor.
-                let cursor = egui::pos2(self.cursor.0 as f32 / ppp, self.cursor.1 as f32 / ppp);
+                let cursor = egui::pos2(
+                    self.pointer.cursor.0 as f32 / ppp,
+                    self.pointer.cursor.1 as f32 / ppp,
+                );
                 if let Some(b) = drawn_box.or(dragged.map(|(lo, hi, _)| (lo, hi))) {
                     preview::paint_box_size(&painter, cursor, b);
                 }
@@ -307,11 +339,11 @@ impl Editor {
         } = output;
         gfx.host.handle_platform_output(platform_output);
         // Texture changes wait here until a frame with the UI applies them.
-        self.pending_textures.append(textures_delta);
+        self.frames.textures.append(textures_delta);
         let primitives = egui_ctx.tessellate(shapes, pixels_per_point);
         // While the camera moves and while a stroke is drawn: the moving scale, so each
         // change shows in the next, cheaper frame.
-        let moving = self.motion.is_moving() || self.drawing.is_some();
+        let moving = self.motion.is_moving() || self.pointer.is_drawing();
         let still = internal;
         let internal = if moving {
             self.budgeted(scaled(
@@ -343,7 +375,7 @@ impl Editor {
             params: &params,
             internal,
             output: shown,
-            spp: self.budget.spp,
+            spp: self.frames.budget.spp,
             target_spp,
             exposure: doc.scene.params.settings.exposure + self.settings.exposure,
             bgra: false,
@@ -353,7 +385,7 @@ impl Editor {
         let ui = (!capture_now).then(|| EguiFrame {
             primitives: &primitives,
             pixels_per_point,
-            textures: &self.pending_textures,
+            textures: &self.frames.textures,
         });
         let (presented, captured) = gfx.presenter.frame(
             &mut gfx.viewport,
@@ -367,12 +399,12 @@ impl Editor {
         match &presented {
             Presented::Shown(status) => {
                 if !capture_now {
-                    self.pending_textures.clear();
+                    self.frames.textures.clear();
                 }
-                self.last_added = status.added;
+                self.frames.last_added = status.added;
                 self.report.line(format_args!(
                     "frame {} spp {}",
-                    self.frames,
+                    self.frames.count,
                     gfx.viewport.samples()
                 ));
                 self.motion.shown();
@@ -429,14 +461,14 @@ impl Editor {
         if self.script.is_some() {
             internal
         } else {
-            self.budget.apply(internal)
+            self.frames.budget.apply(internal)
         }
     }
 
     /// Samples per frame and the traced resolution follow the GPU time ([`budget`]).
     pub(super) fn adapt_samples(&mut self, gpu: Option<f64>) {
         if let Some(t) = gpu {
-            self.budget.update(t);
+            self.frames.budget.update(t);
         }
     }
 

@@ -50,7 +50,7 @@ impl Editor {
         }
         let to_ui = match &input {
             Input::Moved { x, y } => self.on_ui((*x, *y)),
-            Input::Button { .. } | Input::Wheel(_) => self.on_ui(self.cursor),
+            Input::Button { .. } | Input::Wheel(_) => self.on_ui(self.pointer.cursor),
             Input::Key { .. } => consumed || self.egui.egui_wants_keyboard_input(),
             Input::Text(_) => true,
             _ => false,
@@ -79,7 +79,7 @@ impl Editor {
                         .push(format!("{} is not a .ron or .vox file", path.display()));
                 }
             }
-            Input::Modifiers(m) => self.mods = m,
+            Input::Modifiers(m) => self.pointer.mods = m,
             // egui's alone.
             Input::Text(_) => {}
             Input::Key {
@@ -92,7 +92,7 @@ impl Editor {
             Input::Button { button, pressed } => self.button(button, pressed),
             Input::Moved { x, y } => self.cursor_moved(x, y),
             Input::Wheel(steps) => {
-                if self.on_ui(self.cursor) {
+                if self.on_ui(self.pointer.cursor) {
                     return;
                 }
                 self.zoom(steps);
@@ -112,20 +112,18 @@ impl Editor {
         if consumed || self.egui.egui_wants_keyboard_input() {
             return;
         }
-        if code == KeyCode::Escape && self.drawing.take().is_some() {
+        if code == KeyCode::Escape && self.pointer.drawing.take().is_some() {
             self.edits.submit(&self.doc, Edit::StrokeAbort);
             return;
         }
-        if code == KeyCode::Escape && (self.pasting || self.selecting.is_some()) {
-            self.pasting = false;
-            self.selecting = None;
+        if code == KeyCode::Escape && self.pointer.cancel_placing() {
             return;
         }
-        if let Some(a) = self.keymap.action(code, self.mods) {
+        if let Some(a) = self.keymap.action(code, self.pointer.mods) {
             if !repeat {
                 self.action(a);
             }
-        } else if !self.mods.ctrl && input::fly_axis(code).is_some() {
+        } else if !self.pointer.mods.ctrl && input::fly_axis(code).is_some() {
             // Keys already held fly until now in their old direction.
             if self.flight.is_flying() {
                 self.tick_fly();
@@ -157,40 +155,44 @@ impl Editor {
 
     fn button(&mut self, button: MouseButton, pressed: bool) {
         self.request_redraw();
-        let free = !self.on_ui(self.cursor);
+        let free = !self.on_ui(self.pointer.cursor);
         match (pressed, button) {
             (true, MouseButton::Left) if free => self.press(),
-            (false, MouseButton::Left) if self.drawing.is_some() => {
+            (false, MouseButton::Left) if self.pointer.drawing.is_some() => {
                 // The release position was the last move's, already taken (taking it again
                 // would dig an erase stroke deeper where the cursor stopped).
-                if let Some(d) = &self.drawing {
+                if let Some(d) = &self.pointer.drawing {
                     self.report.line(format_args!(
                         "stroke release {} {} voxel {} {} {}",
-                        self.cursor.0, self.cursor.1, d.last.x, d.last.y, d.last.z
+                        self.pointer.cursor.0, self.pointer.cursor.1, d.last.x, d.last.y, d.last.z
                     ));
                 }
-                self.drawing = None;
+                self.pointer.drawing = None;
                 self.edits.submit(&self.doc, Edit::StrokeEnd);
                 // Back to the full internal size shortly after, as after a move.
                 self.motion.settling();
             }
-            (false, MouseButton::Left) if self.selecting.is_some() => self.select_release(),
+            (false, MouseButton::Left) if self.pointer.selecting.is_some() => self.select_release(),
             (true, _) if free => {
-                self.drag = input::drag_for_button(button, self.mods).map(|d| (d, self.cursor));
+                self.pointer.drag = input::drag_for_button(button, self.pointer.mods)
+                    .map(|d| (d, self.pointer.cursor));
             }
-            (false, _) => self.drag = None,
+            (false, _) => self.pointer.drag = None,
             _ => {}
         }
     }
 
     fn cursor_moved(&mut self, x: f64, y: f64) {
-        let previous = self.cursor;
-        self.cursor = (x, y);
+        let previous = self.pointer.cursor;
+        self.pointer.cursor = (x, y);
         // The preview follows the cursor.
         self.request_redraw();
-        if let Some((drag, _)) = self.drag {
+        if let Some((drag, _)) = self.pointer.drag {
             let h = self.view_area.3.max(1) as f64;
-            let (dx, dy) = (self.cursor.0 - previous.0, self.cursor.1 - previous.1);
+            let (dx, dy) = (
+                self.pointer.cursor.0 - previous.0,
+                self.pointer.cursor.1 - previous.1,
+            );
             match drag {
                 Drag::Orbit => self.view.orbit(-dx * 0.3, -dy * 0.3),
                 Drag::Pan => {
@@ -207,11 +209,11 @@ impl Editor {
     /// Left button down: a paste being placed goes down, the eyedropper (Alt), the selection
     /// tool, or a new stroke under the cursor.
     pub(super) fn press(&mut self) {
-        if self.pasting {
+        if self.pointer.pasting {
             self.paste_press();
             return;
         }
-        if self.settings.brush.tool == Tool::Select && !self.mods.alt {
+        if self.settings.brush.tool == Tool::Select && !self.pointer.mods.alt {
             self.select_press();
             return;
         }
@@ -219,13 +221,15 @@ impl Editor {
         let doc = self.doc.clone();
         let doc = doc.read().unwrap_or_else(|p| p.into_inner());
         let view = doc.scene.world.read();
-        if self.mods.alt {
+        if self.pointer.mods.alt {
             if let Some((_, material)) = tools::pick(&view, origin, dir) {
                 self.settings.brush.material = material;
             }
             return;
         }
-        if self.mods.shift && self.settings.brush.mode == crate::editor::command::BrushMode::Paint {
+        if self.pointer.mods.shift
+            && self.settings.brush.mode == crate::editor::command::BrushMode::Paint
+        {
             // Flood fill: the connected surface of the clicked voxel's material.
             if let Some((hit, _)) = tools::pick(&view, origin, dir) {
                 let material = self.settings.brush.material;
@@ -247,9 +251,9 @@ impl Editor {
         drop(doc);
         self.report.line(format_args!(
             "stroke begin {} {} voxel {} {} {}",
-            self.cursor.0, self.cursor.1, v.x, v.y, v.z
+            self.pointer.cursor.0, self.pointer.cursor.1, v.x, v.y, v.z
         ));
-        self.drawing = Some(Drawing {
+        self.pointer.drawing = Some(super::pointer::Drawing {
             layer,
             first: v,
             last: v,
@@ -259,7 +263,9 @@ impl Editor {
 
     /// While drawing: the stroke's next point, when the cursor reached another voxel.
     pub(super) fn stroke_to_cursor(&mut self) {
-        let Some(d) = &self.drawing else { return };
+        let Some(d) = &self.pointer.drawing else {
+            return;
+        };
         let (origin, dir) = self.cursor_ray();
         let next = {
             let doc = self.read();
@@ -269,12 +275,12 @@ impl Editor {
         if let Some(v) = next
             && v != d.last
         {
-            if let Some(d) = &mut self.drawing {
+            if let Some(d) = &mut self.pointer.drawing {
                 d.last = v;
             }
             self.report.line(format_args!(
                 "stroke point {} {} voxel {} {} {}",
-                self.cursor.0, self.cursor.1, v.x, v.y, v.z
+                self.pointer.cursor.0, self.pointer.cursor.1, v.x, v.y, v.z
             ));
             self.edits
                 .submit(&self.doc, Edit::StrokeExtend(vec![tools::centre(v)]));
@@ -288,16 +294,16 @@ impl Editor {
     ) -> Option<crate::editor::command::Stroke> {
         let brush = &self.settings.brush;
         let dims = view.dims().voxels();
-        if brush.tool == Tool::Select || self.pasting {
+        if brush.tool == Tool::Select || self.pointer.pasting {
             return None;
         }
-        match &self.drawing {
+        match &self.pointer.drawing {
             Some(d) if brush.shape == crate::editor::command::BrushShape::Box => {
                 Some(brush.stroke(vec![tools::centre(d.first), tools::centre(d.last)], dims))
             }
             Some(_) => None,
             None => {
-                if self.on_ui(self.cursor) {
+                if self.on_ui(self.pointer.cursor) {
                     return None;
                 }
                 let (origin, dir) = self.cursor_ray();
@@ -332,7 +338,7 @@ impl Editor {
     /// Held movement keys move the camera by the time since the last tick ([`flight`]):
     /// half the view distance per second (Shift: twice it), at least 8 voxels' worth.
     pub(super) fn tick_fly(&mut self) {
-        let speed = self.view.distance.max(8.0) * if self.mods.shift { 2.0 } else { 0.5 };
+        let speed = self.view.distance.max(8.0) * if self.pointer.mods.shift { 2.0 } else { 0.5 };
         if let Some(step) = self.flight.step(speed) {
             self.view.fly(step);
             self.moved();

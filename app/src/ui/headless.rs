@@ -19,7 +19,6 @@ impl Editor {
     /// memory ([`Editor::take_report`]), fly keys move a fixed 1/60 s per frame. Opens
     /// `options.file` (or builds the default scene) like the window does.
     pub fn headless(options: EditorOptions, size: (u32, u32)) -> Result<Self> {
-        copy_recording_start(&options)?;
         let validation = options.validation;
         let device = options.device.clone();
         let mut editor = Self::new(options, Arc::new(|| {}), true)?;
@@ -44,7 +43,7 @@ impl Editor {
     pub fn input(&mut self, input: Input) {
         let mods = match &input {
             Input::Modifiers(m) => *m,
-            _ => self.mods,
+            _ => self.pointer.mods,
         };
         if let Some(Gfx {
             host: Host::Headless(h),
@@ -204,7 +203,7 @@ impl Editor {
 
     /// How many voxel faces the paste being placed shows (0: no paste, or too large a clip).
     pub fn paste_preview_faces(&self) -> usize {
-        if self.pasting {
+        if self.pointer.pasting {
             self.preview.paste_faces()
         } else {
             0

@@ -35,8 +35,11 @@ pub mod jobs;
 pub mod keymap;
 mod motion;
 pub mod panels;
+mod pending;
+mod pointer;
 mod preview;
 pub mod purpose;
+mod recording;
 pub mod report;
 mod saves;
 mod selecting;
@@ -55,9 +58,10 @@ pub use event::Input;
 use files::{ConfigDir, Done, FileWorker, SharedDocument};
 use glam::DVec3;
 use host::Host;
-use input::{Action, Drag, Mods};
+use input::{Action, Drag};
 use jobs::{Edit, EditQueue, Edited};
 use panels::{PanelState, UiEvent, UnsavedAnswer, ViewSettings};
+use pending::Pending;
 use purpose::Purpose;
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use render::present::{EguiFrame, Presented, Presenter};
@@ -112,7 +116,6 @@ pub fn run(options: EditorOptions) -> Result<()> {
         anyhow!("cannot open a window: {e} (no display? set DISPLAY or WAYLAND_DISPLAY)")
     })?;
     let proxy = event_loop.create_proxy();
-    copy_recording_start(&options)?;
     let wake: Arc<dyn Fn() + Send + Sync> = Arc::new(move || {
         let _ = proxy.send_event(Wake);
     });
@@ -123,33 +126,6 @@ pub fn run(options: EditorOptions) -> Result<()> {
     std::mem::replace(&mut editor.outcome, Ok(()))
 }
 
-/// With `--record`: the recording starts from the file as it is now (a save may overwrite
-/// it), so it is copied beside the recording first.
-fn copy_recording_start(options: &EditorOptions) -> Result<()> {
-    if let (Some(record), Some(file)) = (&options.record, &options.file) {
-        let start = recording_copy(record, file, "start");
-        std::fs::copy(file, &start).with_context(|| {
-            format!(
-                "--record: copying {} to {}",
-                file.display(),
-                start.display()
-            )
-        })?;
-    }
-    Ok(())
-}
-
-/// Where `--record OUT` keeps a file the session opened, as it was: beside OUT, named after
-/// it and `what` (`start`, `open-2`, …).
-fn recording_copy(record: &Path, file: &Path, what: &str) -> PathBuf {
-    let ext = file.extension().and_then(|e| e.to_str()).unwrap_or("ron");
-    let stem = record
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or("session");
-    record.with_file_name(format!("{stem}-{what}.{ext}"))
-}
-
 /// What the GPU and the window are, once the window exists (or its headless stand-in).
 /// Field order is drop order: the presenter and the session go before the window their
 /// surface belongs to.
@@ -157,6 +133,21 @@ struct Gfx {
     presenter: Presenter,
     viewport: Viewport,
     host: Host,
+    /// The document generation whose world the viewport holds.
+    generation: u64,
+    /// The window title last set.
+    title: String,
+}
+
+impl Gfx {
+    /// Sets the window's title when it changed (each set is a round trip to the window
+    /// system).
+    fn set_title(&mut self, title: String) {
+        if title != self.title {
+            self.host.set_title(&title);
+            self.title = title;
+        }
+    }
 }
 
 /// A script run through the live editor.
@@ -170,24 +161,6 @@ struct LiveScript {
     captured_at: Option<Instant>,
 }
 
-/// A stroke being drawn: the layer it keeps to, its first and its last voxel sent.
-struct Drawing {
-    layer: tools::Layer,
-    first: glam::IVec3,
-    last: glam::IVec3,
-}
-
-/// What to do once the unsaved-changes question is answered.
-#[derive(Clone, Debug)]
-enum Pending {
-    Quit,
-    Open(Option<PathBuf>),
-    New {
-        size: (u32, u32, u32),
-        terrain: bool,
-    },
-}
-
 /// The application handler.
 pub struct Editor {
     options: EditorOptions,
@@ -199,7 +172,6 @@ pub struct Editor {
     progress: Arc<crate::editor::progress::Progress>,
     /// Bumped whenever the document is replaced (the GPU world is then rebuilt).
     generation: u64,
-    gpu_generation: u64,
     files: FileWorker,
     edits: EditQueue,
     /// Input that arrived while an edit held the frame gate (and whether egui kept it),
@@ -211,9 +183,6 @@ pub struct Editor {
     slots: [Option<ViewCamera>; 9],
     settings: ViewSettings,
     panels: PanelState,
-    mods: Mods,
-    drag: Option<(Drag, (f64, f64))>,
-    cursor: (f64, f64),
     /// When pointer or key input last went to the UI (a panel, a menu, a window): for
     /// [`frame::UI_FIRST`] after it, refinement waits and frames are the UI's.
     ui_touched: Option<Instant>,
@@ -221,24 +190,12 @@ pub struct Editor {
     flight: flight::Flight,
     /// The view in motion (the moving scale) and input to photon.
     motion: motion::Motion,
-    /// Samples per frame and the traced resolution's scale, from the GPU time per frame.
-    budget: budget::FrameBudget,
-    /// Samples per pixel the last shown frame added (0 once converged).
-    last_added: u32,
-    pending: Option<Pending>,
-    save_then: Option<Pending>,
+    /// The unsaved-changes question, a save before an open or a quit, a built scene on its
+    /// way, a recovery being loaded.
+    waits: pending::Waits,
     script: Option<LiveScript>,
-    /// A built scene (the default one, or New) is on its way: a `Loaded` without a path replaces
-    /// the document only then.
-    awaiting_built_scene: bool,
-    pending_textures: egui::TexturesDelta,
-    /// The window title last set.
-    title: String,
-    recovering: bool,
     quitting: bool,
     outcome: Result<()>,
-    /// Frames drawn.
-    frames: u64,
     /// Which keys do what (keys.ron).
     keymap: keymap::KeyMap,
     /// The window's inner size in physical pixels (cursor positions are in these).
@@ -246,29 +203,21 @@ pub struct Editor {
     /// Where the viewport shows in the window (x, y, width, height in pixels): what the bars
     /// and docked panels leave, as last drawn. Framing, picking and the camera's aspect use it.
     view_area: (u32, u32, u32, u32),
-    /// The stroke being drawn with the left button.
-    drawing: Option<Drawing>,
+    /// The modifiers, the cursor and the gesture in progress.
+    pointer: pointer::Pointer,
     /// What a click would change, under the cursor.
     preview: preview::Preview,
-    /// The selection box being dragged.
-    selecting: Option<selecting::SelectDrag>,
-    /// A paste follows the cursor until a click.
-    pasting: bool,
     /// The handshake log (`VOXBRICK_REPORT`).
     report: report::Report,
-    /// Tests only: the frame that fails as if the device were lost
-    /// (`VOXBRICK_TEST_GPU_FAILURE_AT_FRAME`), to check nothing is lost when the GPU fails.
-    #[cfg(feature = "test-hooks")]
-    fail_at_frame: Option<u64>,
+    /// Frames drawn, the samples-per-frame budget, textures waiting for a frame.
+    frames: frame::Frames,
     /// No window: frames are drawn offscreen, no native dialog is shown, fly keys move the
     /// camera a fixed 1/60 s per frame (a headless session is a function of its input).
     headless: bool,
     /// The editor asked to stop (the window loop exits; a headless driver is told).
     exit: bool,
-    /// Files opened since the recording started (each copied beside it).
-    recorded_opens: u32,
-    /// The recording, once a built scene ended it (written at exit).
-    ended_recording: Option<script::Recorder>,
+    /// `--record`: the copies of opened files and a recording a built scene ended.
+    recording: recording::Recording,
 }
 
 impl Editor {
@@ -277,6 +226,8 @@ impl Editor {
         wake: Arc<dyn Fn() + Send + Sync>,
         headless: bool,
     ) -> Result<Self> {
+        let recording =
+            recording::Recording::start(options.record.as_deref(), options.file.as_deref())?;
         let mut files = FileWorker::new(wake.clone());
         files.dialogs = !headless;
         let wake_preview = wake.clone();
@@ -338,48 +289,30 @@ impl Editor {
             progress: doc.progress.clone(),
             doc: Arc::new(RwLock::new(doc)),
             generation: 0,
-            gpu_generation: 0,
             files,
             edits,
             backlog: Vec::new(),
             saves: saves::Saves::new(),
             view,
             slots: Default::default(),
-            mods: Mods::default(),
-            drag: None,
-            cursor: (0.0, 0.0),
             ui_touched: None,
             flight: flight::Flight::new(headless),
             motion: motion::Motion::new(),
-            budget: Default::default(),
-            last_added: 0,
-            pending: None,
-            save_then: None,
-            awaiting_built_scene: false,
-            pending_textures: Default::default(),
-            title: String::new(),
-            recovering: false,
+            waits: Default::default(),
             quitting: false,
             outcome: Ok(()),
-            frames: 0,
             keymap: Default::default(),
             window_size: (16, 9),
             view_area: (0, 0, 16, 9),
-            drawing: None,
             preview: preview::Preview::new(wake_preview),
-            selecting: None,
-            pasting: false,
+            pointer: pointer::Pointer::default(),
             report: report::Report::from_env(),
-            #[cfg(feature = "test-hooks")]
-            fail_at_frame: std::env::var("VOXBRICK_TEST_GPU_FAILURE_AT_FRAME")
-                .ok()
-                .and_then(|v| v.parse().ok()),
+            frames: frame::Frames::new(),
             script: script_run,
             options,
             headless,
             exit: false,
-            recorded_opens: 0,
-            ended_recording: None,
+            recording,
         };
         // No fades or slides: egui's clock stands still while a slow frame blocks the loop
         // (host::InputClock), so on a slow device a 0.1 s fade took seconds and dialogs
@@ -413,7 +346,7 @@ impl Editor {
             match editor.options.file.clone() {
                 Some(f) => editor.files.load(f, editor.options.workers),
                 None => {
-                    editor.awaiting_built_scene = true;
+                    editor.waits.building();
                     editor.files.build_default(editor.options.workers);
                 }
             }
@@ -440,7 +373,7 @@ impl Editor {
 
     /// Normalized device coordinates of the cursor in the viewport (v up).
     fn cursor_ndc(&self) -> (f64, f64) {
-        self.ndc(self.cursor)
+        self.ndc(self.pointer.cursor)
     }
 
     /// Normalized device coordinates of a window point in the viewport (v up).
@@ -602,6 +535,6 @@ impl Editor {
 impl Drop for Editor {
     fn drop(&mut self) {
         self.gfx = None;
-        self.pending_textures.clear();
+        self.frames.textures.clear();
     }
 }

@@ -467,12 +467,24 @@ pub fn draw(
     }
     if !state.errors.is_empty() {
         let mut dismiss = false;
-        window(area, "Error").collapsible(false).show(ctx, |ui| {
-            for e in &state.errors {
-                ui.colored_label(egui::Color32::LIGHT_RED, e);
-            }
-            dismiss = ui.button("OK").clicked();
-        });
+        // As tall as its messages (a resizable window with a scroll area keeps egui's
+        // 420-pixel default height, most of it empty), scrolling past the viewport's height.
+        egui::Window::new("Error")
+            .constrain_to(area)
+            .collapsible(false)
+            .resizable(false)
+            .default_width(360.0)
+            .show(ctx, |ui| {
+                egui::ScrollArea::vertical()
+                    .max_height((area.height() - 120.0).max(60.0))
+                    .auto_shrink([false, true])
+                    .show(ui, |ui| {
+                        for e in &state.errors {
+                            ui.colored_label(egui::Color32::LIGHT_RED, e);
+                        }
+                    });
+                dismiss = ui.button("OK").clicked();
+            });
         if dismiss {
             state.errors.clear();
         }

@@ -116,7 +116,7 @@ impl Editor {
     /// cursor; a plain click on nothing selects nothing.
     pub(super) fn select_press(&mut self) {
         let (origin, dir) = self.cursor_ray();
-        let kind = DragKind::of(self.mods);
+        let kind = DragKind::of(self.pointer.mods);
         let start = {
             let doc = self.read();
             let view = doc.scene.world.read();
@@ -125,7 +125,7 @@ impl Editor {
         };
         match start {
             Some(((v, layer), (hit, _))) => {
-                self.selecting = Some(SelectDrag {
+                self.pointer.selecting = Some(SelectDrag {
                     layer,
                     inward: -hit.normal[layer.axis],
                     first: v,
@@ -141,11 +141,13 @@ impl Editor {
     /// While dragging a selection box: its corner follows the cursor on the first face's
     /// plane.
     pub(super) fn select_to_cursor(&mut self) {
-        let Some(d) = &self.selecting else { return };
+        let Some(d) = &self.pointer.selecting else {
+            return;
+        };
         let (origin, dir) = self.cursor_ray();
         let dims = self.read().scene.world.dims().voxels();
         if let Some(v) = tools::on_layer(d.layer, origin, dir, dims)
-            && let Some(d) = &mut self.selecting
+            && let Some(d) = &mut self.pointer.selecting
         {
             d.last = v;
         }
@@ -153,7 +155,7 @@ impl Editor {
 
     /// The box being dragged, if any.
     pub(super) fn dragged_box(&self) -> Option<(IVec3, IVec3, DragKind)> {
-        let d = self.selecting.as_ref()?;
+        let d = self.pointer.selecting.as_ref()?;
         let depth = self.settings.brush.select_depth;
         let (lo, hi) = drag_box(d.first, d.last, d.layer, d.inward, depth);
         Some((lo, hi, d.kind))
@@ -162,7 +164,7 @@ impl Editor {
     /// Left button up: the dragged box changes the selection (one command).
     pub(super) fn select_release(&mut self) {
         if let Some((lo, hi, kind)) = self.dragged_box() {
-            self.selecting = None;
+            self.pointer.selecting = None;
             self.select(kind.op((lo, hi)));
         }
     }
@@ -178,13 +180,17 @@ impl Editor {
             return;
         }
         let step = nudge_offset(n, self.view.camera.forward());
-        let step = if self.mods.shift { step * 8 } else { step };
+        let step = if self.pointer.mods.shift {
+            step * 8
+        } else {
+            step
+        };
         self.execute(Command::MoveSelection(step));
     }
 
     /// Where the paste being placed would go now in `doc` (its minimum corner and size).
     pub(super) fn paste_target(&self, doc: &Document) -> Option<(IVec3, IVec3)> {
-        if !self.pasting {
+        if !self.pointer.pasting {
             return None;
         }
         let size = doc.scene.clipboard.as_ref()?.size;
@@ -196,7 +202,7 @@ impl Editor {
     /// A click while placing a paste: it goes down there.
     pub(super) fn paste_press(&mut self) {
         let target = self.paste_target(&self.read());
-        self.pasting = false;
+        self.pointer.pasting = false;
         if let Some((at, _)) = target {
             self.edits
                 .submit(&self.doc, Edit::Command(Command::Paste { at }));

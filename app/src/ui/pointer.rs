@@ -1,0 +1,61 @@
+//! The pointer and the gesture it is making: the modifier keys held, the cursor, a camera
+//! drag, a stroke being drawn, a selection box being dragged, a paste following the cursor.
+//! `handle.rs` and `selecting.rs` change it; the frame reads it (the paste preview, whether a
+//! stroke is drawn); replacing the document ends every gesture.
+
+use super::input::{Drag, Mods};
+use super::selecting::SelectDrag;
+use super::tools;
+
+/// A stroke being drawn: the layer it keeps to, its first and its last voxel sent.
+pub(super) struct Drawing {
+    pub(super) layer: tools::Layer,
+    pub(super) first: glam::IVec3,
+    pub(super) last: glam::IVec3,
+}
+
+/// What the pointer is doing.
+#[derive(Default)]
+pub(super) struct Pointer {
+    /// Modifier keys held.
+    pub(super) mods: Mods,
+    /// Where the cursor is, in window pixels.
+    pub(super) cursor: (f64, f64),
+    /// A camera drag and where it was last.
+    pub(super) drag: Option<(Drag, (f64, f64))>,
+    /// The stroke being drawn with the left button.
+    pub(super) drawing: Option<Drawing>,
+    /// The selection box being dragged.
+    pub(super) selecting: Option<SelectDrag>,
+    /// A paste follows the cursor until a click.
+    pub(super) pasting: bool,
+}
+
+impl Pointer {
+    /// Ends a paste and a selection drag (Escape, or a new document); whether one was on.
+    pub(super) fn cancel_placing(&mut self) -> bool {
+        let was = self.pasting || self.selecting.is_some();
+        self.pasting = false;
+        self.selecting = None;
+        was
+    }
+
+    /// Whether a stroke is being drawn (the frame draws at the moving scale then).
+    pub(super) fn is_drawing(&self) -> bool {
+        self.drawing.is_some()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cancelling_ends_a_paste_and_a_selection_drag_and_says_so() {
+        let mut p = Pointer::default();
+        assert!(!p.cancel_placing());
+        p.pasting = true;
+        assert!(p.cancel_placing());
+        assert!(!p.pasting && !p.cancel_placing());
+    }
+}
