@@ -86,30 +86,30 @@ enum Command {
     Replay(cli::replay::ReplayArgs),
     /// The editor's frame loop without a window (frames in flight, trace and display) on the
     /// thesis scene: GPU and host time per frame, camera move to first frame.
-    BenchViewport(cli::bench_viewport::BenchViewport),
+    BenchViewport(cli::harness::bench_viewport::BenchViewport),
     /// Time the GPU path tracer on the thesis scene with Vulkan timestamp queries: medians
     /// after warm-up for the thesis's complexities 1, 2 and 3.
-    BenchGpu(cli::bench_gpu::BenchGpu),
+    BenchGpu(cli::harness::bench_gpu::BenchGpu),
     /// The thesis benchmark along a camera path: GPU frame times (Vulkan timestamps) per
     /// preset (complexity 1, 2, 3, physical) and internal resolution, rays per second by
     /// kind, the CPU reference at a small size, and sculpting while the path plays; writes
     /// bench.json, bench.md and frame-time plots (PNG) into --out.
-    Bench(cli::bench::Bench),
+    Bench(cli::harness::bench::Bench),
     /// Image error against samples and GPU time at views along the benchmark path: every
     /// preset and sampling choice, relMSE and FLIP against a converged reference whose own
     /// noise is measured, slope and bias checks, efficiency at equal error. Writes
     /// error.csv, error.md, error.json and log-log plots; exits non-zero if a check fails.
-    BenchError(cli::bench_error::BenchError),
+    BenchError(cli::harness::bench_error::BenchError),
     /// What each skip buys: the pipeline variants, the coarse-grid and in-brick empty-space
     /// skips, uniform media, full cells, accumulation when still and the lower resolution while
     /// moving, with and without each, on the thesis scene and on a scene that needs it. Writes
     /// skips.md and skips.json.
-    BenchSkips(cli::bench_skips::BenchSkips),
+    BenchSkips(cli::harness::bench_skips::BenchSkips),
     /// The numerical stress suite: random and adversarial rays through the GPU traversal
     /// against the exact CPU ray cast, and adversarial scenes' images (NaN, infinite and
     /// negative samples, white-furnace energy, iteration caps) on the GPU and the CPU
     /// reference. Exits non-zero if any count is not zero.
-    Stress(cli::stress::Stress),
+    Stress(cli::harness::stress::Stress),
     /// Print a scene file's dimensions, voxel count, materials and memory.
     Info(cli::scene_file::InfoArgs),
 }
@@ -164,11 +164,11 @@ fn run(cli: Cli) -> Result<()> {
         Command::Render(a) => cli::render::render_command(a, workers),
         Command::Soak(a) => cli::soak::soak_command(a, workers),
         Command::Replay(a) => cli::replay::replay(a, workers),
-        Command::BenchViewport(a) => cli::bench_viewport::command(a, workers),
-        Command::BenchGpu(a) => cli::bench_gpu::run(a, workers),
-        Command::Bench(a) => cli::bench::run(a, workers),
-        Command::BenchError(a) => cli::bench_error::run(a, workers),
-        Command::BenchSkips(a) => cli::bench_skips::run(a, workers),
-        Command::Stress(a) => cli::stress::run(a),
+        Command::BenchViewport(a) => cli::harness::bench_viewport::command(a, workers),
+        Command::BenchGpu(a) => cli::harness::bench_gpu::run(a, workers),
+        Command::Bench(a) => cli::harness::bench::run(a, workers),
+        Command::BenchError(a) => cli::harness::bench_error::run(a, workers),
+        Command::BenchSkips(a) => cli::harness::bench_skips::run(a, workers),
+        Command::Stress(a) => cli::harness::stress::run(a),
     }
 }

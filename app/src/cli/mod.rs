@@ -3,25 +3,17 @@
 //!
 //! - scene files: `scene_file.rs` (`new`, `convert`, `info`), `stats.rs` (`stats` and the
 //!   statistics text), `render.rs`, `replay.rs`, `soak.rs`;
-//! - benchmarks and suites: `bench.rs` (the thesis path), `bench_gpu.rs` (complexities,
-//!   `--convergence`) with `bench_lights.rs` (`--lights`), `bench_viewport.rs`,
-//!   `bench_skips.rs`, `bench_error.rs`, `stress.rs`; `plot.rs` draws their plots;
+//! - benchmarks and suites: `harness/` (the thesis path, complexities, lights, the
+//!   viewport, skips, error against time, the stress suite, their plots);
 //! - `args.rs`: the value parsers they share; this file: the spinner and stdout helpers.
 
 pub mod args;
-pub mod bench;
-pub mod bench_error;
-pub mod bench_gpu;
-pub mod bench_lights;
-pub mod bench_skips;
-pub mod bench_viewport;
-pub mod plot;
+pub mod harness;
 pub mod render;
 pub mod replay;
 pub mod scene_file;
 pub mod soak;
 pub mod stats;
-pub mod stress;
 pub mod table;
 
 use anyhow::Result;

@@ -197,7 +197,7 @@ pub(super) fn report(
         plots(b, run)?;
     }
     let json = serde_json::json!({
-        "device": ctx.name, "driver": ctx.driver, "clocks": crate::cli::bench::clocks(),
+        "device": ctx.name, "driver": ctx.driver, "clocks": crate::cli::harness::bench::clocks(),
         "size": [w, h], "reference_spp": b.reference_spp, "max_spp": b.max_spp,
         "rel_mse_epsilon": render::convergence::REL_MSE_EPSILON, "z_max": Z_MAX,
         "cases": runs,

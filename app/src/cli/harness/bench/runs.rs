@@ -2,7 +2,7 @@
 //! reference's frames, and a sculpting stroke while the path plays.
 
 use super::*;
-use crate::cli::bench_viewport::edit_request;
+use crate::cli::harness::bench_viewport::edit_request;
 
 fn times(frames: usize, duration: f64) -> Vec<f64> {
     (0..frames)
