@@ -7,10 +7,10 @@
 //!
 //! Run: `cargo bench -p app --bench edits`.
 
+use app::builtin::{SceneSize, default_scene};
 use app::editor::Document;
 use app::editor::command::{BrushMode, BrushShape, Command, Mirror, Stroke};
 use app::editor::history::History;
-use app::scene::{SceneSize, default_scene};
 use app::selection::SelectOp;
 use divan::Bencher;
 use glam::{DVec3, IVec3};

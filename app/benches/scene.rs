@@ -4,8 +4,8 @@
 //!
 //! Run: `cargo bench -p app --bench scene`.
 
+use app::builtin::thesis_scene;
 use app::formats::{project, vox};
-use app::scene::thesis_scene;
 use divan::Bencher;
 use std::path::Path;
 

@@ -1,8 +1,9 @@
 //! voxbrick's application library: the scene and its document engine (commands, history,
-//! scripts), the file formats, the interactive editor (`ui`), the soak test and the GPU
+//! scripts), the built-in scenes, the file formats, the interactive editor (`ui`), the soak test and the GPU
 //! session opener. The `voxbrick` binary (`main.rs`, its subcommands in `cli/`) is built on it.
 
 pub mod atomic;
+pub mod builtin;
 pub mod camera_path;
 pub mod editor;
 pub mod formats;

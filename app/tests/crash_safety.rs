@@ -123,5 +123,5 @@ fn saves_killed_at_random_moments_leave_the_old_file_or_the_complete_new_one() {
     assert!(new_project("1", &target).status().unwrap().success());
     assert_eq!(std::fs::read(&target).unwrap(), bytes_a);
     assert_eq!(leftovers(), 0, "temporary files of killed saves remain");
-    app::Scene::load(&target, 1).expect("the file loads");
+    app::formats::load(&target, 1).expect("the file loads");
 }

@@ -34,10 +34,11 @@ impl Session {
             })
             .unwrap();
         let file = dir.join("terrain.ron");
-        app::ui::files::new_scene((48, 24, 48), true, 2)
-            .unwrap()
-            .save(&file)
-            .unwrap();
+        app::formats::save(
+            &app::ui::files::new_scene((48, 24, 48), true, 2).unwrap(),
+            &file,
+        )
+        .unwrap();
         let ed = match Editor::headless(
             EditorOptions {
                 file: Some(file),
@@ -460,10 +461,11 @@ fn without_a_dialog_save_as_and_open_ask_in_the_browser(s: &mut Session, dir: &s
 /// A new empty scene has a floor to aim at: the first click attaches on it.
 fn the_first_click_on_an_empty_scene_attaches_on_the_floor(s: &mut Session, dir: &std::path::Path) {
     let empty = dir.join("empty.ron");
-    app::ui::files::new_scene((32, 16, 32), false, 1)
-        .unwrap()
-        .save(&empty)
-        .unwrap();
+    app::formats::save(
+        &app::ui::files::new_scene((32, 16, 32), false, 1).unwrap(),
+        &empty,
+    )
+    .unwrap();
     let generation = s.ed.generation();
     s.ed.input(Input::Dropped(empty));
     s.quiet();

@@ -208,7 +208,11 @@ fn new_terrain(path: &Path, size: &str) {
 }
 
 fn hash(p: &Path) -> u64 {
-    app::Scene::load(p, 1).unwrap().world.read().content_hash()
+    app::formats::load(p, 1)
+        .unwrap()
+        .world
+        .read()
+        .content_hash()
 }
 
 fn tools_ready() -> Option<Xvfb> {
@@ -317,7 +321,7 @@ fn strokes_drawn_with_the_mouse_replay_headlessly_to_the_same_scene() {
 
 /// The solid voxels of a scene file.
 fn solid(path: &Path) -> HashSet<(i32, i32, i32)> {
-    let scene = app::Scene::load(path, 1).unwrap();
+    let scene = app::formats::load(path, 1).unwrap();
     let view = scene.world.read();
     let v = view.dims().voxels();
     let mut out = HashSet::new();
@@ -437,13 +441,13 @@ fn a_drag_faster_than_the_frames_is_one_connected_stroke_reaching_the_release_po
     );
     let alone = dir.join("alone.ron");
     let mut doc = app::editor::Document::new(
-        app::Scene::load(&work, 1).unwrap(),
+        app::formats::load(&work, 1).unwrap(),
         app::editor::history::History::default(),
     );
     doc.execute(app::editor::command::Command::Clear).unwrap();
     doc.execute(app::editor::command::Command::Stroke(strokes[0].clone()))
         .unwrap();
-    doc.scene.save(&alone).unwrap();
+    app::formats::save(&doc.scene, &alone).unwrap();
     let added: BTreeSet<(i32, i32, i32)> = solid(&alone).into_iter().collect();
     assert!(added.len() >= points, "{} voxels added", added.len());
     assert_eq!(components(&added), 1, "the stroke is in pieces");

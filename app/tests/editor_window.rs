@@ -380,8 +380,8 @@ fn a_gpu_failure_mid_session_keeps_the_unsaved_work_in_the_recovery_file() {
     // The recovery file holds the edit made after the save, exactly.
     let recovery = dir.join("config").join("recovery.ron");
     assert!(recovery.exists(), "{stderr}");
-    let recovered = app::Scene::load(&recovery, 1).unwrap();
-    let mut expected = app::Scene::load(&dir.join("saved.ron"), 1).unwrap();
+    let recovered = app::formats::load(&recovery, 1).unwrap();
+    let mut expected = app::formats::load(&dir.join("saved.ron"), 1).unwrap();
     let hash = |s: &app::Scene| s.world.read().content_hash();
     assert_ne!(hash(&recovered), hash(&expected));
     let command: app::editor::command::Command = ron::from_str(last).unwrap();

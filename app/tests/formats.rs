@@ -4,8 +4,8 @@
 mod common;
 
 use app::Scene;
+use app::builtin::{SceneSize, default_scene};
 use app::formats::{FormatError, project, vox};
-use app::scene::{SceneSize, default_scene};
 use brickmap::{EditOp, GridDims, Material, MaterialKind, Mode, Shape, VoxelEdit, VoxelOp, World};
 use glam::{DVec3, IVec3};
 use std::path::{Path, PathBuf};
@@ -60,8 +60,8 @@ fn project_round_trips_everything() {
     let scene = Scene { params, ..scene };
     let d = scratch("roundtrip");
     let path = d.join("scene.ron");
-    scene.save(&path).unwrap();
-    let loaded = Scene::load(&path, 3).unwrap();
+    app::formats::save(&scene, &path).unwrap();
+    let loaded = app::formats::load(&path, 3).unwrap();
     assert_eq!(loaded.params, scene.params);
     assert_eq!(
         loaded.world.read().content_hash(),
@@ -77,19 +77,22 @@ fn project_round_trips_everything() {
     // orthographic one round-trips, and a bad height is refused by name.
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(!text.contains("projection"));
-    let mut ortho = Scene::load(&path, 2).unwrap();
+    let mut ortho = app::formats::load(&path, 2).unwrap();
     ortho.params.camera.projection = render::Projection::Orthographic { height: 37.5 };
     let ortho_path = d.join("ortho.ron");
-    ortho.save(&ortho_path).unwrap();
+    app::formats::save(&ortho, &ortho_path).unwrap();
     let ortho_text = std::fs::read_to_string(&ortho_path).unwrap();
     assert!(ortho_text.contains("projection: Orthographic(height: 37.5)"));
-    assert_eq!(Scene::load(&ortho_path, 2).unwrap().params, ortho.params);
+    assert_eq!(
+        app::formats::load(&ortho_path, 2).unwrap().params,
+        ortho.params
+    );
     std::fs::write(
         &ortho_path,
         ortho_text.replace("height: 37.5", "height: -1.0"),
     )
     .unwrap();
-    let err = Scene::load(&ortho_path, 2).unwrap_err().to_string();
+    let err = app::formats::load(&ortho_path, 2).unwrap_err().to_string();
     assert!(err.contains("orthographic height"), "{err}");
     // The non-voxel part is readable RON.
     assert!(
@@ -217,9 +220,9 @@ fn failed_save_keeps_the_previous_file() {
     let blocked = d.join("blocked.ron");
     std::fs::create_dir(&blocked).unwrap();
     std::fs::write(blocked.join("keep"), "x").unwrap();
-    assert!(scene.save(&blocked).is_err());
+    assert!(app::formats::save(&scene, &blocked).is_err());
     assert!(blocked.join("keep").exists());
-    assert!(scene.save(&d.join("missing/scene.ron")).is_err());
+    assert!(app::formats::save(&scene, &d.join("missing/scene.ron")).is_err());
     assert_eq!(std::fs::read_to_string(&path).unwrap(), "previous");
     let leftovers: Vec<_> = std::fs::read_dir(&d)
         .unwrap()
@@ -584,7 +587,16 @@ fn hostile_vox_files_are_refused_and_nothing_left_out_silently() {
         let e = vox::import_file(&seeds.join(file), &vox::ImportOptions::default(), 1)
             .map(|_| ())
             .unwrap_err();
-        assert!(matches!(e, FormatError::Invalid { .. }), "{file}: {e}");
+        assert!(
+            matches!(
+                e,
+                FormatError::Vox {
+                    error: vox::VoxError::Malformed(_),
+                    ..
+                }
+            ),
+            "{file}: {e}"
+        );
         assert!(e.to_string().contains(want), "{file}: {e}");
         // The command line: a one-line error, exit non-zero, nothing written.
         let out = dir.join(format!("{file}.ron"));
@@ -686,6 +698,7 @@ fn hostile_vox_files_are_refused_and_nothing_left_out_silently() {
     )
     .map(|_| ())
     .unwrap_err();
-    assert!(e.contains("outside the"), "{e}");
+    assert!(matches!(e, vox::VoxError::OutsideGrid { .. }), "{e}");
+    assert!(e.to_string().contains("outside the"), "{e}");
     assert_eq!(world.read().content_hash(), before);
 }

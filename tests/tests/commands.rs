@@ -1,12 +1,12 @@
 //! Every command kind: execute → undo restores the exact content hash and every non-voxel
 //! field → redo re-applies exactly. History bounds, coalescing and failures.
 
+use app::builtin::{SceneSize, default_scene};
 use app::editor::Document;
 use app::editor::command::{
     BrushMode, BrushShape, Command, KindSpec, MaterialSpec, Mirror, Stroke, TerrainSpec,
 };
 use app::editor::history::History;
-use app::scene::{SceneSize, default_scene};
 use glam::{DVec3, IVec3};
 use render::{Camera, RenderSettings, Sky, Sun};
 

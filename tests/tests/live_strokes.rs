@@ -4,11 +4,11 @@
 //! segment that fails undoes the whole stroke; the recorder replays the stroke at once to the
 //! same hash.
 
+use app::builtin::{SceneSize, default_scene};
 use app::editor::Document;
 use app::editor::command::{BrushMode, BrushShape, Command, Mirror, Stroke};
 use app::editor::history::History;
 use app::editor::{EditError, script};
-use app::scene::{SceneSize, default_scene};
 use glam::DVec3;
 
 fn document() -> Document {

@@ -3,10 +3,10 @@
 //! and redo of each to the exact content hash and selection, moves and pastes over the grid's
 //! edges, and the refusals that change nothing.
 
+use app::builtin::{SceneSize, default_scene};
 use app::editor::Document;
 use app::editor::command::{BrushMode, BrushShape, Command, Mirror, Stroke};
 use app::editor::history::History;
-use app::scene::{SceneSize, default_scene};
 use app::selection::SelectOp;
 use glam::{DVec3, IVec3};
 

@@ -2,7 +2,6 @@
 
 use super::{emit, with_progress};
 use anyhow::{Context, Result, bail};
-use app::Scene;
 use glam::DVec3;
 use render::viewport::RenderHow;
 use std::path::PathBuf;
@@ -71,7 +70,7 @@ pub(crate) fn render_command(a: RenderArgs, workers: usize) -> Result<()> {
         bail!("--scale {} is outside (0, 1]", a.scale);
     }
     let scene = with_progress(format!("reading {}", a.scene.display()), || {
-        Ok(Scene::load(&a.scene, workers)?)
+        Ok(app::formats::load(&a.scene, workers)?)
     })?;
     let mut params = scene.params.clone();
     if let Some(spec) = &a.camera {

@@ -39,7 +39,7 @@ pub(crate) fn replay(a: ReplayArgs, workers: usize) -> Result<()> {
     })?;
     let doc = &replayed.document;
     if let Some(path) = &a.save {
-        doc.scene.save(path)?;
+        app::formats::save(&doc.scene, path)?;
     }
     if let Some(path) = &a.render {
         let view = doc.scene.world.read();

@@ -4,8 +4,8 @@ use super::stats::stats_text;
 use super::{args, emit, with_progress};
 use anyhow::{Context, Result, bail};
 use app::Scene;
+use app::builtin::{terrain_materials, thesis_scene, thesis_terrain};
 use app::formats::{self, Format};
-use app::scene::{terrain_materials, thesis_scene, thesis_terrain};
 use brickmap::GridDims;
 use brickmap::terrain::{NoiseKind, NoiseTerrain};
 use glam::IVec3;
@@ -90,7 +90,7 @@ pub(crate) fn new(a: NewArgs, workers: usize) -> Result<()> {
 /// Writes `scene` to `path` (atomically, as every save), with a spinner.
 fn save(scene: &Scene, path: &std::path::Path) -> Result<()> {
     with_progress(format!("writing {}", path.display()), || {
-        Ok(scene.save(path)?)
+        Ok(app::formats::save(scene, path)?)
     })
 }
 
@@ -154,7 +154,7 @@ pub(crate) fn info(a: InfoArgs, workers: usize) -> Result<()> {
     let file = a.file;
     let started = Instant::now();
     let scene = with_progress(format!("reading {}", file.display()), || {
-        Ok(Scene::load(&file, workers)?)
+        Ok(app::formats::load(&file, workers)?)
     })?;
     let p = &scene.params;
     let mut text = format!("file         {}\n", file.display());

@@ -3,7 +3,7 @@
 
 use super::{emit, with_progress};
 use anyhow::Result;
-use app::scene::{SceneSize, default_scene};
+use app::builtin::{SceneSize, default_scene};
 use brickmap::{Ray, World};
 use glam::DVec3;
 use std::time::Instant;

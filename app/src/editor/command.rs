@@ -442,9 +442,9 @@ impl Command {
             Command::GenerateTerrain(t) => {
                 let before = world.materials().clone();
                 let result = (|| {
-                    let materials = crate::scene::terrain_materials(world)?;
+                    let materials = crate::builtin::terrain_materials(world)?;
                     let mut params =
-                        crate::scene::thesis_terrain(materials, world.dims().voxels().y as u32);
+                        crate::builtin::thesis_terrain(materials, world.dims().voxels().y as u32);
                     (params.seed, params.noise, params.scale, params.octaves) =
                         (t.seed, t.noise, t.scale, t.octaves);
                     (params.height_range, params.water_level) = (t.height_range, t.water_level);
@@ -492,7 +492,7 @@ impl Command {
                     },
                     Err(e) => {
                         world.replace_materials(before)?;
-                        return Err(crate::formats::FormatError::invalid(&file, e).into());
+                        return Err(crate::formats::FormatError::vox(&file, e).into());
                     }
                 }
             }

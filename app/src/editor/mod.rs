@@ -190,7 +190,7 @@ impl Document {
 
     /// Saves (project or .vox by extension) atomically; a project save clears the dirty flag.
     pub fn save(&mut self, path: &Path) -> Result<(), crate::formats::FormatError> {
-        self.scene.save(path)?;
+        crate::formats::save(&self.scene, path)?;
         self.mark_saved(path, self.revision);
         Ok(())
     }

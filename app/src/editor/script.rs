@@ -272,9 +272,11 @@ impl ScriptRun {
                 }
                 doc.scene
             }
-            Start::File(f) => Scene::load(&folder.join(f), workers).context("start")?,
-            Start::Default => crate::scene::default_scene(crate::scene::SceneSize::Full, workers)
-                .context("start: the default scene")?,
+            Start::File(f) => crate::formats::load(&folder.join(f), workers).context("start")?,
+            Start::Default => {
+                crate::builtin::default_scene(crate::builtin::SceneSize::Full, workers)
+                    .context("start: the default scene")?
+            }
         };
         let mut document = Document::new(scene, history());
         document.folder = folder.to_path_buf();
@@ -353,7 +355,7 @@ fn run_step(
             } else {
                 doc.folder.join(p)
             };
-            let scene = Scene::load(&path, doc.scene.world.workers())?;
+            let scene = crate::formats::load(&path, doc.scene.world.workers())?;
             let budget = options
                 .history_budget
                 .unwrap_or(super::history::DEFAULT_BUDGET);

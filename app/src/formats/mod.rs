@@ -1,13 +1,32 @@
 //! Scene file formats: RON projects (`project`, with the voxel payload in `payload`) and
-//! MagicaVoxel `.vox` (`vox`, its chunk structure checked first by `vox_check`).
+//! MagicaVoxel `.vox` (`vox`, its chunk structure checked first by `vox::check`).
 
 pub mod palette;
 pub mod payload;
 pub mod project;
 pub mod vox;
-pub mod vox_check;
 
+use crate::scene::Scene;
 use std::path::Path;
+
+/// Loads a `.ron` project or imports a `.vox` file (which gets the default sun and sky),
+/// choosing by the extension.
+pub fn load(path: &Path, workers: usize) -> Result<Scene, FormatError> {
+    match Format::of(path)? {
+        Format::Project => project::load(path, workers),
+        Format::Vox => {
+            vox::import_file(path, &vox::ImportOptions::default(), workers).map(|(s, _)| s)
+        }
+    }
+}
+
+/// Saves as a `.ron` project or exports `.vox`, atomically, choosing by the extension.
+pub fn save(scene: &Scene, path: &Path) -> Result<(), FormatError> {
+    match Format::of(path)? {
+        Format::Project => project::save(scene, path),
+        Format::Vox => vox::export_file(scene, path).map(|_| ()),
+    }
+}
 
 /// Why a file could not be read or written. Messages name the file and what is wrong.
 #[derive(Debug, thiserror::Error)]
@@ -40,6 +59,22 @@ pub enum FormatError {
         /// The newest version known here.
         known: u32,
     },
+    /// A `.vox` file could not be imported, or a scene not exported as one.
+    #[error("{path}: {error}")]
+    Vox {
+        /// The file.
+        path: String,
+        /// The cause (shown in the message, so not chained again).
+        error: vox::VoxError,
+    },
+    /// A project's voxel payload is corrupt.
+    #[error("{path}: {error}")]
+    Payload {
+        /// The file.
+        path: String,
+        /// What is wrong and where.
+        error: payload::PayloadError,
+    },
     /// The content does not fit the world (grid, materials, budget).
     #[error("{path}: {error}")]
     World {
@@ -61,6 +96,18 @@ impl FormatError {
         FormatError::Io {
             path: path.display().to_string(),
             error: source,
+        }
+    }
+    pub(crate) fn vox(path: &Path, error: vox::VoxError) -> Self {
+        FormatError::Vox {
+            path: path.display().to_string(),
+            error,
+        }
+    }
+    pub(crate) fn payload(path: &Path, error: payload::PayloadError) -> Self {
+        FormatError::Payload {
+            path: path.display().to_string(),
+            error,
         }
     }
     pub(crate) fn world(path: &Path, source: brickmap::BrickmapError) -> Self {

@@ -18,7 +18,7 @@ pub fn load(path: &Path) -> Result<Vec<[u8; 3]>, FormatError> {
     match ext.as_deref() {
         Some("png") => from_png(&bytes).map_err(|m| FormatError::invalid(path, m)),
         Some("vox") => {
-            let data = super::vox::parse(&bytes).map_err(|m| FormatError::invalid(path, m))?;
+            let data = super::vox::parse(&bytes).map_err(|e| FormatError::vox(path, e))?;
             if data.palette.len() < SIZE {
                 return Err(FormatError::invalid(
                     path,

@@ -59,6 +59,70 @@ pub fn encode(view: &WorldView<'_>) -> Vec<u8> {
     out
 }
 
+/// Why a voxel payload cannot be decoded; byte offsets are into the payload.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum PayloadError {
+    /// The first four bytes are not the magic.
+    #[error("voxel payload does not start with VXB1")]
+    NoMagic,
+    /// The payload ends inside a record (its length).
+    #[error("voxel payload truncated at byte {0}")]
+    Truncated(usize),
+    /// More bricks declared than the bytes can hold.
+    #[error("voxel payload declares {declared} bricks but holds at most {most}")]
+    TooManyBricks {
+        /// Bricks declared.
+        declared: u64,
+        /// The most the payload's length allows.
+        most: usize,
+    },
+    /// A brick's cell lies outside the grid.
+    #[error("brick cell beyond the {}×{}×{} grid at payload byte {at}", bricks.x, bricks.y, bricks.z)]
+    CellBeyondGrid {
+        /// The grid in bricks.
+        bricks: UVec3,
+        /// Where.
+        at: usize,
+    },
+    /// A brick record's kind byte is unknown.
+    #[error("unknown brick kind {kind} at payload byte {at}")]
+    UnknownKind {
+        /// The kind byte.
+        kind: u8,
+        /// Where.
+        at: usize,
+    },
+    /// A brick's mask is empty (such bricks are not stored).
+    #[error("empty brick mask at payload byte {0}")]
+    EmptyMask(usize),
+    /// A material index beyond the scene's table.
+    #[error("material {material} at payload byte {at} is beyond the table ({entries} entries)")]
+    MaterialBeyondTable {
+        /// The index.
+        material: u8,
+        /// Where.
+        at: usize,
+        /// Entries in the table.
+        entries: usize,
+    },
+    /// A run of materials longer than the voxels left in its brick (or empty).
+    #[error("material run of {run} at payload byte {at} does not fit the brick's {voxels} voxels")]
+    RunTooLong {
+        /// The run's length.
+        run: u64,
+        /// Where.
+        at: usize,
+        /// Voxels in the brick.
+        voxels: usize,
+    },
+    /// A varint of more than 64 bits.
+    #[error("varint too long at payload byte {0}")]
+    VarintTooLong(usize),
+    /// Bytes after the last brick.
+    #[error("{0} unexpected bytes after the last brick")]
+    TrailingBytes(usize),
+}
+
 /// Decodes a payload for a grid and a table of `materials` entries, checking everything:
 /// on success every brick is in the grid, every material in the table, every mask matches
 /// its materials. Allocation is bounded by the input length.
@@ -66,28 +130,30 @@ pub fn decode(
     bytes: &[u8],
     dims: &GridDims,
     materials: usize,
-) -> Result<Vec<(UVec3, Mask, PriorMaterials)>, String> {
+) -> Result<Vec<(UVec3, Mask, PriorMaterials)>, PayloadError> {
     let mut r = Reader { bytes, at: 0 };
     if r.take(4)? != MAGIC {
-        return Err("voxel payload does not start with VXB1".into());
+        return Err(PayloadError::NoMagic);
     }
     let n = r.varint()?;
     // Every record takes at least two bytes: a count beyond that is a lie, not a reason to
     // reserve memory.
     if n > (bytes.len() as u64) / 2 {
-        return Err(format!(
-            "voxel payload declares {n} bricks but holds at most {}",
-            bytes.len() / 2
-        ));
+        return Err(PayloadError::TooManyBricks {
+            declared: n,
+            most: bytes.len() / 2,
+        });
     }
     let cells = dims.brick_cells() as u64;
     let check = |m: u8, at: usize| {
         if (m as usize) < materials {
             Ok(m)
         } else {
-            Err(format!(
-                "material {m} at payload byte {at} is beyond the table ({materials} entries)"
-            ))
+            Err(PayloadError::MaterialBeyondTable {
+                material: m,
+                at,
+                entries: materials,
+            })
         }
     };
     let mut out = Vec::with_capacity(n as usize);
@@ -98,14 +164,9 @@ pub fn decode(
             .wrapping_add(1)
             .checked_add(gap)
             .filter(|c| *c < cells)
-            .ok_or_else(|| {
-                format!(
-                    "brick cell beyond the {}×{}×{} grid at payload byte {}",
-                    dims.bricks().x,
-                    dims.bricks().y,
-                    dims.bricks().z,
-                    r.at
-                )
+            .ok_or(PayloadError::CellBeyondGrid {
+                bricks: dims.bricks(),
+                at: r.at,
             })?;
         previous = cell;
         let brick = dims.cell_coord(cell as usize);
@@ -128,23 +189,26 @@ pub fn decode(
                     let run = r.varint()?;
                     let m = check(r.byte()?, r.at - 1)?;
                     if run == 0 || run > (want - mats.len()) as u64 {
-                        return Err(format!(
-                            "material run of {run} at payload byte {} does not fit the brick's {want} voxels",
-                            r.at
-                        ));
+                        return Err(PayloadError::RunTooLong {
+                            run,
+                            at: r.at,
+                            voxels: want,
+                        });
                     }
                     mats.resize(mats.len() + run as usize, m);
                 }
                 out.push((brick, mask, PriorMaterials::PerVoxel(mats)));
             }
-            k => return Err(format!("unknown brick kind {k} at payload byte {kind_at}")),
+            k => {
+                return Err(PayloadError::UnknownKind {
+                    kind: k,
+                    at: kind_at,
+                });
+            }
         }
     }
     if r.at != bytes.len() {
-        return Err(format!(
-            "{} unexpected bytes after the last brick",
-            bytes.len() - r.at
-        ));
+        return Err(PayloadError::TrailingBytes(bytes.len() - r.at));
     }
     Ok(out)
 }
@@ -155,26 +219,25 @@ struct Reader<'a> {
 }
 
 impl Reader<'_> {
-    fn take(&mut self, n: usize) -> Result<&[u8], String> {
+    fn take(&mut self, n: usize) -> Result<&[u8], PayloadError> {
         let end = self.at.checked_add(n).filter(|e| *e <= self.bytes.len());
-        let end =
-            end.ok_or_else(|| format!("voxel payload truncated at byte {}", self.bytes.len()))?;
+        let end = end.ok_or(PayloadError::Truncated(self.bytes.len()))?;
         let s = &self.bytes[self.at..end];
         self.at = end;
         Ok(s)
     }
-    fn byte(&mut self) -> Result<u8, String> {
+    fn byte(&mut self) -> Result<u8, PayloadError> {
         Ok(self.take(1)?[0])
     }
-    fn mask(&mut self) -> Result<Mask, String> {
+    fn mask(&mut self) -> Result<Mask, PayloadError> {
         let at = self.at;
         let mask: Mask = bytemuck::pod_read_unaligned(self.take(64)?);
         if mask.is_empty() {
-            return Err(format!("empty brick mask at payload byte {at}"));
+            return Err(PayloadError::EmptyMask(at));
         }
         Ok(mask)
     }
-    fn varint(&mut self) -> Result<u64, String> {
+    fn varint(&mut self) -> Result<u64, PayloadError> {
         let mut v = 0u64;
         for shift in (0..64).step_by(7) {
             let b = self.byte()?;
@@ -183,7 +246,7 @@ impl Reader<'_> {
                 return Ok(v);
             }
         }
-        Err(format!("varint too long at payload byte {}", self.at))
+        Err(PayloadError::VarintTooLong(self.at))
     }
 }
 
@@ -261,17 +324,14 @@ mod tests {
                 }
             }
         }
-        assert!(
-            decode(&bytes, &w.dims(), 2)
-                .unwrap_err()
-                .contains("beyond the table")
-        );
+        assert!(matches!(
+            decode(&bytes, &w.dims(), 2).unwrap_err(),
+            PayloadError::MaterialBeyondTable { entries: 2, .. }
+        ));
         let small = GridDims::new(2, 2, 2).unwrap();
-        assert!(
-            decode(&bytes, &small, 4)
-                .unwrap_err()
-                .contains("beyond the")
-        );
+        let e = decode(&bytes, &small, 4).unwrap_err();
+        assert!(matches!(e, PayloadError::CellBeyondGrid { .. }), "{e}");
+        assert!(e.to_string().contains("beyond the 2×2×2 grid"), "{e}");
     }
 
     #[test]
@@ -279,17 +339,16 @@ mod tests {
         let mut bytes = MAGIC.to_vec();
         put_varint(&mut bytes, u64::MAX / 3);
         let err = decode(&bytes, &GridDims::new(1, 1, 1).unwrap(), 1).unwrap_err();
-        assert!(err.contains("declares"), "{err}");
+        assert!(matches!(err, PayloadError::TooManyBricks { .. }), "{err}");
         let mut runs = MAGIC.to_vec();
         put_varint(&mut runs, 1);
         runs.extend_from_slice(&[0, 2]);
         runs.extend_from_slice(&[0xFF; 64]);
         put_varint(&mut runs, 1 << 40);
         runs.push(0);
-        assert!(
-            decode(&runs, &GridDims::new(1, 1, 1).unwrap(), 1)
-                .unwrap_err()
-                .contains("does not fit")
-        );
+        assert!(matches!(
+            decode(&runs, &GridDims::new(1, 1, 1).unwrap(), 1).unwrap_err(),
+            PayloadError::RunTooLong { run, voxels: 512, .. } if run == 1 << 40
+        ));
     }
 }

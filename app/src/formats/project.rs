@@ -234,13 +234,13 @@ pub fn from_bytes(text: &[u8], path: &Path, workers: usize) -> Result<Scene, For
     let (x, y, z) = file.grid_bricks;
     let dims = GridDims::new(x, y, z).map_err(|e| FormatError::world(path, e))?;
     let table = material_table(
+        path,
         &file.materials,
         &file.colours,
         &file.roughness,
         &file.ior,
         &file.strength,
-    )
-    .map_err(invalid)?;
+    )?;
     if file.voxels.encoding != ENCODING {
         return Err(invalid(format!(
             "unknown voxel encoding {:?} (expected {ENCODING:?})",
@@ -250,7 +250,8 @@ pub fn from_bytes(text: &[u8], path: &Path, workers: usize) -> Result<Scene, For
     let data = base64::engine::general_purpose::STANDARD
         .decode(file.voxels.data.as_bytes())
         .map_err(|e| invalid(format!("voxel payload is not base64: {e}")))?;
-    let bricks = payload::decode(&data, &dims, table.len()).map_err(invalid)?;
+    let bricks =
+        payload::decode(&data, &dims, table.len()).map_err(|e| FormatError::payload(path, e))?;
     if bricks.len() as u64 != file.voxels.bricks {
         return Err(invalid(format!(
             "voxel payload holds {} bricks, the header says {}",
@@ -277,24 +278,27 @@ pub fn from_bytes(text: &[u8], path: &Path, workers: usize) -> Result<Scene, For
     Ok(Scene::new(world, params))
 }
 
+/// The scene's material table from the file's records; an error says which entry is wrong.
 fn material_table(
+    path: &Path,
     materials: &[MaterialRecord],
     colours: &[String],
     roughness: &[f32],
     ior: &[f32],
     strength: &[f32],
-) -> Result<MaterialTable, String> {
+) -> Result<MaterialTable, FormatError> {
+    let invalid = |m: String| FormatError::invalid(path, m);
     if materials.is_empty() || materials.len() > 256 {
-        return Err(format!(
+        return Err(invalid(format!(
             "{} materials: a scene has 1 to 256",
             materials.len()
-        ));
+        )));
     }
     if colours.len() != 256 {
-        return Err(format!(
+        return Err(invalid(format!(
             "{} colours: the colour table has exactly 256",
             colours.len()
-        ));
+        )));
     }
     for (name, t) in [
         ("roughness", roughness),
@@ -302,17 +306,17 @@ fn material_table(
         ("strength", strength),
     ] {
         if t.len() != brickmap::material::PARAMS {
-            return Err(format!(
+            return Err(invalid(format!(
                 "{} {name} values: the table has exactly 64",
                 t.len()
-            ));
+            )));
         }
     }
     let mut table = MaterialTable::default();
     for (i, c) in colours.iter().enumerate() {
         table.set_colour(
             i as u8,
-            parse_colour(c).ok_or_else(|| format!("colour {i} {c:?} is not #rrggbb"))?,
+            parse_colour(c).ok_or_else(|| invalid(format!("colour {i} {c:?} is not #rrggbb")))?,
         );
     }
     for (kind, values) in [
@@ -323,7 +327,7 @@ fn material_table(
         for (i, v) in values.iter().enumerate() {
             table
                 .set_param(kind, i as u8, *v)
-                .map_err(|e| format!("{kind:?} parameter {i}: {e}"))?;
+                .map_err(|e| invalid(format!("{kind:?} parameter {i}: {e}")))?;
         }
     }
     for (i, m) in materials.iter().enumerate() {
@@ -337,7 +341,7 @@ fn material_table(
         } else {
             table.push(m)
         };
-        r.map_err(|e| format!("material {i}: {e}"))?;
+        r.map_err(|e| invalid(format!("material {i}: {e}")))?;
     }
     Ok(table)
 }

@@ -30,10 +30,13 @@ use glam::IVec3;
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
+mod check;
+mod error;
 mod export;
 mod graph;
 mod materials;
 
+pub use error::VoxError;
 pub use export::*;
 pub use graph::*;
 use materials::*;
@@ -75,9 +78,6 @@ pub struct ExportReport {
     pub bytes: u64,
 }
 
-/// The start of the error for a shape whose model does not exist.
-const MISSING_MODEL: &str = "shape refers to missing model";
-
 /// Limits that keep a hostile file from exhausting memory or time.
 const MAX_DEPTH: usize = 64;
 const MAX_PLACED_VOXELS: u64 = 1 << 28;
@@ -96,18 +96,18 @@ fn slab6_dims(bytes: &[u8]) -> Option<(u64, u64, u64)> {
 }
 
 /// Parses `.vox` bytes; a `dot_vox` panic on malformed input is caught and reported.
-pub fn parse(bytes: &[u8]) -> Result<DotVoxData, String> {
+pub fn parse(bytes: &[u8]) -> Result<DotVoxData, VoxError> {
     if let Some((x, y, z)) = slab6_dims(bytes) {
-        return Err(format!(
-            "this is a Ken Silverman SLAB6 .vox (a plain {x}×{y}×{z} volume with a 768-byte palette, no \"VOX \" header), which voxbrick does not import; MagicaVoxel or vengi can convert it"
-        ));
+        return Err(VoxError::Slab6(x, y, z));
     }
-    super::vox_check::check(bytes).map_err(|e| format!("not a valid .vox file: {e}"))?;
+    check::check(bytes)?;
     let parsed = std::panic::catch_unwind(|| dot_vox::load_bytes(bytes));
     match parsed {
         Ok(Ok(data)) => Ok(data),
-        Ok(Err(e)) => Err(format!("not a valid .vox file: {e}")),
-        Err(_) => Err("not a valid .vox file: the parser failed on malformed data".into()),
+        Ok(Err(e)) => Err(VoxError::Malformed(e.to_string())),
+        Err(_) => Err(VoxError::Malformed(
+            "the parser failed on malformed data".into(),
+        )),
     }
 }
 
@@ -128,15 +128,11 @@ pub fn import_bytes(
     options: &ImportOptions,
     workers: usize,
 ) -> Result<(Scene, ImportReport), FormatError> {
-    let invalid = |m: String| FormatError::invalid(path, m);
+    let invalid = |e: VoxError| FormatError::vox(path, e);
     let (data, placed, mut report) = prepare(bytes, options).map_err(invalid)?;
     let top = bounds(&placed).map_or(IVec3::ZERO, |b| b.1);
-    let dims = GridDims::from_voxels((top + 1).max(IVec3::ONE).as_uvec3()).map_err(|_| {
-        invalid(format!(
-            "the model needs a {} voxel grid, beyond the largest supported",
-            top + 1
-        ))
-    })?;
+    let dims = GridDims::from_voxels((top + 1).max(IVec3::ONE).as_uvec3())
+        .map_err(|_| invalid(VoxError::TooLarge(top + 1)))?;
     let mut scene = Scene::empty(dims, workers).map_err(|e| FormatError::world(path, e))?;
     if let Some((lo, hi)) = bounds(&placed) {
         // Framed whole (the default camera's direction), as the editor's "frame the scene".
@@ -168,16 +164,16 @@ pub fn import_into(
     bytes: &[u8],
     options: &ImportOptions,
     material: Option<u8>,
-) -> Result<(ImportReport, brickmap::EditInverse), String> {
+) -> Result<(ImportReport, brickmap::EditInverse), VoxError> {
     let (data, mut placed, mut report) = prepare(bytes, options)?;
     let dims = world.dims();
     let before = placed.len();
     placed.retain(|(p, _)| dims.contains_voxel(*p));
     if placed.is_empty() && before > 0 {
-        return Err(format!(
-            "nothing to import: all {before} voxels land outside the {} voxel grid (try another offset)",
-            dims.voxels()
-        ));
+        return Err(VoxError::OutsideGrid {
+            voxels: before,
+            grid: dims.voxels(),
+        });
     }
     if placed.len() < before {
         report.dropped.push(format!(
@@ -187,10 +183,7 @@ pub fn import_into(
     }
     let map = match material {
         Some(m) => {
-            world
-                .materials()
-                .check(m as u32)
-                .map_err(|e| e.to_string())?;
+            world.materials().check(m as u32)?;
             [m; 256]
         }
         None => {
@@ -201,13 +194,12 @@ pub fn import_into(
             })?
         }
     };
-    let inverse = write_voxels(world, &placed, |i| map[i as usize], &mut report)
-        .map_err(|e| e.to_string())?;
+    let inverse = write_voxels(world, &placed, |i| map[i as usize], &mut report)?;
     Ok((report, inverse))
 }
 
 /// The size in voxels (voxbrick axes) of what importing `bytes` would place.
-pub fn extent(bytes: &[u8]) -> Result<IVec3, String> {
+pub fn extent(bytes: &[u8]) -> Result<IVec3, VoxError> {
     let (_, placed, _) = prepare(bytes, &ImportOptions::default())?;
     Ok(bounds(&placed).map_or(IVec3::ZERO, |(lo, hi)| hi - lo + 1))
 }
@@ -229,7 +221,7 @@ impl ImportReport {
 type Prepared = (DotVoxData, Vec<(IVec3, u8)>, ImportReport);
 
 /// Parses, places every instance and shifts into the grid (see the module docs).
-fn prepare(bytes: &[u8], options: &ImportOptions) -> Result<Prepared, String> {
+fn prepare(bytes: &[u8], options: &ImportOptions) -> Result<Prepared, VoxError> {
     let data = parse(bytes)?;
     let mut report = ImportReport {
         models: data.models.len(),
@@ -241,17 +233,13 @@ fn prepare(bytes: &[u8], options: &ImportOptions) -> Result<Prepared, String> {
             .iter()
             .map(|(id, n)| format!("unsupported chunk {id} ignored (×{n})")),
     );
-    let mut placed = place_instances(&data, options, &mut report).map_err(|e| {
+    let mut placed = place_instances(&data, options, &mut report).map_err(|e| match e {
         // A shape whose model is not in SIZE/XYZI chunks: its voxels are elsewhere.
-        if e.starts_with(MISSING_MODEL) && !unmapped.is_empty() {
-            let chunks: Vec<String> = unmapped.keys().map(|id| describe_chunk(id)).collect();
-            format!(
-                "{e}: its voxels are not in SIZE/XYZI chunks; the file also holds {}, which voxbrick does not read",
-                chunks.join(", ")
-            )
-        } else {
-            e
-        }
+        VoxError::MissingModel { model, .. } => VoxError::MissingModel {
+            model,
+            unread: unmapped.keys().map(|id| describe_chunk(id)).collect(),
+        },
+        e => e,
     })?;
     let declared: u64 = data.models.iter().map(|m| m.voxels.len() as u64).sum();
     if placed.is_empty() && declared > 0 {
@@ -261,18 +249,16 @@ fn prepare(bytes: &[u8], options: &ImportOptions) -> Result<Prepared, String> {
         } else {
             report.dropped.join("; ")
         };
-        return Err(format!(
-            "nothing to import: the file's {} models hold {declared} voxels, and every one was left out ({why})",
-            data.models.len()
-        ));
+        return Err(VoxError::NothingPlaced {
+            models: data.models.len(),
+            voxels: declared,
+            why,
+        });
     }
     if let Some((lo, _)) = bounds(&placed) {
         let shift = (-lo).max(IVec3::ZERO) + options.offset;
         if (lo + shift).cmplt(IVec3::ZERO).any() {
-            return Err(format!(
-                "the offset {} moves voxels below the grid origin",
-                options.offset
-            ));
+            return Err(VoxError::BelowOrigin(options.offset));
         }
         for (p, _) in &mut placed {
             *p += shift;
@@ -340,7 +326,7 @@ fn colour_slot(
     world: &World,
     c: Color,
     taken: &mut std::collections::HashSet<u8>,
-) -> Result<u8, String> {
+) -> Result<u8, VoxError> {
     let rgb = [c.r, c.g, c.b];
     let table = world.materials();
     if let Some(i) = (0..=255u8).find(|&i| table.colour(i) == rgb) {
@@ -354,7 +340,7 @@ fn colour_slot(
         .rev()
         .find(|i| !used.contains(i) && !taken.contains(i));
     drop(table);
-    let slot = free.ok_or("no free colour slot: every colour is used by a material")?;
+    let slot = free.ok_or(VoxError::NoFreeColour)?;
     taken.insert(slot);
     world.set_colour(slot, rgb);
     Ok(slot)

@@ -62,7 +62,7 @@ impl EditorSession {
         )?;
         let file = dir.join(format!("soak-editor-{}.ron", opts.seed));
         let (scene, _) = super::start_scene(opts)?;
-        scene.save(&file).context("the soak's start file")?;
+        crate::formats::save(&scene, &file).context("the soak's start file")?;
         let device = opts.device.clone().unwrap_or_else(|| "gpu".into());
         let editor = Editor::headless(
             EditorOptions {
@@ -566,7 +566,7 @@ impl EditorSession {
         self.settle()?;
         let dirty = doc.read().unwrap_or_else(|p| p.into_inner()).dirty;
         ensure!(!dirty, "Ctrl+S left the document unsaved");
-        let loaded = crate::Scene::load(&path, self.opts.workers)
+        let loaded = crate::formats::load(&path, self.opts.workers)
             .context("reloading the save")?
             .world
             .read()

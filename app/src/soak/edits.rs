@@ -7,7 +7,6 @@
 //! window's would. Each edit is waited for, so each event's invariants are checked on its own.
 
 use super::{Rng, SoakOptions, SoakReport, rss};
-use crate::Scene;
 use crate::editor::Document;
 use crate::editor::command::{
     Axis, BrushMode, BrushShape, Command, KindSpec, MaterialSpec, Mirror, Stroke, TerrainSpec,
@@ -393,7 +392,7 @@ impl Session {
             let mut d = self.doc.write().unwrap_or_else(|p| p.into_inner());
             d.save(&path).context("saving")?;
         }
-        let scene = Scene::load(&path, self.opts.workers).context("reloading the save")?;
+        let scene = crate::formats::load(&path, self.opts.workers).context("reloading the save")?;
         let loaded = scene.world.read().content_hash();
         ensure!(
             loaded == before,

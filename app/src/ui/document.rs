@@ -353,7 +353,7 @@ impl Editor {
             let recovery = self.config.recovery_file();
             match std::fs::create_dir_all(self.config.0.as_path())
                 .map_err(anyhow::Error::from)
-                .and_then(|()| Ok(self.read().scene.save(&recovery)?))
+                .and_then(|()| Ok(crate::formats::save(&self.read().scene, &recovery)?))
             {
                 Ok(()) => eprintln!(
                     "voxbrick: unsaved work is in {} (offered on the next start)",
@@ -395,7 +395,7 @@ impl Editor {
                 .save_file()
         });
         if let Some(path) = path {
-            match self.read().scene.save(&path) {
+            match crate::formats::save(&self.read().scene, &path) {
                 Ok(()) => eprintln!("voxbrick: saved {}", path.display()),
                 Err(e) => eprintln!("voxbrick: saving {} failed: {e}", path.display()),
             }

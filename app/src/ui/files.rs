@@ -250,8 +250,8 @@ impl FileWorker {
     pub fn load(&mut self, path: PathBuf, workers: usize) {
         self.spawn(format!("opening {}", path.display()), move || {
             // The format's error names the file already.
-            let scene =
-                Scene::load(&path, workers).map_err(|e| anyhow::anyhow!("Could not open {e}"));
+            let scene = crate::formats::load(&path, workers)
+                .map_err(|e| anyhow::anyhow!("Could not open {e}"));
             Done::Loaded(Some(path), Box::new(scene))
         });
     }
@@ -282,7 +282,7 @@ impl FileWorker {
     /// Builds the embedded default scene on a worker thread.
     pub fn build_default(&mut self, workers: usize) {
         self.spawn("building the default scene".into(), move || {
-            let scene = crate::scene::default_scene(crate::scene::SceneSize::Full, workers);
+            let scene = crate::builtin::default_scene(crate::builtin::SceneSize::Full, workers);
             Done::Loaded(None, Box::new(scene))
         });
     }
@@ -336,8 +336,7 @@ fn save_scene(scene: &Scene, path: &Path, autosave: bool) -> Result<()> {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     // The format's error names the file already.
-    scene
-        .save(path)
+    crate::formats::save(scene, path)
         .map_err(|e| anyhow::anyhow!("Could not save {e}; pick another place with Save As"))
 }
 

@@ -366,7 +366,7 @@ mod tests {
         let vox = dir.join("one.vox");
         let mut scene = Scene::empty(GridDims::new(1, 1, 1).unwrap(), 1).unwrap();
         sphere(2.0).apply(&mut scene, &dir).unwrap();
-        scene.save(&vox).unwrap();
+        crate::formats::save(&scene, &vox).unwrap();
         q.submit(&d, import(vox.display().to_string()));
         let Edited::Command(_, Ok(done), _) = next(&mut q) else {
             panic!("the import works")

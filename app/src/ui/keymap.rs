@@ -41,9 +41,36 @@ impl Default for KeyMap {
     }
 }
 
+/// Why a key map cannot be read.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum KeyMapError {
+    /// keys.ron is not a list of bindings.
+    #[error("{0}")]
+    Syntax(String),
+    /// A chord without a key ("Ctrl+").
+    #[error("\"{0}\": no key")]
+    NoKey(String),
+    /// A modifier that is not Ctrl, Shift or Alt.
+    #[error("\"{chord}\": \"{modifier}\" is not Ctrl, Shift or Alt")]
+    Modifier {
+        /// The chord as written.
+        chord: String,
+        /// The word that is not a modifier.
+        modifier: String,
+    },
+    /// A key name that names no key.
+    #[error("\"{chord}\": no key is called \"{key}\"")]
+    UnknownKey {
+        /// The chord as written.
+        chord: String,
+        /// The name.
+        key: String,
+    },
+}
+
 impl KeyMap {
     /// The map of these bindings; an error names the first bad chord.
-    pub fn from_bindings(bindings: &[Binding]) -> Result<Self, String> {
+    pub fn from_bindings(bindings: &[Binding]) -> Result<Self, KeyMapError> {
         let chords = bindings
             .iter()
             .map(|b| parse_chord(&b.keys).map(|c| (c, b.action)))
@@ -84,8 +111,9 @@ impl KeyMap {
     /// Parses keys.ron's text. An action the file does not bind keeps its default chord when
     /// the file does not use that chord for something else (a file written by an older
     /// version still gets the shortcuts added since).
-    pub fn parse(text: &str) -> Result<Self, String> {
-        let mut bindings: Vec<Binding> = ron::from_str(text).map_err(|e| e.to_string())?;
+    pub fn parse(text: &str) -> Result<Self, KeyMapError> {
+        let mut bindings: Vec<Binding> =
+            ron::from_str(text).map_err(|e| KeyMapError::Syntax(e.to_string()))?;
         let user = Self::from_bindings(&bindings)?;
         for d in default_bindings() {
             let chord = parse_chord(&d.keys)?;
@@ -159,23 +187,31 @@ pub fn default_bindings() -> Vec<Binding> {
         .collect()
 }
 
-fn parse_chord(s: &str) -> Result<Chord, String> {
+fn parse_chord(s: &str) -> Result<Chord, KeyMapError> {
     let mut mods = Mods::default();
     let parts: Vec<&str> = s.split('+').map(str::trim).collect();
     // "Ctrl++" would be Ctrl and "+"; no default uses it, and "+" alone is allowed.
     let (key, held) = match parts.split_last() {
         Some((k, held)) if !k.is_empty() => (*k, held),
-        _ => return Err(format!("\"{s}\": no key")),
+        _ => return Err(KeyMapError::NoKey(s.to_string())),
     };
     for m in held {
         match m.to_ascii_lowercase().as_str() {
             "ctrl" | "control" | "cmd" => mods.ctrl = true,
             "shift" => mods.shift = true,
             "alt" => mods.alt = true,
-            other => return Err(format!("\"{s}\": \"{other}\" is not Ctrl, Shift or Alt")),
+            other => {
+                return Err(KeyMapError::Modifier {
+                    chord: s.to_string(),
+                    modifier: other.to_string(),
+                });
+            }
         }
     }
-    let key = key_code(key).ok_or_else(|| format!("\"{s}\": no key is called \"{key}\""))?;
+    let key = key_code(key).ok_or_else(|| KeyMapError::UnknownKey {
+        chord: s.to_string(),
+        key: key.to_string(),
+    })?;
     Ok(Chord { key, mods })
 }
 
@@ -343,9 +379,29 @@ mod tests {
             "the defaults are replaced"
         );
         let err = KeyMap::parse(r#"[(keys: "Ctrl+Banana", action: Undo)]"#).unwrap_err();
-        assert!(err.contains("Banana"), "{err}");
+        assert_eq!(
+            err,
+            KeyMapError::UnknownKey {
+                chord: "Ctrl+Banana".into(),
+                key: "Banana".into()
+            }
+        );
+        assert!(
+            err.to_string().contains("no key is called \"Banana\""),
+            "{err}"
+        );
         let err = KeyMap::parse(r#"[(keys: "Hyper+Z", action: Undo)]"#).unwrap_err();
-        assert!(err.contains("Hyper"), "{err}");
-        assert!(KeyMap::parse(r#"[(keys: "Z", action: Fly)]"#).is_err());
+        assert!(
+            matches!(err, KeyMapError::Modifier { ref modifier, .. } if modifier == "hyper"),
+            "{err}"
+        );
+        assert!(matches!(
+            KeyMap::parse(r#"[(keys: "Z", action: Fly)]"#),
+            Err(KeyMapError::Syntax(_))
+        ));
+        assert!(matches!(
+            KeyMap::parse(r#"[(keys: "Ctrl+", action: Undo)]"#),
+            Err(KeyMapError::NoKey(_))
+        ));
     }
 }

@@ -289,7 +289,7 @@ fn bench(b: Bench, workers: usize) -> Result<String> {
         None => CameraPath::thesis(),
     };
     let presets = select_presets(&b.presets)?;
-    let mut scene = app::scene::thesis_scene(workers)?;
+    let mut scene = app::builtin::thesis_scene(workers)?;
     // The path's sun circles the scene; the scene's own sun gives its height and distance.
     scene.params.sun.animate = true;
     scene.params.sun.speed_deg_per_s = path.sun_deg_per_s;

@@ -526,7 +526,7 @@ fn bench_error(b: BenchError, workers: usize) -> Result<String> {
             let mut scene = if *lamps {
                 super::bench_lights::thesis_with_lamps(workers)?
             } else {
-                app::scene::thesis_scene(workers)?
+                app::builtin::thesis_scene(workers)?
             };
             scene.params.sun.animate = true;
             scene.params.sun.speed_deg_per_s = path.sun_deg_per_s;

@@ -3,7 +3,7 @@
 
 use super::{emit, with_progress};
 use anyhow::{Context, Result, bail};
-use app::scene::thesis_scene;
+use app::builtin::thesis_scene;
 use render::viewport::RenderHow;
 
 /// `voxbrick bench-gpu`: what to measure.

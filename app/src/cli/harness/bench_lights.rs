@@ -8,7 +8,7 @@
 use super::with_progress;
 use anyhow::{Context, Result, bail};
 use app::Scene;
-use app::scene::thesis_scene;
+use app::builtin::thesis_scene;
 use brickmap::{EditOp, GpuBuffer, GridDims, MaterialKind, Mode, Shape};
 use glam::{DVec3, IVec3};
 use render::cpu::RenderJob;

@@ -483,7 +483,7 @@ pub(crate) fn run(b: BenchSkips, workers: usize) -> Result<()> {
 fn bench_skips(b: BenchSkips, workers: usize) -> Result<String> {
     std::fs::create_dir_all(&b.out).with_context(|| format!("creating {}", b.out.display()))?;
     let ctx = app::gpu::context(&b.device, false)?;
-    let thesis = app::scene::thesis_scene(workers)?;
+    let thesis = app::builtin::thesis_scene(workers)?;
     let path = CameraPath::thesis();
     let preset = &PRESETS[2];
     let centre = thesis.world.read().dims().voxels().as_dvec3() * 0.5;

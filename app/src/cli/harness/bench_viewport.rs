@@ -6,7 +6,7 @@
 
 use super::{args, emit, with_progress};
 use anyhow::{Result, bail};
-use app::scene::{SceneSize, default_scene, thesis_scene};
+use app::builtin::{SceneSize, default_scene, thesis_scene};
 use brickmap::World;
 use render::SceneParams;
 use render::present::{EguiFrame, Presented, Presenter};

@@ -5,7 +5,7 @@ use super::*;
 
 /// The `.vox` data of a scene: ≤ 256³ models under one group, a palette slot per used
 /// material (at most 255), MATL for each.
-pub fn export_data(world: &World) -> Result<DotVoxData, String> {
+pub fn export_data(world: &World) -> Result<DotVoxData, VoxError> {
     let view = world.read();
     let table = view.materials();
     let mut slot_of = [u8::MAX; 256];
@@ -21,9 +21,7 @@ pub fn export_data(world: &World) -> Result<DotVoxData, String> {
             };
             if slot_of[m as usize] == u8::MAX {
                 if used.len() == 255 {
-                    failure.get_or_insert_with(|| {
-                        "the scene uses more than 255 materials; .vox holds at most 255".to_string()
-                    });
+                    failure.get_or_insert(VoxError::TooManyMaterials);
                     return;
                 }
                 slot_of[m as usize] = used.len() as u8;
@@ -51,12 +49,10 @@ pub fn export_data(world: &World) -> Result<DotVoxData, String> {
     let mut palette = dot_vox::DEFAULT_PALETTE.to_vec();
     let mut materials = Vec::new();
     for (slot, &m) in used.iter().enumerate() {
-        let mat = table.get(m).map_err(|e| e.to_string())?;
+        let mat = table.get(m)?;
         let [r, g, b] = table.colour(mat.colour);
         palette[slot] = Color { r, g, b, a: 255 };
-        let param = table
-            .param(mat.kind, mat.param)
-            .map_err(|e| e.to_string())?;
+        let param = table.param(mat.kind, mat.param)?;
         let mut props = dot_vox::Dict::new();
         let mut set = |k: &str, v: String| {
             props.insert(k.to_string(), v);
@@ -149,7 +145,7 @@ pub fn export_data(world: &World) -> Result<DotVoxData, String> {
 
 /// Exports a scene to a `.vox` file, atomically.
 pub fn export_file(scene: &Scene, path: &Path) -> Result<ExportReport, FormatError> {
-    let data = export_data(&scene.world).map_err(|m| FormatError::invalid(path, m))?;
+    let data = export_data(&scene.world).map_err(|e| FormatError::vox(path, e))?;
     let mut bytes = Vec::new();
     data.write_vox(&mut bytes)
         .map_err(|e| FormatError::io(path, e))?;

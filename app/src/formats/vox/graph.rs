@@ -79,7 +79,7 @@ pub(super) fn place_instances(
     data: &DotVoxData,
     options: &ImportOptions,
     report: &mut ImportReport,
-) -> Result<Vec<(IVec3, u8)>, String> {
+) -> Result<Vec<(IVec3, u8)>, VoxError> {
     let mut out = Vec::new();
     if data.scenes.is_empty() {
         // Without a scene graph (files before MagicaVoxel 0.99), several SIZE/XYZI pairs are
@@ -121,14 +121,12 @@ pub(super) fn walk(
     out: &mut Vec<(IVec3, u8)>,
     report: &mut ImportReport,
     notes: &mut BTreeMap<String, usize>,
-) -> Result<(), String> {
+) -> Result<(), VoxError> {
     if depth > MAX_DEPTH {
-        return Err(format!(
-            "scene graph deeper than {MAX_DEPTH} levels (or cyclic)"
-        ));
+        return Err(VoxError::TooDeep);
     }
     let Some(n) = data.scenes.get(node as usize) else {
-        return Err(format!("scene graph refers to missing node {node}"));
+        return Err(VoxError::MissingNode(node));
     };
     let hidden = |attrs: &dot_vox::Dict| attrs.get("_hidden").is_some_and(|v| v == "1");
     match n {
@@ -164,9 +162,10 @@ pub(super) fn walk(
                         .filter_map(|s| s.parse().ok())
                         .collect();
                     if v.len() != 3 || v.iter().any(|c| c.abs() > 1 << 20) {
-                        return Err(format!(
-                            "node {node}: translation {t:?} is not three integers within ±2^20"
-                        ));
+                        return Err(VoxError::BadTranslation {
+                            node,
+                            value: t.clone(),
+                        });
                     }
                     local.t = IVec3::new(v[0], v[1], v[2]);
                 }
@@ -215,7 +214,10 @@ pub(super) fn walk(
                 let model = data
                     .models
                     .get(m.model_id as usize)
-                    .ok_or_else(|| format!("{MISSING_MODEL} {}", m.model_id))?;
+                    .ok_or(VoxError::MissingModel {
+                        model: m.model_id,
+                        unread: Vec::new(),
+                    })?;
                 place_model(model, parent, out)?;
                 report.instances += 1;
             }
@@ -228,11 +230,9 @@ pub(super) fn place_model(
     model: &Model,
     tr: Transform,
     out: &mut Vec<(IVec3, u8)>,
-) -> Result<(), String> {
+) -> Result<(), VoxError> {
     if out.len() as u64 + model.voxels.len() as u64 > MAX_PLACED_VOXELS {
-        return Err(format!(
-            "the scene places more than {MAX_PLACED_VOXELS} voxels"
-        ));
+        return Err(VoxError::TooManyVoxels);
     }
     let size = IVec3::new(
         model.size.x as i32,

@@ -11,8 +11,8 @@ pub(super) fn install_materials(
     data: &DotVoxData,
     placed: &[(IVec3, u8)],
     report: &mut ImportReport,
-    mut colour_of: impl FnMut(u8) -> Result<u8, String>,
-) -> Result<[u8; 256], String> {
+    mut colour_of: impl FnMut(u8) -> Result<u8, VoxError>,
+) -> Result<[u8; 256], VoxError> {
     let matl: HashMap<u32, &dot_vox::Dict> = data
         .materials
         .iter()
@@ -42,10 +42,10 @@ pub(super) fn install_materials(
             (None, Some(idx)) if !fresh || idx != 0 || !created.is_empty() => idx,
             // In a new scene the default material 0 is replaced by the first one imported.
             (None, _) if fresh && created.is_empty() => {
-                world.set_material(0, m).map_err(|e| e.to_string())?;
+                world.set_material(0, m)?;
                 0
             }
-            (None, _) => world.push_material(m).map_err(|e| e.to_string())?,
+            (None, _) => world.push_material(m)?,
         };
         created.insert(m, index);
         map[i] = index;
@@ -63,24 +63,24 @@ pub(super) struct ParamSlots {
 }
 
 impl ParamSlots {
-    fn slot(&mut self, world: &World, kind: MaterialKind, value: f32) -> Result<u8, String> {
+    fn slot(&mut self, world: &World, kind: MaterialKind, value: f32) -> Result<u8, VoxError> {
         let table = world.materials();
         for i in 0..brickmap::material::PARAMS as u8 {
-            if (table.param(kind, i).map_err(|e| e.to_string())? - value).abs() < 1e-4 {
+            if (table.param(kind, i)? - value).abs() < 1e-4 {
                 return Ok(i);
             }
         }
         drop(table);
         let next = self.next.entry(kind).or_insert(2);
         if *next as usize >= brickmap::material::PARAMS {
-            return Err(format!(
-                "more than {} distinct {kind:?} parameters",
-                brickmap::material::PARAMS - 2
-            ));
+            return Err(VoxError::TooManyParameters {
+                kind,
+                max: brickmap::material::PARAMS - 2,
+            });
         }
         let i = *next;
         *next += 1;
-        world.set_param(kind, i, value).map_err(|e| e.to_string())?;
+        world.set_param(kind, i, value)?;
         Ok(i)
     }
 }
@@ -91,7 +91,7 @@ pub(super) fn material_from_matl(
     props: Option<&dot_vox::Dict>,
     params: &mut ParamSlots,
     notes: &mut BTreeMap<String, usize>,
-) -> Result<Material, String> {
+) -> Result<Material, VoxError> {
     let lambertian = Material::lambertian(colour);
     let Some(props) = props else {
         return Ok(lambertian);

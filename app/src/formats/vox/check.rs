@@ -10,8 +10,10 @@
 //! little-endian), N content bytes, M bytes of child chunks. `SIZE` holds x, y, z (u32); the
 //! `XYZI` after it holds a count and count × (x, y, z, colour index) bytes.
 
+use super::VoxError;
+
 /// MagicaVoxel's largest model side.
-pub const MAX_MODEL_SIDE: u32 = 256;
+const MAX_MODEL_SIDE: u32 = 256;
 
 fn u32_at(bytes: &[u8], at: usize) -> Option<u32> {
     bytes
@@ -34,21 +36,21 @@ fn id_text(id: &[u8]) -> String {
 
 /// Checks the chunk structure of `.vox` bytes that start with "VOX " (other bytes are left
 /// to the parser's own error). The error names the chunk and its byte offset.
-pub fn check(bytes: &[u8]) -> Result<(), String> {
+pub fn check(bytes: &[u8]) -> Result<(), VoxError> {
     if !bytes.starts_with(b"VOX ") {
         return Ok(());
     }
     if bytes.len() < 8 + 12 {
-        return Err(format!(
+        return Err(VoxError::Malformed(format!(
             "the file ends after {} bytes, inside its header (a .vox needs at least 20: \"VOX \", a version and the MAIN chunk's header)",
             bytes.len()
-        ));
+        )));
     }
     if &bytes[8..12] != b"MAIN" {
-        return Err(format!(
+        return Err(VoxError::Malformed(format!(
             "the first chunk (byte 8) is {:?}, not MAIN",
             id_text(&bytes[8..12])
-        ));
+        )));
     }
     let (n, m) = (
         u32_at(bytes, 12).unwrap_or(0) as u64,
@@ -56,10 +58,10 @@ pub fn check(bytes: &[u8]) -> Result<(), String> {
     );
     let end = 20 + n + m;
     if end > bytes.len() as u64 {
-        return Err(format!(
+        return Err(VoxError::Malformed(format!(
             "chunk MAIN at byte 8 declares {n} content and {m} children bytes, but the file ends {} bytes short (truncated)",
             end - bytes.len() as u64
-        ));
+        )));
     }
     let mut at = 20 + n as usize;
     let end = end as usize;
@@ -67,10 +69,10 @@ pub fn check(bytes: &[u8]) -> Result<(), String> {
     let mut size: Option<(usize, [u32; 3])> = None;
     while at < end {
         if end - at < 12 {
-            return Err(format!(
+            return Err(VoxError::Malformed(format!(
                 "a chunk header at byte {at} is cut off: {} bytes left of the 12 a header needs (truncated)",
                 end - at
-            ));
+            )));
         }
         let id = &bytes[at..at + 4];
         let name = id_text(id);
@@ -78,62 +80,62 @@ pub fn check(bytes: &[u8]) -> Result<(), String> {
         let m = u32_at(bytes, at + 8).unwrap_or(0) as u64;
         let next = at as u64 + 12 + n + m;
         if next > end as u64 {
-            return Err(format!(
+            return Err(VoxError::Malformed(format!(
                 "chunk {name} at byte {at} declares {n} content and {m} children bytes, {} more than its parent holds (truncated)",
                 next - end as u64
-            ));
+            )));
         }
         let content = &bytes[at + 12..at + 12 + n as usize];
         match id {
             b"SIZE" => {
                 if let Some((prev, _)) = size {
-                    return Err(format!(
+                    return Err(VoxError::Malformed(format!(
                         "chunk SIZE at byte {at} follows the SIZE at byte {prev} without its XYZI"
-                    ));
+                    )));
                 }
                 if content.len() < 12 {
-                    return Err(format!(
+                    return Err(VoxError::Malformed(format!(
                         "chunk SIZE at byte {at} holds {} content bytes, not the 12 of a model size",
                         content.len()
-                    ));
+                    )));
                 }
                 let dims = [0, 4, 8].map(|o| u32_at(content, o).unwrap_or(0));
                 if dims.iter().any(|&d| d == 0 || d > MAX_MODEL_SIDE) {
-                    return Err(format!(
+                    return Err(VoxError::Malformed(format!(
                         "chunk SIZE at byte {at} declares a {} × {} × {} model; MagicaVoxel's models are 1..{MAX_MODEL_SIDE} voxels on each axis",
                         dims[0], dims[1], dims[2]
-                    ));
+                    )));
                 }
                 size = Some((at, dims));
             }
             b"XYZI" => {
                 let Some((_, dims)) = size.take() else {
-                    return Err(format!(
+                    return Err(VoxError::Malformed(format!(
                         "chunk XYZI at byte {at} has no SIZE chunk before it (a model's size comes first)"
-                    ));
+                    )));
                 };
                 let Some(count) = u32_at(content, 0) else {
-                    return Err(format!(
+                    return Err(VoxError::Malformed(format!(
                         "chunk XYZI at byte {at} holds {} content bytes, too few for its voxel count",
                         content.len()
-                    ));
+                    )));
                 };
                 let room = (content.len() as u64 - 4) / 4;
                 if u64::from(count) > room {
-                    return Err(format!(
+                    return Err(VoxError::Malformed(format!(
                         "chunk XYZI at byte {at} claims {count} voxels but holds {room} ({} content bytes)",
                         content.len()
-                    ));
+                    )));
                 }
                 for (k, v) in content[4..4 + 4 * count as usize]
                     .chunks_exact(4)
                     .enumerate()
                 {
                     if (0..3).any(|a| u32::from(v[a]) >= dims[a]) {
-                        return Err(format!(
+                        return Err(VoxError::Malformed(format!(
                             "chunk XYZI at byte {at}: voxel {k} at ({}, {}, {}) lies outside its {} × {} × {} model",
                             v[0], v[1], v[2], dims[0], dims[1], dims[2]
-                        ));
+                        )));
                     }
                 }
             }
@@ -142,9 +144,9 @@ pub fn check(bytes: &[u8]) -> Result<(), String> {
         at = next as usize;
     }
     if let Some((prev, _)) = size {
-        return Err(format!(
+        return Err(VoxError::Malformed(format!(
             "chunk SIZE at byte {prev} has no XYZI chunk after it (the model's voxels are missing)"
-        ));
+        )));
     }
     Ok(())
 }
@@ -228,7 +230,7 @@ mod tests {
             (b"VOX \x96\0\0\0MA".to_vec(), "inside its header"),
         ];
         for (bytes, want) in cases {
-            let e = check(&bytes).unwrap_err();
+            let e = check(&bytes).unwrap_err().to_string();
             assert!(e.contains(want), "{e:?} lacks {want:?}");
         }
         // Truncations at every length of a good file: each refused, none panics.
@@ -242,7 +244,7 @@ mod tests {
         check(&good).unwrap();
         for len in 0..good.len() {
             if len >= 4 {
-                let e = check(&good[..len]).unwrap_err();
+                let e = check(&good[..len]).unwrap_err().to_string();
                 assert!(e.contains("byte") || e.contains("bytes"), "{len}: {e}");
             }
         }
@@ -250,7 +252,7 @@ mod tests {
         let mut long = file(&size(2, 2, 2));
         let at = 20 + 4;
         long[at..at + 4].copy_from_slice(&100u32.to_le_bytes());
-        let e = check(&long).unwrap_err();
+        let e = check(&long).unwrap_err().to_string();
         assert!(
             e.contains("chunk SIZE at byte 20 declares 100 content"),
             "{e}"
