@@ -5,6 +5,8 @@
 //! restores the prior content, and applying it returns the inverse of that in turn (redo).
 
 use crate::brick::Mask;
+use crate::error::{BrickmapError, Result};
+use crate::material::MaterialTable;
 use crate::shape::Shape;
 use glam::{IVec3, UVec3};
 use std::sync::Arc;
@@ -155,4 +157,59 @@ pub struct EditOutcome {
     pub inverse: EditInverse,
     /// Voxels whose occupancy or material changed.
     pub changed_voxels: u64,
+}
+
+/// Checks an edit against a table and a grid of `voxels` (a world's or a model's) before
+/// anything changes: finite shapes, material indices in the table, single voxels and restored
+/// bricks inside, restored materials counted right. Shapes are clipped, not refused.
+pub(crate) fn validate(op: &EditOp, table: &MaterialTable, voxels: IVec3) -> Result<()> {
+    let inside = |v: IVec3| v.cmpge(IVec3::ZERO).all() && v.cmplt(voxels).all();
+    match op {
+        EditOp::Shape { shape, mode } => {
+            shape.validate()?;
+            if let Shape::Voxel(v) = shape
+                && !inside(*v)
+            {
+                return Err(BrickmapError::OutOfRange(*v, voxels));
+            }
+            if let Mode::Add(m) | Mode::Paint(m) = mode {
+                table.check(*m as u32)?;
+            }
+        }
+        EditOp::Voxels(list) => {
+            for e in list {
+                if !inside(e.pos) {
+                    return Err(BrickmapError::OutOfRange(e.pos, voxels));
+                }
+                if let VoxelOp::Set(m) | VoxelOp::Paint(m) = e.op {
+                    table.check(m as u32)?;
+                }
+            }
+        }
+        EditOp::Generate(g) => {
+            for m in g.0.materials() {
+                table.check(m as u32)?;
+            }
+        }
+        EditOp::Restore(inv) => {
+            let bricks = (voxels + 7) / 8;
+            for u in &inv.bricks {
+                if u.brick.as_ivec3().cmpge(bricks).any() {
+                    return Err(BrickmapError::BadInverse("brick outside the grid"));
+                }
+                match &u.prior {
+                    PriorMaterials::Uniform(m) => table.check(*m as u32)?,
+                    PriorMaterials::PerVoxel(v) => {
+                        if v.len() != u.prior_mask.and(&u.touched).count() as usize {
+                            return Err(BrickmapError::BadInverse("material count mismatch"));
+                        }
+                        for m in v {
+                            table.check(*m as u32)?;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
 }

@@ -21,6 +21,7 @@ pub mod error;
 pub mod grid;
 pub mod lights;
 pub mod material;
+pub mod objects;
 pub mod raycast;
 pub mod shape;
 mod slab;

@@ -19,12 +19,11 @@
 use crate::brick::Brick;
 pub use crate::brick::BrickMaterials;
 use crate::dirty::DirtyRanges;
-use crate::edit::{EditInverse, EditOp, EditOutcome, Mode, PriorMaterials, VoxelEdit};
+use crate::edit::{EditInverse, EditOp, EditOutcome, VoxelEdit};
 use crate::error::{BrickmapError, Result};
 use crate::grid::{GridDims, SlabBounds};
 use crate::lights::{self, Lights};
 use crate::material::{Material, MaterialKind, MaterialTable, MaterialTablesGpu};
-use crate::shape::Shape;
 use crate::slab::{CellState, Slab, WorkItem};
 use crate::storage::{BRICK_CHUNK, BucketSizes, ChunkCounters, MATERIAL_CHUNK};
 use crossbeam_channel::{Receiver, Sender};
@@ -288,54 +287,7 @@ impl World {
     }
 
     fn validate(&self, op: &EditOp) -> Result<()> {
-        let table = self.materials();
-        match op {
-            EditOp::Shape { shape, mode } => {
-                shape.validate()?;
-                if let Shape::Voxel(v) = shape
-                    && !self.dims.contains_voxel(*v)
-                {
-                    return Err(BrickmapError::OutOfRange(*v, self.dims.voxels()));
-                }
-                if let Mode::Add(m) | Mode::Paint(m) = mode {
-                    table.check(*m as u32)?;
-                }
-            }
-            EditOp::Voxels(list) => {
-                for e in list {
-                    if !self.dims.contains_voxel(e.pos) {
-                        return Err(BrickmapError::OutOfRange(e.pos, self.dims.voxels()));
-                    }
-                    if let crate::edit::VoxelOp::Set(m) | crate::edit::VoxelOp::Paint(m) = e.op {
-                        table.check(m as u32)?;
-                    }
-                }
-            }
-            EditOp::Generate(g) => {
-                for m in g.0.materials() {
-                    table.check(m as u32)?;
-                }
-            }
-            EditOp::Restore(inv) => {
-                for u in &inv.bricks {
-                    if u.brick.cmpge(self.dims.bricks()).any() {
-                        return Err(BrickmapError::BadInverse("brick outside the grid"));
-                    }
-                    match &u.prior {
-                        PriorMaterials::Uniform(m) => table.check(*m as u32)?,
-                        PriorMaterials::PerVoxel(v) => {
-                            if v.len() != u.prior_mask.and(&u.touched).count() as usize {
-                                return Err(BrickmapError::BadInverse("material count mismatch"));
-                            }
-                            for m in v {
-                                table.check(*m as u32)?;
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        Ok(())
+        crate::edit::validate(op, &self.materials(), self.dims.voxels())
     }
 
     fn split(&self, op: EditOp) -> Vec<(usize, WorkItem)> {

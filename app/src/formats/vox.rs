@@ -38,7 +38,7 @@ mod materials;
 
 pub use error::VoxError;
 pub use export::*;
-pub use graph::*;
+use graph::*;
 use materials::*;
 
 /// How to import.
@@ -393,25 +393,5 @@ fn describe_chunk(id: &str) -> String {
     match id {
         "TDCZ" => "TDCZ (Teardown's compressed voxel data)".into(),
         other => other.to_string(),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn rotation_bytes_decode_to_signed_permutations() {
-        assert_eq!(decode_rotation(0b0000100), Some(IMat3::IDENTITY));
-        let mut valid = 0;
-        for b in 0..=127u8 {
-            if let Some(m) = decode_rotation(b) {
-                valid += 1;
-                assert!(m.det() == 1 || m.det() == -1, "{b}: {m:?}");
-            }
-        }
-        assert_eq!(valid, 48, "6 permutations × 8 sign patterns");
-        assert_eq!(decode_rotation(0b0000011), None);
-        assert_eq!(decode_rotation(0b0000000), None);
     }
 }

@@ -1,78 +1,13 @@
-//! The `.vox` scene graph: MagicaVoxel's rotations as signed permutation matrices
-//! ([`IMat3`], [`decode_rotation`], checked here because `dot_vox` asserts on bad bytes),
-//! transforms, and the walk that places every visible model instance's voxels about its
-//! integer pivot ⌊s/2⌋.
+//! The `.vox` scene graph: the walk that places every visible model instance's voxels,
+//! MagicaVoxel's rotation bytes read as `brickmap::objects::Orientation` (checked there,
+//! because `dot_vox` asserts on bad bytes) and the placement about the integer pivot ⌊s/2⌋.
 
 use super::*;
+use brickmap::objects::{Orientation, Placement};
 
-/// A 3×3 integer matrix (MagicaVoxel rotations are signed permutations), rows stored.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct IMat3(pub [[i32; 3]; 3]);
-
-impl IMat3 {
-    /// The identity.
-    pub const IDENTITY: IMat3 = IMat3([[1, 0, 0], [0, 1, 0], [0, 0, 1]]);
-    /// Determinant.
-    pub fn det(&self) -> i32 {
-        let m = &self.0;
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-    }
-}
-
-impl std::ops::Mul<IVec3> for IMat3 {
-    type Output = IVec3;
-    fn mul(self, v: IVec3) -> IVec3 {
-        let r = |i: usize| self.0[i][0] * v.x + self.0[i][1] * v.y + self.0[i][2] * v.z;
-        IVec3::new(r(0), r(1), r(2))
-    }
-}
-
-impl std::ops::Mul for IMat3 {
-    type Output = IMat3;
-    fn mul(self, o: IMat3) -> IMat3 {
-        IMat3(std::array::from_fn(|i| {
-            std::array::from_fn(|j| (0..3).map(|k| self.0[i][k] * o.0[k][j]).sum())
-        }))
-    }
-}
-
-/// A node's transform: rotation then translation, in MagicaVoxel coordinates.
-#[derive(Clone, Copy)]
-pub(super) struct Transform {
-    rot: IMat3,
-    t: IVec3,
-}
-
-impl Transform {
-    const IDENTITY: Transform = Transform {
-        rot: IMat3::IDENTITY,
-        t: IVec3::ZERO,
-    };
-    fn then(self, local: Transform) -> Transform {
-        Transform {
-            rot: self.rot * local.rot,
-            t: self.rot * local.t + self.t,
-        }
-    }
-}
-
-/// Decodes MagicaVoxel's packed rotation byte (bits 0–1: column of row 0's non-zero entry,
-/// bits 2–3: row 1's, bits 4–6: signs of rows 0–2). `None` when invalid.
-pub fn decode_rotation(byte: u8) -> Option<IMat3> {
-    let (c0, c1) = ((byte & 3) as usize, (byte >> 2 & 3) as usize);
-    if c0 == 3 || c1 == 3 || c0 == c1 {
-        return None;
-    }
-    let c2 = 3 - c0 - c1;
-    let sign = |bit: u8| if byte >> bit & 1 == 1 { -1 } else { 1 };
-    let mut rows = [[0i32; 3]; 3];
-    rows[0][c0] = sign(4);
-    rows[1][c1] = sign(5);
-    rows[2][c2] = sign(6);
-    Some(IMat3(rows))
-}
+/// A node's transform, in MagicaVoxel's axes: an orientation and a translation about the
+/// model's pivot, composed down the graph (the objects' own rule, `brickmap::objects`).
+pub(super) type Transform = Placement;
 
 /// Every placed voxel (voxbrick coordinates, before the shift) with its 0-based palette index.
 pub(super) fn place_instances(
@@ -170,7 +105,12 @@ pub(super) fn walk(
                     local.t = IVec3::new(v[0], v[1], v[2]);
                 }
                 if let Some(r) = frame.attributes.get("_r") {
-                    match r.trim().parse::<u8>().ok().and_then(decode_rotation) {
+                    match r
+                        .trim()
+                        .parse::<u8>()
+                        .ok()
+                        .and_then(Orientation::from_vox_byte)
+                    {
                         Some(rot) => local.rot = rot,
                         None => {
                             *notes
@@ -183,7 +123,7 @@ pub(super) fn walk(
             walk(
                 data,
                 *child,
-                parent.then(local),
+                parent.then(&local),
                 depth + 1,
                 options,
                 out,
@@ -240,10 +180,7 @@ pub(super) fn place_model(
         model.size.z as i32,
     );
     for v in &model.voxels {
-        // ⌊R·(v + ½ − ⌊s/2⌋) + t⌋, in doubled integers to stay exact: 2v + 1 − 2⌊s/2⌋.
-        let twice = IVec3::new(v.x as i32, v.y as i32, v.z as i32) * 2 + 1 - (size / 2) * 2;
-        let p = tr.rot * twice + tr.t * 2;
-        let vox = IVec3::new(p.x.div_euclid(2), p.y.div_euclid(2), p.z.div_euclid(2));
+        let vox = tr.place(IVec3::new(v.x as i32, v.y as i32, v.z as i32), size);
         out.push((IVec3::new(vox.x, vox.z, -vox.y - 1), v.i));
     }
     Ok(())

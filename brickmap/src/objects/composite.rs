@@ -1,0 +1,292 @@
+//! The composite: the visible objects written into the one `World` the renderers trace.
+//!
+//! A world brick's content is computed from scratch from every drawn object whose placed box
+//! overlaps it, in drawing order, so a later object's solid voxel replaces an earlier one's
+//! and empty voxels hide nothing (docs/DESIGN.md, "Objects"). Recomputed bricks are written
+//! whole through the world's bulk restore, so the world's workers, dirty ranges and light
+//! faces serve the objects unchanged. Only what a change touched is recomputed:
+//! [`Composite::model_edited`] the world bricks a model edit's touched bricks land in, in
+//! every visible instance; [`Composite::update`] the old and new boxes of the objects whose
+//! placement, model or visibility changed (and of the nodes the caller names, for a change of
+//! drawing order).
+//!
+//! The composite is derived state: it is never saved and never undone itself; undoing a model
+//! edit or a tree change and then updating the composite gives the same world.
+
+use super::model::Model;
+use super::tree::{Drawn, ModelId, NodeId, ObjectTree};
+use crate::brick::{Mask, voxel_bit};
+use crate::edit::{EditInverse, PriorMaterials};
+use crate::error::Result as WorldResult;
+use crate::world::World;
+use glam::{IVec3, UVec3};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+
+/// Where the composite finds a model.
+pub trait ModelSource {
+    /// The model, if it exists.
+    fn model(&self, id: ModelId) -> Option<&Model>;
+}
+
+impl ModelSource for BTreeMap<ModelId, Model> {
+    fn model(&self, id: ModelId) -> Option<&Model> {
+        self.get(&id)
+    }
+}
+
+impl ModelSource for HashMap<ModelId, Model> {
+    fn model(&self, id: ModelId) -> Option<&Model> {
+        self.get(&id)
+    }
+}
+
+/// Why a composite cannot be built or written; the world is unchanged.
+#[derive(Debug, thiserror::Error)]
+pub enum CompositeError {
+    /// An object places a model that does not exist.
+    #[error("object #{} places model {}, which does not exist", .node.0, .model.0)]
+    NoModel {
+        /// The object.
+        node: NodeId,
+        /// The model it names.
+        model: ModelId,
+    },
+    /// An object's placed box leaves the world's grid.
+    #[error(
+        "object #{} covers {lo}..{hi}, outside the {grid} voxel grid (the composite's limit)",
+        .node.0
+    )]
+    OutsideGrid {
+        /// The object.
+        node: NodeId,
+        /// Its lowest cell.
+        lo: IVec3,
+        /// One past its highest.
+        hi: IVec3,
+        /// The grid in voxels.
+        grid: IVec3,
+    },
+    /// The world refused the write.
+    #[error(transparent)]
+    World(#[from] crate::error::BrickmapError),
+}
+
+/// Side of a cell of the index of object boxes, in bricks.
+const CELL_BRICKS: i32 = 4;
+
+/// One drawn object with what the composite needs of it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Entry {
+    drawn: Drawn,
+    size: IVec3,
+    lo: IVec3,
+    hi: IVec3,
+}
+
+/// The drawn objects of a tree, their boxes, and an index from world regions to the objects
+/// overlapping them.
+#[derive(Clone, Debug)]
+pub struct Composite {
+    grid: IVec3,
+    entries: Vec<Entry>,
+    /// Index cell (CELL_BRICKS³ bricks) → drawing positions of the entries overlapping it,
+    /// ascending.
+    index: HashMap<[i32; 3], Vec<u32>>,
+}
+
+impl Composite {
+    /// The composite of a tree's visible objects for a world of `grid` voxels. Refuses an
+    /// object outside the grid or naming a missing model.
+    pub fn new(
+        tree: &ObjectTree,
+        models: &impl ModelSource,
+        grid: IVec3,
+    ) -> Result<Self, CompositeError> {
+        let mut entries = Vec::new();
+        for drawn in tree.drawn() {
+            let model = models.model(drawn.model).ok_or(CompositeError::NoModel {
+                node: drawn.node,
+                model: drawn.model,
+            })?;
+            let size = model.size();
+            let (lo, hi) = drawn.placement.bounds(size);
+            if lo.cmplt(IVec3::ZERO).any() || hi.cmpgt(grid).any() {
+                return Err(CompositeError::OutsideGrid {
+                    node: drawn.node,
+                    lo,
+                    hi,
+                    grid,
+                });
+            }
+            entries.push(Entry {
+                drawn,
+                size,
+                lo,
+                hi,
+            });
+        }
+        let mut index: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
+        for (i, e) in entries.iter().enumerate() {
+            let (a, b) = (e.lo / (8 * CELL_BRICKS), (e.hi - 1) / (8 * CELL_BRICKS));
+            for z in a.z..=b.z {
+                for y in a.y..=b.y {
+                    for x in a.x..=b.x {
+                        index.entry([x, y, z]).or_default().push(i as u32);
+                    }
+                }
+            }
+        }
+        Ok(Self {
+            grid,
+            entries,
+            index,
+        })
+    }
+
+    /// The drawn objects, in drawing order.
+    pub fn drawn(&self) -> impl Iterator<Item = Drawn> + '_ {
+        self.entries.iter().map(|e| e.drawn)
+    }
+
+    /// The content of world brick `b`: solid voxels and their materials (0 where empty).
+    pub fn brick(&self, b: UVec3, models: &impl ModelSource) -> (Mask, Box<[u8; 512]>) {
+        let mut mask = Mask::EMPTY;
+        let mut mats = Box::new([0u8; 512]);
+        let min = b.as_ivec3() * 8;
+        let max = min + 7;
+        let cell = (b.as_ivec3() / CELL_BRICKS).to_array();
+        let Some(list) = self.index.get(&cell) else {
+            return (mask, mats);
+        };
+        for &i in list {
+            let e = &self.entries[i as usize];
+            let lo = e.lo.max(min);
+            let hi = (e.hi - 1).min(max);
+            if lo.cmpgt(hi).any() {
+                continue;
+            }
+            let Some(model) = models.model(e.drawn.model) else {
+                continue;
+            };
+            for z in lo.z..=hi.z {
+                for y in lo.y..=hi.y {
+                    for x in lo.x..=hi.x {
+                        let w = IVec3::new(x, y, z);
+                        if let Some(m) = model.voxel(e.drawn.placement.unplace(w, e.size)) {
+                            let bit = voxel_bit(x & 7, y & 7, z & 7);
+                            mask.set(bit);
+                            mats[bit] = m;
+                        }
+                    }
+                }
+            }
+        }
+        (mask, mats)
+    }
+
+    /// Recomputes world bricks and writes them whole; returns the world's inverse (which the
+    /// caller may drop: the composite is derived).
+    pub fn write(
+        &self,
+        world: &World,
+        bricks: &BTreeSet<[u32; 3]>,
+        models: &impl ModelSource,
+    ) -> WorldResult<EditInverse> {
+        let contents: Vec<_> = bricks
+            .iter()
+            .map(|k| {
+                let b = UVec3::from_array(*k);
+                let (mask, mats) = self.brick(b, models);
+                let held: Vec<u8> = mask.ones().map(|bit| mats[bit]).collect();
+                let prior = match held.first() {
+                    Some(&m) if held.iter().all(|x| *x == m) => PriorMaterials::Uniform(m),
+                    None => PriorMaterials::Uniform(0),
+                    _ => PriorMaterials::PerVoxel(held),
+                };
+                (b, mask, prior)
+            })
+            .collect();
+        if contents.is_empty() {
+            return Ok(EditInverse::default());
+        }
+        Ok(world.apply(crate::terrain::set_bricks(contents))?.inverse)
+    }
+
+    /// Every world brick the composite covers (for a first write into an empty world).
+    pub fn all_bricks(&self) -> BTreeSet<[u32; 3]> {
+        let mut out = BTreeSet::new();
+        for e in &self.entries {
+            add_box(&mut out, e.lo, e.hi);
+        }
+        out
+    }
+
+    /// After a model edit (its inverse names the touched model bricks): rewrites the world
+    /// bricks they land in, in every drawn instance.
+    pub fn model_edited(
+        &self,
+        world: &World,
+        models: &impl ModelSource,
+        model: ModelId,
+        edit: &EditInverse,
+    ) -> WorldResult<EditInverse> {
+        let mut bricks = BTreeSet::new();
+        for e in self.entries.iter().filter(|e| e.drawn.model == model) {
+            for u in &edit.bricks {
+                let a = (u.brick.as_ivec3() * 8).min(e.size - 1);
+                let b = (u.brick.as_ivec3() * 8 + 7).min(e.size - 1);
+                let (pa, pb) = (
+                    e.drawn.placement.place(a, e.size),
+                    e.drawn.placement.place(b, e.size),
+                );
+                add_box(&mut bricks, pa.min(pb), pa.max(pb) + 1);
+            }
+        }
+        self.write(world, &bricks, models)
+    }
+
+    /// Replaces this composite by the one of the tree as it is now and rewrites the world
+    /// bricks that may differ: the old and new boxes of every object that appeared,
+    /// disappeared, or changed model or placement, and of the `also` nodes (objects whose
+    /// place in the drawing order changed). The world is unchanged on an error.
+    pub fn update(
+        &mut self,
+        world: &World,
+        tree: &ObjectTree,
+        models: &impl ModelSource,
+        also: &[NodeId],
+    ) -> Result<EditInverse, CompositeError> {
+        let next = Composite::new(tree, models, self.grid)?;
+        let old: HashMap<NodeId, &Entry> = self.entries.iter().map(|e| (e.drawn.node, e)).collect();
+        let new: HashMap<NodeId, &Entry> = next.entries.iter().map(|e| (e.drawn.node, e)).collect();
+        let mut bricks = BTreeSet::new();
+        for (map, other) in [(&old, &new), (&new, &old)] {
+            for (node, e) in map {
+                let same = other
+                    .get(node)
+                    .is_some_and(|o| o.drawn == e.drawn && o.size == e.size);
+                if !same || also.contains(node) {
+                    add_box(&mut bricks, e.lo, e.hi);
+                }
+            }
+        }
+        let inverse = next.write(world, &bricks, models)?;
+        *self = next;
+        Ok(inverse)
+    }
+}
+
+/// Adds the world bricks that voxel box lo..hi (exclusive) touches.
+fn add_box(out: &mut BTreeSet<[u32; 3]>, lo: IVec3, hi: IVec3) {
+    let (a, b) = (lo / 8, (hi - 1) / 8);
+    for z in a.z..=b.z {
+        for y in a.y..=b.y {
+            for x in a.x..=b.x {
+                out.insert([x as u32, y as u32, z as u32]);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
