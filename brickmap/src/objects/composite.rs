@@ -14,6 +14,7 @@
 //! edit or a tree change and then updating the composite gives the same world.
 
 use super::model::Model;
+use super::orient::Orientation;
 use super::tree::{Drawn, ModelId, NodeId, ObjectTree};
 use crate::brick::{Mask, voxel_bit};
 use crate::edit::{EditInverse, PriorMaterials};
@@ -168,14 +169,40 @@ impl Composite {
             let Some(model) = models.model(e.drawn.model) else {
                 continue;
             };
+            let p = e.drawn.placement;
+            // At identity, model voxel v lands at v + offset.
+            let offset = p.t - e.size / 2;
+            if p.rot == Orientation::IDENTITY && offset % 8 == IVec3::ZERO {
+                // Brick-aligned: the model brick is the world brick, copied whole (a model's
+                // voxels outside its size are never solid).
+                if let Some(mb) = model.brick((min - offset).as_uvec3() / 8) {
+                    mask = mask.or(&mb.mask);
+                    for bit in mb.mask.ones() {
+                        mats[bit] = mb.materials[bit];
+                    }
+                }
+                continue;
+            }
+            // One model-brick lookup per run of voxels in the same model brick.
+            let mut last: Option<(IVec3, Option<&super::model::ModelBrick>)> = None;
             for z in lo.z..=hi.z {
                 for y in lo.y..=hi.y {
                     for x in lo.x..=hi.x {
-                        let w = IVec3::new(x, y, z);
-                        if let Some(m) = model.voxel(e.drawn.placement.unplace(w, e.size)) {
+                        let v = p.unplace(IVec3::new(x, y, z), e.size);
+                        let mb = match last {
+                            Some((k, mb)) if k == v / 8 => mb,
+                            _ => {
+                                let mb = model.brick((v / 8).as_uvec3());
+                                last = Some((v / 8, mb));
+                                mb
+                            }
+                        };
+                        let Some(mb) = mb else { continue };
+                        let from = voxel_bit(v.x & 7, v.y & 7, v.z & 7);
+                        if mb.mask.get(from) {
                             let bit = voxel_bit(x & 7, y & 7, z & 7);
                             mask.set(bit);
-                            mats[bit] = m;
+                            mats[bit] = mb.materials[from];
                         }
                     }
                 }
@@ -184,28 +211,51 @@ impl Composite {
         (mask, mats)
     }
 
+    /// A brick's content as the world's bulk write takes it.
+    fn packed(
+        &self,
+        b: UVec3,
+        models: &(impl ModelSource + Sync),
+    ) -> (UVec3, Mask, PriorMaterials) {
+        let (mask, mats) = self.brick(b, models);
+        let held: Vec<u8> = mask.ones().map(|bit| mats[bit]).collect();
+        let prior = match held.first() {
+            Some(&m) if held.iter().all(|x| *x == m) => PriorMaterials::Uniform(m),
+            None => PriorMaterials::Uniform(0),
+            _ => PriorMaterials::PerVoxel(held),
+        };
+        (b, mask, prior)
+    }
+
     /// Recomputes world bricks and writes them whole; returns the world's inverse (which the
     /// caller may drop: the composite is derived).
     pub fn write(
         &self,
         world: &World,
         bricks: &BTreeSet<[u32; 3]>,
-        models: &impl ModelSource,
+        models: &(impl ModelSource + Sync),
     ) -> WorldResult<EditInverse> {
-        let contents: Vec<_> = bricks
-            .iter()
-            .map(|k| {
-                let b = UVec3::from_array(*k);
-                let (mask, mats) = self.brick(b, models);
-                let held: Vec<u8> = mask.ones().map(|bit| mats[bit]).collect();
-                let prior = match held.first() {
-                    Some(&m) if held.iter().all(|x| *x == m) => PriorMaterials::Uniform(m),
-                    None => PriorMaterials::Uniform(0),
-                    _ => PriorMaterials::PerVoxel(held),
-                };
-                (b, mask, prior)
-            })
-            .collect();
+        let list: Vec<UVec3> = bricks.iter().map(|k| UVec3::from_array(*k)).collect();
+        // Bricks are independent: computed on as many threads as the world has workers, in
+        // contiguous chunks joined in order (the same result whatever the count).
+        let threads = world.workers().clamp(1, list.len().max(1));
+        let chunk = list.len().div_ceil(threads).max(1);
+        let contents: Vec<_> = std::thread::scope(|s| {
+            let parts: Vec<_> = list
+                .chunks(chunk)
+                .map(|part| {
+                    s.spawn(move || {
+                        part.iter()
+                            .map(|b| self.packed(*b, models))
+                            .collect::<Vec<_>>()
+                    })
+                })
+                .collect();
+            parts
+                .into_iter()
+                .flat_map(|h| h.join().expect("composite threads do not panic"))
+                .collect()
+        });
         if contents.is_empty() {
             return Ok(EditInverse::default());
         }
@@ -226,7 +276,7 @@ impl Composite {
     pub fn model_edited(
         &self,
         world: &World,
-        models: &impl ModelSource,
+        models: &(impl ModelSource + Sync),
         model: ModelId,
         edit: &EditInverse,
     ) -> WorldResult<EditInverse> {
@@ -253,7 +303,7 @@ impl Composite {
         &mut self,
         world: &World,
         tree: &ObjectTree,
-        models: &impl ModelSource,
+        models: &(impl ModelSource + Sync),
         also: &[NodeId],
     ) -> Result<EditInverse, CompositeError> {
         let next = Composite::new(tree, models, self.grid)?;

@@ -243,9 +243,16 @@ impl Session {
                 let node = *self.objects.get(o)?;
                 let n = self.tree.node_mut(node).ok()?;
                 n.visible = !n.visible;
-                self.composite
+                if self
+                    .composite
                     .update(&self.world, &self.tree, &self.models, &[])
-                    .unwrap();
+                    .is_err()
+                {
+                    // Shown again outside the grid (it moved while hidden): refused.
+                    let n = self.tree.node_mut(node).unwrap();
+                    n.visible = !n.visible;
+                    return None;
+                }
                 Some(Undo::Hide(node))
             }
             Step::Reorder { o } => {

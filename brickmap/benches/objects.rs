@@ -1,0 +1,196 @@
+//! Objects benchmarks: compositing a whole 512 × 256 × 512 terrain model into an empty world
+//! (brick-aligned at identity, the copy path, and turned 90° about y, the per-voxel path), a
+//! sphere edit of that model followed by its re-composite, and 10,000 small objects: building
+//! the composite and updating it after one object moved.
+//!
+//! Run: `cargo bench -p brickmap --bench objects` (set BRICKMAP_WORKERS to pin workers).
+
+use brickmap::objects::{
+    Axis, Composite, LayerId, Model, ModelId, NewNode, ObjectTree, Orientation, Placement,
+};
+use brickmap::{EditOp, GridDims, Mode, Shape, World, WorldConfig, terrain};
+use divan::Bencher;
+use glam::{DVec3, IVec3};
+use std::collections::BTreeMap;
+
+fn workers() -> usize {
+    std::env::var("BRICKMAP_WORKERS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0)
+}
+
+fn dims() -> GridDims {
+    GridDims::new(64, 32, 64).unwrap() // 512 × 256 × 512 voxels
+}
+
+fn world() -> World {
+    let w = World::new(dims(), WorldConfig::with_workers(workers())).unwrap();
+    for c in [2, 3, 4] {
+        w.push_material(brickmap::Material::lambertian(c)).unwrap();
+    }
+    w
+}
+
+/// The rolling-hills terrain as one model of the whole grid.
+fn terrain_model() -> (Model, World) {
+    let source = world();
+    source.apply(terrain::rolling_hills(dims())).unwrap();
+    let mut bricks = Vec::new();
+    source.read().for_each_brick(|b, mask, mats| {
+        let held: Vec<u8> = (0..mask.count() as usize).map(|k| mats.at(k)).collect();
+        bricks.push((b, *mask, brickmap::PriorMaterials::PerVoxel(held)));
+    });
+    let mut model = Model::new(dims().voxels()).unwrap();
+    let table = source.materials().clone();
+    model.apply(&terrain::set_bricks(bricks), &table).unwrap();
+    (model, source)
+}
+
+fn one_object(rot: Orientation, size: IVec3) -> ObjectTree {
+    let mut tree = ObjectTree::new();
+    tree.add(
+        ObjectTree::ROOT,
+        None,
+        "terrain",
+        Placement { rot, t: size / 2 },
+        NewNode::Object {
+            model: ModelId(0),
+            layer: LayerId(0),
+        },
+    )
+    .unwrap();
+    tree
+}
+
+fn main() {
+    divan::main();
+}
+
+/// The whole terrain composited into an empty world (every brick written).
+#[divan::bench(args = ["identity", "turned"], sample_count = 5, sample_size = 1)]
+fn composite_terrain(bencher: Bencher, how: &str) {
+    let (model, _) = terrain_model();
+    let size = model.size();
+    // Turned about y, the model's x and z swap: a square model still fits the grid.
+    let rot = match how {
+        "identity" => Orientation::IDENTITY,
+        _ => Orientation::quarter_turn(Axis::Y, 1),
+    };
+    let tree = one_object(rot, size);
+    let models = BTreeMap::from([(ModelId(0), model)]);
+    let composite = Composite::new(&tree, &models, dims().voxels()).unwrap();
+    let all = composite.all_bricks();
+    bencher.with_inputs(world).bench_local_values(|w| {
+        composite.write(&w, &all, &models).unwrap();
+        w
+    });
+}
+
+/// A sphere brush in the terrain model, then its re-composite (what a stroke segment costs
+/// in edit mode).
+#[divan::bench(args = [16.0, 64.0], sample_count = 20, sample_size = 1)]
+fn model_edit_then_composite(bencher: Bencher, radius: f64) {
+    let (model, source) = terrain_model();
+    let table = source.materials().clone();
+    let size = model.size();
+    let tree = one_object(Orientation::quarter_turn(Axis::Y, 1), size);
+    let mut models = BTreeMap::from([(ModelId(0), model)]);
+    let composite = Composite::new(&tree, &models, dims().voxels()).unwrap();
+    let w = world();
+    composite
+        .write(&w, &composite.all_bricks(), &models)
+        .unwrap();
+    let mut add = true;
+    bencher.bench_local(|| {
+        let op = EditOp::Shape {
+            shape: Shape::Sphere {
+                centre: DVec3::new(256.0, 100.0, 256.0),
+                radius,
+            },
+            mode: if add { Mode::Add(1) } else { Mode::Remove },
+        };
+        add = !add;
+        let m = models.get_mut(&ModelId(0)).unwrap();
+        let out = m.apply(&op, &table).unwrap();
+        composite
+            .model_edited(&w, &models, ModelId(0), &out.inverse)
+            .unwrap();
+        w.take_dirty();
+    });
+}
+
+/// 10,000 objects (100 models of 8 × 8 × 8, each placed 100 times, in 100 groups).
+fn many() -> (ObjectTree, BTreeMap<ModelId, Model>) {
+    let table = world().materials().clone();
+    let mut models = BTreeMap::new();
+    for m in 0..100u32 {
+        let mut model = Model::new(IVec3::splat(8)).unwrap();
+        let op = EditOp::Shape {
+            shape: Shape::Sphere {
+                centre: DVec3::splat(4.0),
+                radius: 2.0 + (m % 3) as f64,
+            },
+            mode: Mode::Add((m % 3 + 1) as u8),
+        };
+        model.apply(&op, &table).unwrap();
+        models.insert(ModelId(m), model);
+    }
+    let mut tree = ObjectTree::new();
+    for g in 0..100 {
+        let group = tree
+            .add(
+                ObjectTree::ROOT,
+                None,
+                format!("row {g}"),
+                Placement::IDENTITY,
+                NewNode::Group,
+            )
+            .unwrap();
+        for i in 0..100 {
+            let t = IVec3::new(
+                8 + (i % 50) * 10,
+                8 + (g % 20) * 12,
+                8 + (g / 20) * 100 + (i / 50) * 40,
+            );
+            let new = NewNode::Object {
+                model: ModelId(((g * 100 + i) % 100) as u32),
+                layer: LayerId(0),
+            };
+            let rot = Orientation::all().nth(((g + i) % 48) as usize).unwrap();
+            tree.add(group, None, format!("o{i}"), Placement { rot, t }, new)
+                .unwrap();
+        }
+    }
+    (tree, models)
+}
+
+/// Building the composite of 10,000 objects (the drawn list, boxes, index) and writing it.
+#[divan::bench(sample_count = 5, sample_size = 1)]
+fn ten_thousand_objects_build(bencher: Bencher) {
+    let (tree, models) = many();
+    bencher.with_inputs(world).bench_local_values(|w| {
+        let c = Composite::new(&tree, &models, dims().voxels()).unwrap();
+        c.write(&w, &c.all_bricks(), &models).unwrap();
+        w
+    });
+}
+
+/// One of 10,000 objects moved: the composite updated (the whole tree walked again, two
+/// small boxes rewritten).
+#[divan::bench(sample_count = 20, sample_size = 1)]
+fn ten_thousand_objects_move_one(bencher: Bencher) {
+    let (mut tree, models) = many();
+    let mut c = Composite::new(&tree, &models, dims().voxels()).unwrap();
+    let w = world();
+    c.write(&w, &c.all_bricks(), &models).unwrap();
+    let node = tree.node(ObjectTree::ROOT).unwrap().children()[50];
+    let node = tree.node(node).unwrap().children()[7];
+    let mut step = 0;
+    bencher.bench_local(|| {
+        step += 1;
+        tree.node_mut(node).unwrap().placement.t.x = 20 + (step % 2) * 3;
+        c.update(&w, &tree, &models, &[]).unwrap();
+        w.take_dirty();
+    });
+}
