@@ -81,6 +81,11 @@ impl Orientation {
         }
     }
 
+    /// The orientation with this matrix, if it is a signed permutation.
+    pub fn from_matrix(m: [[i32; 3]; 3]) -> Option<Orientation> {
+        Orientation::all().find(|o| o.matrix() == m)
+    }
+
     /// The matrix, rows stored.
     pub fn matrix(&self) -> [[i32; 3]; 3] {
         std::array::from_fn(|r| std::array::from_fn(|c| self.entry(r, c)))
@@ -282,7 +287,12 @@ mod tests {
         assert_eq!(set.len(), 48);
         assert_eq!(all.iter().filter(|o| o.is_reflection()).count(), 24);
         let v = IVec3::new(3, -5, 7);
+        assert_eq!(
+            Orientation::from_matrix([[0, 1, 0], [1, 0, 0], [0, 0, 2]]),
+            None
+        );
         for a in &all {
+            assert_eq!(Orientation::from_matrix(a.matrix()), Some(*a));
             assert_eq!(a.after(&a.inverse()), Orientation::IDENTITY, "{a:?}");
             assert_eq!(a.inverse().apply(a.apply(v)), v);
             for b in &all {
