@@ -326,14 +326,7 @@ impl ObjectTree {
         }
         let old_index = self.index_in_parent(id)?;
         let len = self.node(parent)?.children().len() - usize::from(parent == old_parent);
-        let index = index.unwrap_or(len);
-        if index > len {
-            return Err(TreeError::Index {
-                group: parent,
-                index,
-                len,
-            });
-        }
+        let index = position(parent, index, len)?;
         self.children_mut(old_parent)?.remove(old_index);
         self.children_mut(parent)?.insert(index, id);
         self.node_mut(id)?.parent = Some(parent);
@@ -491,16 +484,7 @@ impl ObjectTree {
         if !matches!(n.kind, NodeKind::Group { .. }) {
             return Err(TreeError::NotAGroup(parent));
         }
-        let len = n.children().len();
-        let index = index.unwrap_or(len);
-        if index > len {
-            return Err(TreeError::Index {
-                group: parent,
-                index,
-                len,
-            });
-        }
-        Ok(index)
+        position(parent, index, n.children().len())
     }
 
     fn children_mut(&mut self, id: NodeId) -> Result<&mut Vec<NodeId>, TreeError> {
@@ -509,6 +493,15 @@ impl ObjectTree {
             NodeKind::Object { .. } => Err(TreeError::NotAGroup(id)),
         }
     }
+}
+
+/// A position among a group's `len` children (the end when `None`).
+fn position(group: NodeId, index: Option<usize>, len: usize) -> Result<usize, TreeError> {
+    let index = index.unwrap_or(len);
+    if index > len {
+        return Err(TreeError::Index { group, index, len });
+    }
+    Ok(index)
 }
 
 #[cfg(test)]
