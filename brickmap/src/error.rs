@@ -102,6 +102,10 @@ pub enum BrickmapError {
     /// An inverse edit does not fit this world (wrong grid or stale state).
     #[error("inverse edit does not fit this world: {0}")]
     BadInverse(&'static str),
+    /// An edit that only exists in the world's frame (a brick restore, a generator) was
+    /// asked of an object's model.
+    #[error("{0} cannot be carried into an object's frame")]
+    NotInModelFrame(&'static str),
 }
 
 /// The crate's result type.

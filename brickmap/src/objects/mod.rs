@@ -8,6 +8,7 @@
 //! builds on these: see docs/DESIGN.md, "Objects".
 
 pub mod composite;
+pub mod frame;
 pub mod model;
 pub mod orient;
 pub mod tree;
