@@ -89,12 +89,20 @@ fn composite_terrain(bencher: Bencher, how: &str) {
 
 /// A sphere brush in the terrain model, then its re-composite (what a stroke segment costs
 /// in edit mode).
-#[divan::bench(args = [16.0, 64.0], sample_count = 20, sample_size = 1)]
-fn model_edit_then_composite(bencher: Bencher, radius: f64) {
+#[divan::bench(
+    args = [(16.0, "identity"), (64.0, "identity"), (16.0, "turned"), (64.0, "turned")],
+    sample_count = 20,
+    sample_size = 1
+)]
+fn model_edit_then_composite(bencher: Bencher, (radius, how): (f64, &str)) {
     let (model, source) = terrain_model();
     let table = source.materials().clone();
     let size = model.size();
-    let tree = one_object(Orientation::quarter_turn(Axis::Y, 1), size);
+    let rot = match how {
+        "identity" => Orientation::IDENTITY,
+        _ => Orientation::quarter_turn(Axis::Y, 1),
+    };
+    let tree = one_object(rot, size);
     let mut models = BTreeMap::from([(ModelId(0), model)]);
     let composite = Composite::new(&tree, &models, dims().voxels()).unwrap();
     let w = world();
