@@ -64,6 +64,17 @@ fn one_object(rot: Orientation, size: IVec3) -> ObjectTree {
 }
 
 fn main() {
+    let (model, source) = terrain_model();
+    let bricks = model.bricks().count();
+    println!(
+        "terrain model {:?}: {} solid voxels in {bricks} bricks, {} bytes of mask and materials \
+         (the world: {} stored bricks, {} GPU bytes used)",
+        model.size(),
+        model.solid_count(),
+        bricks * (64 + 512),
+        source.read().brick_count(),
+        source.read().memory().gpu_used()
+    );
     divan::main();
 }
 
