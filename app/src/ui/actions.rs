@@ -2,7 +2,16 @@
 //! panels' events, each turned into an edit on the edit thread, a file job, a camera change
 //! or a panel's state.
 
-use super::*;
+use super::input::Action;
+use super::jobs::Edit;
+use super::panels::{UiEvent, UnsavedAnswer};
+use super::pending::Pending;
+use super::purpose::Purpose;
+use super::tools::Tool;
+use super::{Editor, content_bounds};
+use crate::editor::command::Command;
+use crate::selection::SelectOp;
+use glam::DVec3;
 
 impl Editor {
     pub(super) fn action(&mut self, action: Action) {

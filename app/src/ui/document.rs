@@ -2,7 +2,19 @@
 //! (open, save, save as, new, import, export, autosave, recovery) and their results, the
 //! unsaved-changes question, quitting, and a GPU failure's rescue of unsaved work.
 
-use super::*;
+use super::files::Done;
+use super::jobs::{Edit, Edited};
+use super::pending::Pending;
+use super::purpose::Purpose;
+use super::{Editor, scene_view};
+use crate::Scene;
+use crate::editor::Document;
+use crate::editor::command::Command;
+use crate::editor::history::{DEFAULT_BUDGET, History};
+use crate::editor::script;
+use anyhow::{Result, anyhow};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, RwLock};
 
 impl Editor {
     pub(super) fn read(&self) -> std::sync::RwLockReadGuard<'_, Document> {

@@ -15,7 +15,18 @@
 //! whole-window renders): aspect, picking, framing (`Camera::framing_in`: the narrower field of
 //! view) and the traced size follow it.
 
-use super::*;
+use super::host::Host;
+use super::jobs::Edit;
+use super::{Editor, Gfx, budget, files, panels, preview, selecting};
+use anyhow::{Context, Result};
+use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use render::present::{EguiFrame, Presented, Presenter};
+use render::viewport::{FrameRequest, Viewport};
+use render::vulkan::{ContextOptions, GpuContext, WindowHandles};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+use winit::event_loop::ActiveEventLoop;
+use winit::window::Window;
 
 /// The frames' own state.
 pub(super) struct Frames {

@@ -14,7 +14,16 @@
 //! scene). Fly keys move by elapsed time up to the release (no per-frame clamp; a headless
 //! editor steps 1/60 s per tick unless `fly_in_real_time`).
 
-use super::*;
+use super::Editor;
+use super::event::Input;
+use super::input::{self, Action, Drag};
+use super::jobs::Edit;
+use super::pending::Pending;
+use super::tools::{self, Tool};
+use crate::editor::command::Command;
+use std::time::Instant;
+use winit::event::MouseButton;
+use winit::keyboard::KeyCode;
 
 impl Editor {
     /// One input, with whether egui kept it: handled now, or after the edit that holds the

@@ -10,8 +10,16 @@
 //! says a text was drawn, from egui's accessibility tree, which a headless editor turns on),
 //! `close` — what the soak and `app/tests/editor_handlers.rs` drive.
 
-use super::host::Headless;
-use super::*;
+use super::camera::ViewCamera;
+use super::event::Input;
+use super::files::SharedDocument;
+use super::host::{Headless, Host};
+use super::{Editor, EditorOptions, Gfx, report, tools};
+use anyhow::{Context, Result};
+use glam::DVec3;
+use render::present::Presenter;
+use render::vulkan::{ContextOptions, GpuContext};
+use std::sync::Arc;
 
 impl Editor {
     /// An editor of `size` pixels on the device `options.device`, without a window: no native

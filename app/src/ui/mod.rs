@@ -48,34 +48,25 @@ pub mod tools;
 
 use crate::Scene;
 use crate::editor::Document;
-use crate::editor::command::Command;
 use crate::editor::history::{DEFAULT_BUDGET, History};
 use crate::editor::script::{self, ReplayOptions, Script, ScriptRun};
-use crate::selection::SelectOp;
 use anyhow::{Context, Result, anyhow};
 use camera::ViewCamera;
 pub use event::Input;
-use files::{ConfigDir, Done, FileWorker, SharedDocument};
+use files::{ConfigDir, FileWorker, SharedDocument};
 use glam::DVec3;
 use host::Host;
-use input::{Action, Drag};
-use jobs::{Edit, EditQueue, Edited};
-use panels::{PanelState, UiEvent, UnsavedAnswer, ViewSettings};
-use pending::Pending;
-use purpose::Purpose;
-use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
-use render::present::{EguiFrame, Presented, Presenter};
-use render::viewport::{FrameRequest, Viewport};
-use render::vulkan::{ContextOptions, GpuContext, WindowHandles};
+use jobs::EditQueue;
+use panels::{PanelState, ViewSettings};
+use render::present::Presenter;
+use render::viewport::Viewport;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, RwLock};
 use std::time::{Duration, Instant};
-use tools::Tool;
 use winit::application::ApplicationHandler;
-use winit::event::{MouseButton, WindowEvent};
+use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
-use winit::keyboard::KeyCode;
-use winit::window::{Window, WindowId};
+use winit::window::WindowId;
 
 /// How the editor starts.
 #[derive(Clone, Debug, Default)]
