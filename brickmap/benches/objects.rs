@@ -67,11 +67,11 @@ fn main() {
     let (model, source) = terrain_model();
     let bricks = model.bricks().count();
     println!(
-        "terrain model {:?}: {} solid voxels in {bricks} bricks, {} bytes of mask and materials \
+        "terrain model {:?}: {} solid voxels in {bricks} bricks, {} bytes of bricks \
          (the world: {} stored bricks, {} GPU bytes used)",
         model.size(),
         model.solid_count(),
-        bricks * (64 + 512),
+        model.brick_bytes(),
         source.read().brick_count(),
         source.read().memory().gpu_used()
     );
@@ -211,5 +211,24 @@ fn ten_thousand_objects_move_one(bencher: Bencher) {
         tree.node_mut(node).unwrap().placement.t.x = 20 + (step % 2) * 3;
         c.update(&w, &tree, &models, &[]).unwrap();
         w.take_dirty();
+    });
+}
+
+/// The model edit alone (no composite): how much of an edit through a model is the model's.
+#[divan::bench(args = [16.0, 64.0], sample_count = 20, sample_size = 1)]
+fn model_edit_alone(bencher: Bencher, radius: f64) {
+    let (mut model, source) = terrain_model();
+    let table = source.materials().clone();
+    let mut add = true;
+    bencher.bench_local(|| {
+        let op = EditOp::Shape {
+            shape: Shape::Sphere {
+                centre: DVec3::new(256.0, 100.0, 256.0),
+                radius,
+            },
+            mode: if add { Mode::Add(1) } else { Mode::Remove },
+        };
+        add = !add;
+        model.apply(&op, &table).unwrap()
     });
 }

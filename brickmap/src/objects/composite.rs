@@ -178,31 +178,42 @@ impl Composite {
                 if let Some(mb) = model.brick((min - offset).as_uvec3() / 8) {
                     mask = mask.or(&mb.mask);
                     for bit in mb.mask.ones() {
-                        mats[bit] = mb.materials[bit];
+                        mats[bit] = mb.material(bit);
                     }
                 }
                 continue;
             }
-            // One model-brick lookup per run of voxels in the same model brick.
-            let mut last: Option<(IVec3, Option<&super::model::ModelBrick>)> = None;
+            // Along a world row (+x) the model voxel steps ±1 along one model axis: walk it,
+            // looking a model brick up only when the walk enters another one.
+            let d = p.rot.inverse().apply(IVec3::X);
+            let axis = (0..3).find(|&i| d[i] != 0).expect("a unit vector");
+            let step = d[axis];
+            let bit_step = [1isize, 8, 64][axis] * step as isize;
             for z in lo.z..=hi.z {
                 for y in lo.y..=hi.y {
+                    // Every voxel of lo..=hi lies in the object's box: v is inside the model.
+                    let mut v = p.unplace(IVec3::new(lo.x, y, z), e.size);
+                    let mut mb = model.brick((v / 8).as_uvec3());
+                    let mut from = voxel_bit(v.x & 7, v.y & 7, v.z & 7) as isize;
+                    let row = voxel_bit(0, y & 7, z & 7);
                     for x in lo.x..=hi.x {
-                        let v = p.unplace(IVec3::new(x, y, z), e.size);
-                        let mb = match last {
-                            Some((k, mb)) if k == v / 8 => mb,
-                            _ => {
-                                let mb = model.brick((v / 8).as_uvec3());
-                                last = Some((v / 8, mb));
-                                mb
-                            }
-                        };
-                        let Some(mb) = mb else { continue };
-                        let from = voxel_bit(v.x & 7, v.y & 7, v.z & 7);
-                        if mb.mask.get(from) {
-                            let bit = voxel_bit(x & 7, y & 7, z & 7);
+                        if let Some(b) = mb
+                            && b.mask.get(from as usize)
+                        {
+                            let bit = row + (x & 7) as usize;
                             mask.set(bit);
-                            mats[bit] = mb.materials[from];
+                            mats[bit] = b.material(from as usize);
+                        }
+                        if x == hi.x {
+                            break;
+                        }
+                        let before = v[axis] >> 3;
+                        v[axis] += step;
+                        if v[axis] >> 3 != before {
+                            mb = model.brick((v / 8).as_uvec3());
+                            from = voxel_bit(v.x & 7, v.y & 7, v.z & 7) as isize;
+                        } else {
+                            from += bit_step;
                         }
                     }
                 }

@@ -20,13 +20,73 @@ use std::collections::BTreeMap;
 /// identity fits the largest grid).
 pub const MAX_MODEL_VOXELS: IVec3 = IVec3::new(4096, 1024, 4096);
 
-/// One brick of a model: which voxels are solid and each voxel's material (0 where empty).
+/// One brick of a model: which voxels are solid and their materials.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ModelBrick {
     /// Solid voxels.
     pub mask: Mask,
-    /// Material per voxel (bit order), 0 where empty.
-    pub materials: Box<[u8; 512]>,
+    materials: BrickMaterials,
+}
+
+/// A brick's materials: one for every solid voxel (most bricks inside a solid: 65 bytes), or
+/// one per voxel in bit order (0 where empty).
+#[derive(Clone, Debug, PartialEq, Eq)]
+enum BrickMaterials {
+    Uniform(u8),
+    PerVoxel(Box<[u8; 512]>),
+}
+
+impl ModelBrick {
+    /// The material of voxel `bit` (meaningful where the mask is set).
+    #[inline]
+    pub fn material(&self, bit: usize) -> u8 {
+        match &self.materials {
+            BrickMaterials::Uniform(m) => *m,
+            BrickMaterials::PerVoxel(v) => v[bit],
+        }
+    }
+
+    /// The one material of every solid voxel, if they share one.
+    pub fn uniform(&self) -> Option<u8> {
+        match self.materials {
+            BrickMaterials::Uniform(m) => Some(m),
+            BrickMaterials::PerVoxel(_) => None,
+        }
+    }
+
+    /// Heap and inline bytes it takes.
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + match self.materials {
+                BrickMaterials::Uniform(_) => 0,
+                BrickMaterials::PerVoxel(_) => 512,
+            }
+    }
+
+    /// A brick of a mask and per-voxel materials, kept uniform when the solid voxels share one.
+    fn packed(mask: Mask, per_voxel: Box<[u8; 512]>) -> Self {
+        let mut bits = mask.ones();
+        let first = bits.next().map(|b| per_voxel[b]);
+        let materials = match first {
+            Some(m) if bits.all(|b| per_voxel[b] == m) => BrickMaterials::Uniform(m),
+            None => BrickMaterials::Uniform(0),
+            _ => BrickMaterials::PerVoxel(per_voxel),
+        };
+        Self { mask, materials }
+    }
+
+    fn per_voxel(&self) -> Box<[u8; 512]> {
+        match &self.materials {
+            BrickMaterials::Uniform(m) => {
+                let mut v = Box::new([0u8; 512]);
+                for bit in self.mask.ones() {
+                    v[bit] = *m;
+                }
+                v
+            }
+            BrickMaterials::PerVoxel(v) => v.clone(),
+        }
+    }
 }
 
 /// A model's voxels.
@@ -73,7 +133,7 @@ impl Model {
         }
         let b = self.bricks.get(&key((v / 8).as_uvec3()))?;
         let bit = voxel_bit(v.x & 7, v.y & 7, v.z & 7);
-        b.mask.get(bit).then(|| b.materials[bit])
+        b.mask.get(bit).then(|| b.material(bit))
     }
 
     /// A brick (`None` where empty).
@@ -84,6 +144,11 @@ impl Model {
     /// The non-empty bricks in (x, y, z) order.
     pub fn bricks(&self) -> impl Iterator<Item = (UVec3, &ModelBrick)> + '_ {
         self.bricks.iter().map(|(k, b)| (UVec3::from_array(*k), b))
+    }
+
+    /// Bytes its bricks take (masks, materials, the map's keys), without the map's own nodes.
+    pub fn brick_bytes(&self) -> usize {
+        self.bricks.values().map(|b| b.bytes() + 12).sum()
     }
 
     /// Solid voxels.
@@ -100,7 +165,7 @@ impl Model {
             h.update(bytemuck::bytes_of(k));
             h.update(bytemuck::bytes_of(&b.mask.0));
             for bit in b.mask.ones() {
-                h.update(&[b.materials[bit]]);
+                h.update(&[b.material(bit)]);
             }
         }
         h.digest()
@@ -264,13 +329,14 @@ impl Model {
         let k = key(b);
         let empty = ModelBrick {
             mask: Mask::EMPTY,
-            materials: Box::new([0; 512]),
+            materials: BrickMaterials::Uniform(0),
         };
         let old = self.bricks.get(&k).unwrap_or(&empty);
-        let mut next = old.clone();
+        let mut mask = old.mask;
+        let mut mats = old.per_voxel();
         let mut changed = 0;
         for bit in touched.ones() {
-            let now = old.mask.get(bit).then(|| old.materials[bit]);
+            let now = old.mask.get(bit).then(|| old.material(bit));
             let v = if paint_only && now.is_none() {
                 None
             } else {
@@ -281,12 +347,12 @@ impl Model {
             }
             match v {
                 Some(m) => {
-                    next.mask.set(bit);
-                    next.materials[bit] = m;
+                    mask.set(bit);
+                    mats[bit] = m;
                 }
                 None => {
-                    next.mask.clear(bit);
-                    next.materials[bit] = 0;
+                    mask.clear(bit);
+                    mats[bit] = 0;
                 }
             }
         }
@@ -294,11 +360,16 @@ impl Model {
             return 0;
         }
         let held = old.mask.and(touched);
-        let mats: Vec<u8> = held.ones().map(|bit| old.materials[bit]).collect();
-        let prior = match mats.first() {
-            Some(&m) if mats.iter().all(|x| *x == m) => PriorMaterials::Uniform(m),
-            None => PriorMaterials::Uniform(0),
-            _ => PriorMaterials::PerVoxel(mats),
+        let prior = match old.uniform() {
+            Some(m) => PriorMaterials::Uniform(m),
+            None => {
+                let held: Vec<u8> = held.ones().map(|bit| old.material(bit)).collect();
+                match held.first() {
+                    Some(&m) if held.iter().all(|x| *x == m) => PriorMaterials::Uniform(m),
+                    None => PriorMaterials::Uniform(0),
+                    _ => PriorMaterials::PerVoxel(held),
+                }
+            }
         };
         undo.push(BrickUndo {
             brick: b,
@@ -306,10 +377,10 @@ impl Model {
             touched: *touched,
             prior,
         });
-        if next.mask.is_empty() {
+        if mask.is_empty() {
             self.bricks.remove(&k);
         } else {
-            self.bricks.insert(k, next);
+            self.bricks.insert(k, ModelBrick::packed(mask, mats));
         }
         changed
     }

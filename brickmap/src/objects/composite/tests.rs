@@ -46,7 +46,7 @@ fn reference(tree: &ObjectTree, models: &BTreeMap<ModelId, Model>) -> HashMap<IV
             for bit in brick.mask.ones() {
                 let v = b.as_ivec3() * 8
                     + IVec3::new((bit & 7) as i32, (bit >> 3 & 7) as i32, (bit >> 6) as i32);
-                out.insert(d.placement.place(v, m.size()), brick.materials[bit]);
+                out.insert(d.placement.place(v, m.size()), brick.material(bit));
             }
         }
     }
