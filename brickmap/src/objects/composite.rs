@@ -222,24 +222,30 @@ impl Composite {
         (mask, mats)
     }
 
-    /// A brick's content as the world's bulk write takes it.
-    fn packed(
+    /// A brick's content as the world's bulk write takes it, or `None` where the world holds
+    /// exactly that already.
+    fn changed(
         &self,
         b: UVec3,
         models: &(impl ModelSource + Sync),
-    ) -> (UVec3, Mask, PriorMaterials) {
+        view: &crate::world::WorldView<'_>,
+    ) -> Option<(UVec3, Mask, PriorMaterials)> {
         let (mask, mats) = self.brick(b, models);
+        let (now_mask, now) = view.brick_voxels(b);
+        if now_mask == mask && mask.ones().all(|bit| now[bit] == mats[bit]) {
+            return None;
+        }
         let held: Vec<u8> = mask.ones().map(|bit| mats[bit]).collect();
         let prior = match held.first() {
             Some(&m) if held.iter().all(|x| *x == m) => PriorMaterials::Uniform(m),
             None => PriorMaterials::Uniform(0),
             _ => PriorMaterials::PerVoxel(held),
         };
-        (b, mask, prior)
+        Some((b, mask, prior))
     }
 
-    /// Recomputes world bricks and writes them whole; returns the world's inverse (which the
-    /// caller may drop: the composite is derived).
+    /// Recomputes world bricks and writes those whose content differs, whole; returns the
+    /// world's inverse (which the caller may drop: the composite is derived).
     pub fn write(
         &self,
         world: &World,
@@ -251,13 +257,15 @@ impl Composite {
         // contiguous chunks joined in order (the same result whatever the count).
         let threads = world.workers().clamp(1, list.len().max(1));
         let chunk = list.len().div_ceil(threads).max(1);
+        let view = world.read();
         let contents: Vec<_> = std::thread::scope(|s| {
+            let view = &view;
             let parts: Vec<_> = list
                 .chunks(chunk)
                 .map(|part| {
                     s.spawn(move || {
                         part.iter()
-                            .map(|b| self.packed(*b, models))
+                            .filter_map(|b| self.changed(*b, models, view))
                             .collect::<Vec<_>>()
                     })
                 })
@@ -267,6 +275,8 @@ impl Composite {
                 .flat_map(|h| h.join().expect("composite threads do not panic"))
                 .collect()
         });
+        // The readers' locks go before the write takes the slabs.
+        drop(view);
         if contents.is_empty() {
             return Ok(EditInverse::default());
         }
