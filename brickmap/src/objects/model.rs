@@ -188,27 +188,47 @@ impl Model {
                 let (lo, hi) = shape.voxel_bounds();
                 let lo = lo.clamp(IVec3::ZERO, self.size - 1) / 8;
                 let hi = hi.clamp(IVec3::ZERO, self.size - 1) / 8;
-                let mut changed = 0;
+                let mut list = Vec::new();
                 for z in lo.z..=hi.z {
                     for y in lo.y..=hi.y {
                         for x in lo.x..=hi.x {
-                            let b = UVec3::new(x as u32, y as u32, z as u32);
-                            let touched = shape.mask(b.as_ivec3() * 8).and(&self.inside(b));
-                            changed += self.write(
-                                b,
-                                &touched,
-                                &mut undo,
-                                |_, _| match mode {
-                                    Mode::Add(m) => Some(*m),
-                                    Mode::Remove => None,
-                                    Mode::Paint(m) => Some(*m),
-                                },
-                                matches!(mode, Mode::Paint(_)),
-                            );
+                            list.push(UVec3::new(x as u32, y as u32, z as u32));
                         }
                     }
                 }
-                changed
+                let value = |_: usize, _: Option<u8>| match mode {
+                    Mode::Add(m) | Mode::Paint(m) => Some(*m),
+                    Mode::Remove => None,
+                };
+                let paint = matches!(mode, Mode::Paint(_));
+                let one = |b: &UVec3| {
+                    let touched = shape.mask(b.as_ivec3() * 8).and(&self.inside(*b));
+                    self.rewrite(*b, &touched, value, paint)
+                };
+                // Bricks are independent: a large shape is computed on every core in
+                // contiguous chunks joined in order, then committed in that order.
+                let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+                let rewrites: Vec<Rewrite> = if list.len() < PARALLEL_BRICKS || threads < 2 {
+                    list.iter().filter_map(one).collect()
+                } else {
+                    let chunk = list.len().div_ceil(threads);
+                    std::thread::scope(|s| {
+                        let parts: Vec<_> = list
+                            .chunks(chunk)
+                            .map(|part| {
+                                s.spawn(move || part.iter().filter_map(one).collect::<Vec<_>>())
+                            })
+                            .collect();
+                        parts
+                            .into_iter()
+                            .flat_map(|h| h.join().expect("model threads do not panic"))
+                            .collect()
+                    })
+                };
+                rewrites
+                    .into_iter()
+                    .map(|r| self.commit(r, &mut undo))
+                    .sum()
             }
             EditOp::Voxels(list) => self.apply_voxels(list, &mut undo),
             EditOp::Restore(inv) => {
@@ -323,15 +343,29 @@ impl Model {
         new: impl Fn(usize, Option<u8>) -> Option<u8>,
         paint_only: bool,
     ) -> u64 {
-        if touched.is_empty() {
-            return 0;
+        match self.rewrite(b, touched, new, paint_only) {
+            Some(r) => self.commit(r, undo),
+            None => 0,
         }
-        let k = key(b);
+    }
+
+    /// What [`Model::write`] would do to brick `b`, computed without changing anything
+    /// (`None`: nothing would change).
+    fn rewrite(
+        &self,
+        b: UVec3,
+        touched: &Mask,
+        new: impl Fn(usize, Option<u8>) -> Option<u8>,
+        paint_only: bool,
+    ) -> Option<Rewrite> {
+        if touched.is_empty() {
+            return None;
+        }
         let empty = ModelBrick {
             mask: Mask::EMPTY,
             materials: BrickMaterials::Uniform(0),
         };
-        let old = self.bricks.get(&k).unwrap_or(&empty);
+        let old = self.bricks.get(&key(b)).unwrap_or(&empty);
         let mut mask = old.mask;
         let mut mats = old.per_voxel();
         let mut changed = 0;
@@ -357,7 +391,7 @@ impl Model {
             }
         }
         if changed == 0 {
-            return 0;
+            return None;
         }
         let held = old.mask.and(touched);
         let prior = match old.uniform() {
@@ -371,19 +405,38 @@ impl Model {
                 }
             }
         };
-        undo.push(BrickUndo {
-            brick: b,
-            prior_mask: old.mask,
-            touched: *touched,
-            prior,
-        });
-        if mask.is_empty() {
-            self.bricks.remove(&k);
-        } else {
-            self.bricks.insert(k, ModelBrick::packed(mask, mats));
-        }
-        changed
+        Some(Rewrite {
+            undo: BrickUndo {
+                brick: b,
+                prior_mask: old.mask,
+                touched: *touched,
+                prior,
+            },
+            brick: (!mask.is_empty()).then(|| ModelBrick::packed(mask, mats)),
+            changed,
+        })
     }
+
+    /// Stores a computed rewrite and records its undo; returns the voxels changed.
+    fn commit(&mut self, r: Rewrite, undo: &mut Vec<BrickUndo>) -> u64 {
+        let k = key(r.undo.brick);
+        match r.brick {
+            Some(b) => self.bricks.insert(k, b),
+            None => self.bricks.remove(&k),
+        };
+        undo.push(r.undo);
+        r.changed
+    }
+}
+
+/// Shapes over at least this many bricks are computed on every core.
+const PARALLEL_BRICKS: usize = 256;
+
+/// One brick's new content, its undo and the voxels it changes.
+struct Rewrite {
+    undo: BrickUndo,
+    brick: Option<ModelBrick>,
+    changed: u64,
 }
 
 #[cfg(test)]
@@ -494,6 +547,67 @@ mod tests {
                 model.apply(&EditOp::Restore(inv), &t).unwrap();
             }
             prop_assert_eq!(model.content_hash(), end);
+        }
+    }
+
+    #[test]
+    fn a_large_shape_computed_on_every_core_matches_the_world() {
+        let t = table(4);
+        let size = IVec3::new(128, 64, 96);
+        let world = World::new(
+            GridDims::from_voxels(size.as_uvec3()).unwrap(),
+            WorldConfig::with_workers(3),
+        )
+        .unwrap();
+        world.replace_materials(t.clone()).unwrap();
+        let mut model = Model::new(size).unwrap();
+        let ops = [
+            EditOp::Shape {
+                shape: Shape::Sphere {
+                    centre: DVec3::new(60.3, 30.0, 50.0),
+                    radius: 40.0,
+                },
+                mode: Mode::Add(2),
+            },
+            EditOp::Shape {
+                shape: Shape::Box {
+                    min: IVec3::new(10, 5, 10),
+                    max: IVec3::new(120, 40, 90),
+                },
+                mode: Mode::Paint(3),
+            },
+            EditOp::Shape {
+                shape: Shape::Sphere {
+                    centre: DVec3::new(70.0, 40.5, 40.0),
+                    radius: 25.0,
+                },
+                mode: Mode::Remove,
+            },
+        ];
+        let mut undo = Vec::new();
+        for op in &ops {
+            let before = model.content_hash();
+            let m = model.apply(op, &t).unwrap();
+            if let EditOp::Shape { shape, .. } = op {
+                let (lo, hi) = shape.voxel_bounds();
+                let (lo, hi) = (
+                    lo.clamp(IVec3::ZERO, size - 1) / 8,
+                    hi.clamp(IVec3::ZERO, size - 1) / 8,
+                );
+                let bricks = (hi - lo + 1).element_product() as usize;
+                assert!(
+                    bricks >= PARALLEL_BRICKS,
+                    "the parallel path runs: {bricks}"
+                );
+            }
+            let w = world.apply(op.clone()).unwrap();
+            assert_eq!(m.changed_voxels, w.changed_voxels);
+            undo.push((before, m.inverse));
+        }
+        same(&model, &world);
+        for (before, inv) in undo.into_iter().rev() {
+            model.apply(&EditOp::Restore(inv), &t).unwrap();
+            assert_eq!(model.content_hash(), before);
         }
     }
 
