@@ -11,11 +11,15 @@ pub mod composite;
 pub mod frame;
 pub mod model;
 pub mod orient;
+pub mod scene;
+#[cfg(test)]
+mod testing;
 pub mod tree;
 
 pub use composite::{Composite, CompositeError, ModelSource};
 pub use model::{MAX_MODEL_VOXELS, Model, ModelBrick};
 pub use orient::{Axis, Orientation, Placement};
+pub use scene::{ObjectError, ObjectOp, Objects};
 pub use tree::{
     Detached, Drawn, Layer, LayerId, ModelId, NewNode, Node, NodeId, NodeKind, ObjectTree,
     TreeError,

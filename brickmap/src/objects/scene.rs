@@ -1,0 +1,453 @@
+//! [`Objects`]: the tree, the models and the composite changed together, one [`ObjectOp`] at
+//! a time. Every op is checked before anything changes, applied to the tree or a model, and
+//! followed by the composite's update of the world; it returns its exact inverse (another
+//! op), so a command's undo and redo are ops too. An op the composite refuses (an object
+//! would leave the grid) is taken back and reported; the tree, the models and the world are
+//! then as they were.
+//!
+//! Locked nodes refuse edits, placements, moves and removal (their unlocking is an op).
+
+use super::composite::{Composite, CompositeError};
+use super::model::Model;
+use super::orient::Placement;
+use super::tree::{Detached, LayerId, ModelId, NewNode, NodeId, NodeKind, ObjectTree, TreeError};
+use crate::edit::{EditInverse, EditOp};
+use crate::error::BrickmapError;
+use crate::material::MaterialTable;
+use crate::world::World;
+use glam::IVec3;
+use std::collections::BTreeMap;
+
+/// One change of a scene of objects. Applying it returns its inverse.
+#[derive(Clone, Debug)]
+pub enum ObjectOp {
+    /// An edit in world voxels of an object's model (carried into the object's frame; the
+    /// model's other instances follow).
+    Edit {
+        /// The object.
+        node: NodeId,
+        /// The edit, in world voxels.
+        edit: EditOp,
+    },
+    /// Puts back what a model edit changed (the inverse of `Edit`, in the model's frame).
+    RestoreModel {
+        /// The model.
+        model: ModelId,
+        /// Its inverse.
+        inverse: EditInverse,
+    },
+    /// A node's placement relative to its parent.
+    Place {
+        /// The node.
+        node: NodeId,
+        /// The new placement.
+        placement: Placement,
+    },
+    /// Shows or hides a node and its subtree.
+    Show {
+        /// The node.
+        node: NodeId,
+        /// Visible.
+        visible: bool,
+    },
+    /// Locks or unlocks a node.
+    Lock {
+        /// The node.
+        node: NodeId,
+        /// Locked.
+        locked: bool,
+    },
+    /// Renames a node.
+    Rename {
+        /// The node.
+        node: NodeId,
+        /// The name.
+        name: String,
+    },
+    /// Moves a node under `parent` at `index` (the end when `None`).
+    Move {
+        /// The node.
+        node: NodeId,
+        /// The new parent group.
+        parent: NodeId,
+        /// The position among its children.
+        index: Option<usize>,
+    },
+    /// Adds a node (it takes the lowest free id).
+    Add {
+        /// The parent group.
+        parent: NodeId,
+        /// The position among its children (the end when `None`).
+        index: Option<usize>,
+        /// Its name.
+        name: String,
+        /// Its placement.
+        placement: Placement,
+        /// A group, or an object of an existing model.
+        new: NewNode,
+    },
+    /// Removes a node and its subtree.
+    Remove {
+        /// The node.
+        node: NodeId,
+    },
+    /// Puts a removed subtree back under its ids (the inverse of `Remove`).
+    Restore(Detached),
+    /// Makes an object place another existing model (make unique, instance).
+    SetModel {
+        /// The object.
+        node: NodeId,
+        /// The model.
+        model: ModelId,
+    },
+    /// Adds a model under an unused id (for a duplicate or a split).
+    AddModel {
+        /// Its id.
+        model: ModelId,
+        /// Its voxels.
+        voxels: Box<Model>,
+    },
+    /// Removes a model no object places.
+    RemoveModel {
+        /// Its id.
+        model: ModelId,
+    },
+    /// Shows or hides a layer.
+    ShowLayer {
+        /// The layer.
+        layer: LayerId,
+        /// Visible.
+        visible: bool,
+    },
+    /// Several ops as one: all or none (on an error the ones done are undone).
+    Batch(Vec<ObjectOp>),
+}
+
+/// Why an op was refused; nothing changed.
+#[derive(Debug, thiserror::Error)]
+pub enum ObjectError {
+    /// The tree refused (no such node, a loop, a position, the depth).
+    #[error(transparent)]
+    Tree(#[from] TreeError),
+    /// The composite refused (an object would leave the grid, a model is missing).
+    #[error(transparent)]
+    Composite(#[from] CompositeError),
+    /// The model or the world refused the edit.
+    #[error(transparent)]
+    Edit(#[from] BrickmapError),
+    /// The node is locked.
+    #[error("node #{} is locked", .0.0)]
+    Locked(NodeId),
+    /// The node is a group where an object is needed.
+    #[error("node #{} is a group, not an object", .0.0)]
+    NotAnObject(NodeId),
+    /// No model has this id.
+    #[error("no model {}", .0.0)]
+    NoModel(ModelId),
+    /// The id is taken by another model.
+    #[error("model {} exists already", .0.0)]
+    ModelTaken(ModelId),
+    /// Objects still place the model.
+    #[error("model {} is placed by {} objects", .0.0, .1)]
+    ModelInUse(ModelId, usize),
+}
+
+/// A scene of objects: the tree, the models, and the composite they make in a world of a
+/// fixed grid (see the module doc).
+#[derive(Debug)]
+pub struct Objects {
+    tree: ObjectTree,
+    models: BTreeMap<ModelId, Model>,
+    composite: Composite,
+    grid: IVec3,
+}
+
+impl Objects {
+    /// A scene of a tree and its models for a world of `grid` voxels, written into `world`
+    /// (every brick the objects cover).
+    pub fn new(
+        tree: ObjectTree,
+        models: BTreeMap<ModelId, Model>,
+        world: &World,
+    ) -> Result<Self, ObjectError> {
+        let grid = world.dims().voxels();
+        let composite = Composite::new(&tree, &models, grid)?;
+        composite.write(world, &composite.all_bricks(), &models)?;
+        Ok(Self {
+            tree,
+            models,
+            composite,
+            grid,
+        })
+    }
+
+    /// The tree.
+    pub fn tree(&self) -> &ObjectTree {
+        &self.tree
+    }
+
+    /// A model.
+    pub fn model(&self, id: ModelId) -> Option<&Model> {
+        self.models.get(&id)
+    }
+
+    /// The models by id.
+    pub fn models(&self) -> &BTreeMap<ModelId, Model> {
+        &self.models
+    }
+
+    /// The lowest model id no model has.
+    pub fn free_model_id(&self) -> ModelId {
+        (0..)
+            .map(ModelId)
+            .find(|m| !self.models.contains_key(m))
+            .expect("fewer than 2^32 models")
+    }
+
+    /// Applies an op to the scene and its world; returns the inverse.
+    pub fn apply(
+        &mut self,
+        world: &World,
+        op: ObjectOp,
+        table: &MaterialTable,
+    ) -> Result<ObjectOp, ObjectError> {
+        match op {
+            ObjectOp::Edit { node, edit } => {
+                self.unlocked(node)?;
+                let model = self.object_model(node)?;
+                let p = self.tree.world_placement(node)?;
+                let size = self.models[&model].size();
+                let carried = p.edit_to_model(&edit, size)?;
+                self.edit_model(world, model, &carried, table)
+            }
+            ObjectOp::RestoreModel { model, inverse } => {
+                self.edit_model(world, model, &EditOp::Restore(inverse), table)
+            }
+            ObjectOp::Place { node, placement } => {
+                self.unlocked(node)?;
+                let before = self.tree.node(node)?.placement;
+                self.tree.node_mut(node)?.placement = placement;
+                self.settle(world, &[], |t| {
+                    t.node_mut(node).map(|n| n.placement = before)
+                })?;
+                Ok(ObjectOp::Place {
+                    node,
+                    placement: before,
+                })
+            }
+            ObjectOp::Show { node, visible } => {
+                let before = self.tree.node(node)?.visible;
+                self.tree.node_mut(node)?.visible = visible;
+                self.settle(world, &[], |t| t.node_mut(node).map(|n| n.visible = before))?;
+                Ok(ObjectOp::Show {
+                    node,
+                    visible: before,
+                })
+            }
+            ObjectOp::Lock { node, locked } => {
+                let n = self.tree.node_mut(node)?;
+                let before = std::mem::replace(&mut n.locked, locked);
+                Ok(ObjectOp::Lock {
+                    node,
+                    locked: before,
+                })
+            }
+            ObjectOp::Rename { node, name } => {
+                let n = self.tree.node_mut(node)?;
+                let before = std::mem::replace(&mut n.name, name);
+                Ok(ObjectOp::Rename { node, name: before })
+            }
+            ObjectOp::Move {
+                node,
+                parent,
+                index,
+            } => {
+                self.unlocked(node)?;
+                let (old_parent, old_index) = self.tree.move_node(node, parent, index)?;
+                // Its objects' place in the drawing order changed: their boxes are redrawn.
+                let moved = self.tree.subtree(node)?;
+                self.settle(world, &moved, |t| {
+                    t.move_node(node, old_parent, Some(old_index)).map(|_| ())
+                })?;
+                Ok(ObjectOp::Move {
+                    node,
+                    parent: old_parent,
+                    index: Some(old_index),
+                })
+            }
+            ObjectOp::Add {
+                parent,
+                index,
+                name,
+                placement,
+                new,
+            } => {
+                if let NewNode::Object { model, .. } = new
+                    && !self.models.contains_key(&model)
+                {
+                    return Err(ObjectError::NoModel(model));
+                }
+                let node = self.tree.add(parent, index, name, placement, new)?;
+                self.settle(world, &[], |t| t.remove(node).map(|_| ()))?;
+                Ok(ObjectOp::Remove { node })
+            }
+            ObjectOp::Remove { node } => {
+                for n in self.tree.subtree(node)? {
+                    self.unlocked(n)?;
+                }
+                let detached = self.tree.remove(node)?;
+                let back = detached.clone();
+                self.settle(world, &[], |t| t.restore(back))?;
+                Ok(ObjectOp::Restore(detached))
+            }
+            ObjectOp::Restore(detached) => {
+                let top = detached.top();
+                self.tree.restore(detached)?;
+                self.settle(world, &[], |t| t.remove(top).map(|_| ()))?;
+                Ok(ObjectOp::Remove { node: top })
+            }
+            ObjectOp::SetModel { node, model } => {
+                self.unlocked(node)?;
+                let before = self.object_model(node)?;
+                if !self.models.contains_key(&model) {
+                    return Err(ObjectError::NoModel(model));
+                }
+                self.set_model(node, model)?;
+                self.settle(world, &[], |t| Self::set_model_in(t, node, before))?;
+                Ok(ObjectOp::SetModel {
+                    node,
+                    model: before,
+                })
+            }
+            ObjectOp::AddModel { model, voxels } => {
+                if self.models.contains_key(&model) {
+                    return Err(ObjectError::ModelTaken(model));
+                }
+                self.models.insert(model, *voxels);
+                Ok(ObjectOp::RemoveModel { model })
+            }
+            ObjectOp::RemoveModel { model } => {
+                let users = self.tree.instances(model).len();
+                if users > 0 {
+                    return Err(ObjectError::ModelInUse(model, users));
+                }
+                let voxels = self
+                    .models
+                    .remove(&model)
+                    .ok_or(ObjectError::NoModel(model))?;
+                Ok(ObjectOp::AddModel {
+                    model,
+                    voxels: Box::new(voxels),
+                })
+            }
+            ObjectOp::ShowLayer { layer, visible } => {
+                let before = self.tree.layer_mut(layer)?.visible;
+                self.tree.layer_mut(layer)?.visible = visible;
+                self.settle(world, &[], |t| {
+                    t.layer_mut(layer).map(|l| l.visible = before)
+                })?;
+                Ok(ObjectOp::ShowLayer {
+                    layer,
+                    visible: before,
+                })
+            }
+            ObjectOp::Batch(ops) => {
+                let mut done: Vec<ObjectOp> = Vec::with_capacity(ops.len());
+                for op in ops {
+                    match self.apply(world, op, table) {
+                        Ok(inverse) => done.push(inverse),
+                        Err(e) => {
+                            for inverse in done.into_iter().rev() {
+                                self.apply(world, inverse, table)
+                                    .expect("an inverse of an op just applied applies");
+                            }
+                            return Err(e);
+                        }
+                    }
+                }
+                done.reverse();
+                Ok(ObjectOp::Batch(done))
+            }
+        }
+    }
+
+    fn unlocked(&self, node: NodeId) -> Result<(), ObjectError> {
+        if self.tree.node(node)?.locked {
+            return Err(ObjectError::Locked(node));
+        }
+        Ok(())
+    }
+
+    fn object_model(&self, node: NodeId) -> Result<ModelId, ObjectError> {
+        match self.tree.node(node)?.kind {
+            NodeKind::Object { model, .. } => Ok(model),
+            NodeKind::Group { .. } => Err(ObjectError::NotAnObject(node)),
+        }
+    }
+
+    fn set_model(&mut self, node: NodeId, model: ModelId) -> Result<(), ObjectError> {
+        Self::set_model_in(&mut self.tree, node, model)?;
+        Ok(())
+    }
+
+    fn set_model_in(tree: &mut ObjectTree, node: NodeId, model: ModelId) -> Result<(), TreeError> {
+        if let NodeKind::Object { model: m, .. } = &mut tree.node_mut(node)?.kind {
+            *m = model;
+        }
+        Ok(())
+    }
+
+    /// A model edit (already in the model's frame) and the composite after it.
+    fn edit_model(
+        &mut self,
+        world: &World,
+        model: ModelId,
+        edit: &EditOp,
+        table: &MaterialTable,
+    ) -> Result<ObjectOp, ObjectError> {
+        let m = self
+            .models
+            .get_mut(&model)
+            .ok_or(ObjectError::NoModel(model))?;
+        let out = m.apply(edit, table)?;
+        if let Err(e) = self
+            .composite
+            .model_edited(world, &self.models, model, &out.inverse)
+        {
+            // The world refused the write: the model goes back too.
+            let m = self.models.get_mut(&model).expect("just edited");
+            m.apply(&EditOp::Restore(out.inverse), table)
+                .expect("a model takes its own inverse");
+            return Err(e.into());
+        }
+        Ok(ObjectOp::RestoreModel {
+            model,
+            inverse: out.inverse,
+        })
+    }
+
+    /// Brings the composite to the tree as it now is; if it refuses, `undo` puts the tree
+    /// back (the composite and the world are unchanged then).
+    fn settle(
+        &mut self,
+        world: &World,
+        also: &[NodeId],
+        undo: impl FnOnce(&mut ObjectTree) -> Result<(), TreeError>,
+    ) -> Result<(), ObjectError> {
+        match self.composite.update(world, &self.tree, &self.models, also) {
+            Ok(_) => Ok(()),
+            Err(e) => {
+                undo(&mut self.tree).expect("a tree change just made can be taken back");
+                Err(e.into())
+            }
+        }
+    }
+
+    /// The grid the composite fills, in voxels.
+    pub fn grid(&self) -> IVec3 {
+        self.grid
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,261 @@
+//! Random sessions of object ops: after each, the world is the forward reference of the
+//! tree; undoing them all gives back the first tree, models and world exactly, and redoing
+//! the undos gives back the last.
+
+use super::*;
+use crate::edit::Mode;
+use crate::objects::orient::Orientation;
+use crate::objects::testing::{GRID, assert_matches, model, reference, table, world};
+use crate::objects::tree::Layer;
+use crate::shape::Shape;
+use glam::DVec3;
+use proptest::prelude::*;
+
+/// A session's first scene: a group holding two objects of models 0 and 1, model 1 placed
+/// again at the top level, a second layer.
+fn start(workers: usize) -> (Objects, World) {
+    let mut tree = ObjectTree::new();
+    tree.add_layer(Layer {
+        name: "second".into(),
+        visible: true,
+    })
+    .unwrap();
+    let g = tree
+        .add(
+            ObjectTree::ROOT,
+            None,
+            "g",
+            Placement::at(IVec3::new(24, 12, 20)),
+            NewNode::Group,
+        )
+        .unwrap();
+    let object = |m: u32, layer: u8| NewNode::Object {
+        model: ModelId(m),
+        layer: LayerId(layer),
+    };
+    tree.add(
+        g,
+        None,
+        "a",
+        Placement::at(IVec3::new(-6, 0, 0)),
+        object(0, 0),
+    )
+    .unwrap();
+    tree.add(
+        g,
+        None,
+        "b",
+        Placement::at(IVec3::new(6, 2, 4)),
+        object(1, 1),
+    )
+    .unwrap();
+    tree.add(
+        ObjectTree::ROOT,
+        None,
+        "c",
+        Placement::at(IVec3::new(44, 14, 30)),
+        object(1, 0),
+    )
+    .unwrap();
+    let models = BTreeMap::from([
+        (ModelId(0), model(IVec3::new(9, 6, 5), 0)),
+        (ModelId(1), model(IVec3::new(7, 8, 10), 1)),
+    ]);
+    let w = world(workers);
+    let objects = Objects::new(tree, models, &w).unwrap();
+    (objects, w)
+}
+
+/// A random op over the nodes 0..6 and models 0..3 (many are refused: a test of that too).
+fn op() -> impl Strategy<Value = ObjectOp> {
+    let node = (0u32..6).prop_map(NodeId);
+    let p = (0usize..48, (8..56, 8..24, 8..40)).prop_map(|(r, (x, y, z))| Placement {
+        rot: Orientation::all().nth(r).unwrap(),
+        t: IVec3::new(x, y, z) - IVec3::new(24, 12, 20) * (x % 2),
+    });
+    prop_oneof![
+        (
+            node.clone(),
+            (0..64, 0..32, 0..48),
+            1.0f64..6.0,
+            any::<bool>()
+        )
+            .prop_map(|(node, (x, y, z), radius, remove)| ObjectOp::Edit {
+                node,
+                edit: EditOp::Shape {
+                    shape: Shape::Sphere {
+                        centre: DVec3::new(x as f64, y as f64, z as f64) + 0.5,
+                        radius,
+                    },
+                    mode: if remove { Mode::Remove } else { Mode::Add(4) },
+                },
+            }),
+        (node.clone(), p.clone()).prop_map(|(node, placement)| ObjectOp::Place { node, placement }),
+        (node.clone(), any::<bool>()).prop_map(|(node, visible)| ObjectOp::Show { node, visible }),
+        (node.clone(), any::<bool>()).prop_map(|(node, locked)| ObjectOp::Lock { node, locked }),
+        (node.clone(), node.clone(), 0usize..4).prop_map(|(node, parent, i)| ObjectOp::Move {
+            node,
+            parent,
+            index: Some(i)
+        }),
+        (node.clone(), p, 0u32..3).prop_map(|(parent, placement, m)| ObjectOp::Add {
+            parent,
+            index: None,
+            name: "new".into(),
+            placement,
+            new: NewNode::Object {
+                model: ModelId(m),
+                layer: LayerId(0)
+            },
+        }),
+        node.clone().prop_map(|node| ObjectOp::Remove { node }),
+        (node.clone(), 0u32..3).prop_map(|(node, model)| ObjectOp::SetModel {
+            node,
+            model: ModelId(model)
+        }),
+        (0u32..3).prop_map(|m| ObjectOp::AddModel {
+            model: ModelId(m),
+            voxels: Box::new(model(IVec3::new(5, 5, 3), m as i32 + 2)),
+        }),
+        (0u32..3).prop_map(|m| ObjectOp::RemoveModel { model: ModelId(m) }),
+        any::<bool>().prop_map(|visible| ObjectOp::ShowLayer {
+            layer: LayerId(1),
+            visible
+        }),
+    ]
+}
+
+/// Everything an op may change: the tree, every model's content, the world's content.
+fn state(o: &Objects, w: &World) -> (ObjectTree, Vec<(ModelId, u64)>, u64) {
+    (
+        o.tree().clone(),
+        o.models()
+            .iter()
+            .map(|(id, m)| (*id, m.content_hash()))
+            .collect(),
+        w.read().content_hash(),
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+    #[test]
+    fn random_ops_undo_and_redo_exactly(
+        ops in prop::collection::vec(op(), 1..14),
+        batch in any::<bool>()
+    ) {
+        let t = table();
+        let (mut o, w) = start(2);
+        let first = state(&o, &w);
+        // Half the sessions apply their ops as one batch (all or none).
+        let ops = if batch { vec![ObjectOp::Batch(ops)] } else { ops };
+        let mut undo = Vec::new();
+        for op in ops {
+            let before = state(&o, &w);
+            match o.apply(&w, op, &t) {
+                Ok(inverse) => undo.push(inverse),
+                Err(_) => prop_assert_eq!(&state(&o, &w), &before, "a refused op changes nothing"),
+            }
+            assert_matches(&w, &reference(o.tree(), o.models()));
+        }
+        let last = state(&o, &w);
+        let mut redo = Vec::new();
+        for inverse in undo.into_iter().rev() {
+            redo.push(o.apply(&w, inverse, &t).unwrap());
+        }
+        prop_assert_eq!(&state(&o, &w), &first);
+        for op in redo.into_iter().rev() {
+            o.apply(&w, op, &t).unwrap();
+        }
+        prop_assert_eq!(&state(&o, &w), &last);
+        assert_matches(&w, &reference(o.tree(), o.models()));
+    }
+}
+
+#[test]
+fn locked_objects_refuse_edits_and_moves_and_a_shared_model_edit_shows_in_both() {
+    let t = table();
+    let (mut o, w) = start(1);
+    let (b, c) = (NodeId(3), NodeId(4));
+    assert_eq!(o.tree().instances(ModelId(1)), [b, c]);
+    o.apply(
+        &w,
+        ObjectOp::Lock {
+            node: c,
+            locked: true,
+        },
+        &t,
+    )
+    .unwrap();
+    let before = state(&o, &w);
+    let centre = o.tree().world_placement(c).unwrap().t.as_dvec3();
+    let edit = EditOp::Shape {
+        shape: Shape::Sphere {
+            centre,
+            radius: 3.0,
+        },
+        mode: Mode::Remove,
+    };
+    assert!(matches!(
+        o.apply(&w, ObjectOp::Edit { node: c, edit: edit.clone() }, &t),
+        Err(ObjectError::Locked(n)) if n == c
+    ));
+    assert!(matches!(
+        o.apply(
+            &w,
+            ObjectOp::Place {
+                node: c,
+                placement: Placement::IDENTITY
+            },
+            &t
+        ),
+        Err(ObjectError::Locked(_))
+    ));
+    assert!(matches!(
+        o.apply(
+            &w,
+            ObjectOp::Remove {
+                node: ObjectTree::ROOT
+            },
+            &t
+        ),
+        Err(ObjectError::Locked(_)) | Err(ObjectError::Tree(TreeError::Root))
+    ));
+    assert_eq!(state(&o, &w), before);
+    // Editing b (unlocked) edits model 1, which c shows too.
+    let centre_b = o.tree().world_placement(b).unwrap().t.as_dvec3();
+    let edit_b = EditOp::Shape {
+        shape: Shape::Sphere {
+            centre: centre_b,
+            radius: 3.0,
+        },
+        mode: Mode::Remove,
+    };
+    let solid = o.model(ModelId(1)).unwrap().solid_count();
+    o.apply(
+        &w,
+        ObjectOp::Edit {
+            node: b,
+            edit: edit_b,
+        },
+        &t,
+    )
+    .unwrap();
+    assert!(o.model(ModelId(1)).unwrap().solid_count() < solid);
+    assert_matches(&w, &reference(o.tree(), o.models()));
+    // A model in use cannot be removed; an object cannot leave the grid.
+    assert!(matches!(
+        o.apply(&w, ObjectOp::RemoveModel { model: ModelId(1) }, &t),
+        Err(ObjectError::ModelInUse(_, 2))
+    ));
+    let before = state(&o, &w);
+    let far = ObjectOp::Place {
+        node: b,
+        placement: Placement::at(GRID * 2),
+    };
+    assert!(matches!(
+        o.apply(&w, far, &t),
+        Err(ObjectError::Composite(_))
+    ));
+    assert_eq!(state(&o, &w), before);
+}
