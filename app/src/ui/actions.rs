@@ -30,18 +30,18 @@ impl Editor {
             Action::Frame => {
                 let (min, max) = content_bounds(&self.read().scene);
                 let aspect = self.aspect();
-                self.view.frame(min, max, aspect);
+                self.viewing.camera.frame(min, max, aspect);
                 self.moved();
             }
             Action::ToggleProjection => {
                 let size = self.read().scene.world.dims().voxels().as_dvec3();
-                self.view.toggle_projection(DVec3::ZERO, size);
+                self.viewing.camera.toggle_projection(DVec3::ZERO, size);
                 self.moved();
             }
-            Action::StoreView(n) => self.slots[n as usize - 1] = Some(self.view.clone()),
+            Action::StoreView(n) => self.viewing.store(n),
             Action::RecallView(n) => {
-                if let Some(v) = self.slots[n as usize - 1].clone() {
-                    self.view = v;
+                if let Some(v) = self.viewing.stored(n) {
+                    self.viewing.camera = v;
                     self.moved();
                 }
             }
@@ -115,7 +115,7 @@ impl Editor {
                 }
             }
             UiEvent::UseViewAsSceneCamera => {
-                self.execute(Command::SetCamera(self.view.camera.clone()))
+                self.execute(Command::SetCamera(self.viewing.camera.camera.clone()))
             }
             UiEvent::NewScene { size, terrain } => {
                 self.guard_unsaved(Pending::New { size, terrain })

@@ -87,7 +87,7 @@ impl Editor {
             } => {
                 if camera_changed {
                     let view = scene_view(&self.read().scene);
-                    self.view = view;
+                    self.viewing.camera = view;
                 }
                 if let Some(s) = &mut self.script {
                     s.run = Some(run);
@@ -146,7 +146,7 @@ impl Editor {
             doc.recorder = self.carry_recording(path.as_deref());
         }
         doc.path = path.filter(|_| is_project);
-        self.view = scene_view(&doc.scene);
+        self.viewing.camera = scene_view(&doc.scene);
         self.progress = doc.progress.clone();
         self.doc = Arc::new(RwLock::new(doc));
         self.generation += 1;

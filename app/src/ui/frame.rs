@@ -116,8 +116,8 @@ impl Editor {
         host: Host,
         size: (u32, u32),
     ) -> Result<()> {
-        self.window_size = size;
-        self.view_area = (0, 0, size.0, size.1);
+        self.viewing.set_window(size);
+        self.viewing.set_area((0, 0, size.0, size.1));
         let viewport = {
             let doc = self.read();
             let view = doc.scene.world.read();
@@ -210,7 +210,7 @@ impl Editor {
         let samples = gfx.viewport.samples();
         let gpu_ms = gfx.viewport.last_gpu_seconds().map_or(0.0, |s| s * 1e3);
         let size = gfx.host.inner_size();
-        let shown = (self.view_area.2, self.view_area.3);
+        let shown = (self.viewing.area().2, self.viewing.area().3);
         let internal = gfx.viewport.fit_internal(self.internal_size(shown));
         let paths = internal.0 as f64 * internal.1 as f64 * self.frames.last_added as f64;
         self.panels.status = format!(
@@ -223,7 +223,7 @@ impl Editor {
             },
             internal.0,
             internal.1,
-            if self.view.camera.is_orthographic() {
+            if self.viewing.camera.camera.is_orthographic() {
                 " · orthographic"
             } else {
                 ""
@@ -255,7 +255,7 @@ impl Editor {
                     .as_ref()
                     .filter(|_| self.pointer.pasting),
             );
-            let view_area = self.view_area;
+            let view_area = self.viewing.area();
             let brush = &self.settings.brush;
             let keeps_layer = brush.shape == crate::editor::command::BrushShape::Box
                 || (brush.mode == crate::editor::command::BrushMode::Attach
@@ -284,12 +284,12 @@ impl Editor {
                     egui::pos2(x as f32 / ppp, y as f32 / ppp),
                     egui::vec2(w as f32 / ppp, h as f32 / ppp),
                 );
-                self.preview.paint(&painter, &self.view, rect);
+                self.preview.paint(&painter, &self.viewing.camera, rect);
                 let brush = &self.settings.brush;
                 let dims = doc.scene.world.dims().voxels();
                 selecting::paint(
                     &painter,
-                    &self.view,
+                    &self.viewing.camera,
                     rect,
                     doc.scene.selection.as_ref(),
                     dims,
@@ -297,10 +297,10 @@ impl Editor {
                     paste,
                 );
                 if empty {
-                    preview::paint_floor(&painter, &self.view, rect, dims);
+                    preview::paint_floor(&painter, &self.viewing.camera, rect, dims);
                 }
                 if let Some(layer) = layer {
-                    preview::paint_layer(&painter, &self.view, rect, layer, dims);
+                    preview::paint_layer(&painter, &self.viewing.camera, rect, layer, dims);
                 }
                 // A box being dragged says its size beside the cursor.
                 let cursor = egui::pos2(
@@ -312,11 +312,12 @@ impl Editor {
                 }
                 // The voxels a click pastes, where it pastes them (the box is drawn above).
                 if let Some((at, _)) = paste {
-                    self.preview.paint_paste(&painter, &self.view, rect, at);
+                    self.preview
+                        .paint_paste(&painter, &self.viewing.camera, rect, at);
                 }
                 preview::paint_mirror(
                     &painter,
-                    &self.view,
+                    &self.viewing.camera,
                     rect,
                     brush.mirror,
                     brush.centre(dims),
@@ -334,12 +335,11 @@ impl Editor {
             Some(r) if self.script.is_none() => pixel_area(r, self.egui.pixels_per_point(), size),
             _ => (0, 0, size.0, size.1),
         };
-        if area != self.view_area {
+        if self.viewing.set_area(area) {
             let (x, y, w, h) = area;
             self.report.line(format_args!("viewport {x} {y} {w} {h}"));
         }
-        self.view_area = area;
-        let shown = (self.view_area.2, self.view_area.3);
+        let shown = (area.2, area.3);
         let internal = gfx.viewport.fit_internal(self.internal_size(shown));
         let egui::FullOutput {
             platform_output,
@@ -381,7 +381,7 @@ impl Editor {
         let doc = self.doc.clone();
         let doc = doc.read().unwrap_or_else(|p| p.into_inner());
         let mut params = doc.scene.params.clone();
-        params.camera = self.view.camera.clone();
+        params.camera = self.viewing.camera.camera.clone();
         let request = FrameRequest {
             params: &params,
             internal,
@@ -402,7 +402,7 @@ impl Editor {
             &mut gfx.viewport,
             &doc.scene.world,
             &request,
-            Some(self.view_area),
+            Some(self.viewing.area()),
             ui,
             capture_now,
         )?;

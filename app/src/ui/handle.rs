@@ -70,7 +70,7 @@ impl Editor {
         match input {
             Input::Close => self.action(Action::Quit),
             Input::Resized(w, h) => {
-                self.window_size = (w, h);
+                self.viewing.set_window((w, h));
                 if let Some(gfx) = &mut self.gfx {
                     gfx.presenter.resize((w, h));
                     gfx.host.request_redraw();
@@ -197,16 +197,16 @@ impl Editor {
         // The preview follows the cursor.
         self.request_redraw();
         if let Some((drag, _)) = self.pointer.drag {
-            let h = self.view_area.3.max(1) as f64;
+            let h = self.viewing.area().3.max(1) as f64;
             let (dx, dy) = (
                 self.pointer.cursor.0 - previous.0,
                 self.pointer.cursor.1 - previous.1,
             );
             match drag {
-                Drag::Orbit => self.view.orbit(-dx * 0.3, -dy * 0.3),
+                Drag::Orbit => self.viewing.camera.orbit(-dx * 0.3, -dy * 0.3),
                 Drag::Pan => {
                     let aspect = self.aspect();
-                    self.view.pan(dx / h, -dy / h, aspect)
+                    self.viewing.camera.pan(dx / h, -dy / h, aspect)
                 }
             }
             self.moved();
@@ -325,7 +325,7 @@ impl Editor {
     pub(super) fn zoom(&mut self, steps: f64) {
         let aspect = self.aspect();
         let (u, v) = self.cursor_ndc();
-        let (origin, dir) = self.view.ray(u, v, aspect);
+        let (origin, dir) = self.viewing.camera.ray(u, v, aspect);
         let ray = brickmap::Ray { origin, dir };
         // The surface under the cursor (exact CPU cast), else the pivot plane.
         let hit = self
@@ -338,18 +338,21 @@ impl Editor {
             .flatten();
         let target = match hit {
             Some((h, _)) => ray.origin + dir * h.t,
-            None => self.view.pivot_plane_point(u, v, aspect),
+            None => self.viewing.camera.pivot_plane_point(u, v, aspect),
         };
-        self.view.zoom_towards(target, 0.85f64.powf(steps));
+        self.viewing
+            .camera
+            .zoom_towards(target, 0.85f64.powf(steps));
         self.moved();
     }
 
     /// Held movement keys move the camera by the time since the last tick ([`flight`]):
     /// half the view distance per second (Shift: twice it), at least 8 voxels' worth.
     pub(super) fn tick_fly(&mut self) {
-        let speed = self.view.distance.max(8.0) * if self.pointer.mods.shift { 2.0 } else { 0.5 };
+        let speed =
+            self.viewing.camera.distance.max(8.0) * if self.pointer.mods.shift { 2.0 } else { 0.5 };
         if let Some(step) = self.flight.step(speed) {
-            self.view.fly(step);
+            self.viewing.camera.fly(step);
             self.moved();
         }
     }

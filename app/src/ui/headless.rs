@@ -140,18 +140,17 @@ impl Editor {
 
     /// Where the viewport shows in the window (x, y, width, height in pixels, as last drawn).
     pub fn view_area(&self) -> (u32, u32, u32, u32) {
-        self.view_area
+        self.viewing.area()
     }
 
     /// The view's ray through a window point (pixels): what a click there would pick.
     pub fn ray_at(&self, x: f64, y: f64) -> (DVec3, DVec3) {
-        let (u, v) = self.ndc((x, y));
-        self.view.ray(u, v, self.aspect())
+        self.viewing.ray_at((x, y))
     }
 
     /// The window's size in physical pixels.
     pub fn size(&self) -> (u32, u32) {
-        self.window_size
+        self.viewing.window()
     }
 
     /// The session's recording so far, as a replay script (with `options.record`).
@@ -163,11 +162,8 @@ impl Editor {
     /// eye, outside the window, or under a menu, a status line or a window (as drawn in the
     /// last frame): the places a user would aim at to reach it.
     pub fn aim(&self, p: DVec3) -> Option<(f64, f64)> {
-        let (u, v) = self.view.project(p, self.aspect())?;
-        let (x0, y0, w, h) = self.view_area;
-        let x = f64::from(x0) + (u + 1.0) * 0.5 * f64::from(w);
-        let y = f64::from(y0) + (1.0 - v) * 0.5 * f64::from(h);
-        let (w, h) = self.window_size;
+        let (x, y) = self.viewing.window_point(p)?;
+        let (w, h) = self.viewing.window();
         let inside =
             (1.0..f64::from(w) - 1.0).contains(&x) && (1.0..f64::from(h) - 1.0).contains(&y);
         (inside && !self.covered((x, y))).then_some((x, y))
@@ -235,7 +231,7 @@ impl Editor {
 
     /// The view camera.
     pub fn view(&self) -> &ViewCamera {
-        &self.view
+        &self.viewing.camera
     }
 
     /// Whether a menu or another popup is open (as of the last frame).

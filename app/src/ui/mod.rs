@@ -7,7 +7,8 @@
 //! In detail:
 //! the editor: `run` owns the winit 0.30 event loop; `Editor` (ApplicationHandler) keeps the
 //! document as `Arc<RwLock<Document>>` (the file worker reads it for saves; every edit goes to
-//! `jobs::EditQueue`), the view camera and slots, view settings, panels, and `Gfx` (presenter,
+//! `jobs::EditQueue`), the view (`viewing::Viewing`: camera, stored views, window and
+//! viewport area), view settings, panels, and `Gfx` (presenter,
 //! viewport, `Host`); window events become `Input`s and go to `handle.rs`. Refines until the
 //! target spp, then `ControlFlow::Wait`; internal resolution × `moving_scale` while a stroke is
 //! drawn and for 150 ms after a camera move or a stroke; samples per frame adapt to ~16 ms of
@@ -45,6 +46,7 @@ mod saves;
 mod selecting;
 mod swatch;
 pub mod tools;
+mod viewing;
 
 use crate::Scene;
 use crate::editor::Document;
@@ -170,8 +172,8 @@ pub struct Editor {
     backlog: Vec<(Input, bool)>,
     /// Saves waiting for queued edits, finished saves to record, the autosave clock.
     saves: saves::Saves,
-    view: ViewCamera,
-    slots: [Option<ViewCamera>; 9],
+    /// The view camera, the stored views, the window's size and the viewport's area.
+    viewing: viewing::Viewing,
     settings: ViewSettings,
     panels: PanelState,
     /// When pointer or key input last went to the UI (a panel, a menu, a window): for
@@ -189,11 +191,6 @@ pub struct Editor {
     outcome: Result<()>,
     /// Which keys do what (keys.ron).
     keymap: keymap::KeyMap,
-    /// The window's inner size in physical pixels (cursor positions are in these).
-    window_size: (u32, u32),
-    /// Where the viewport shows in the window (x, y, width, height in pixels): what the bars
-    /// and docked panels leave, as last drawn. Framing, picking and the camera's aspect use it.
-    view_area: (u32, u32, u32, u32),
     /// The modifiers, the cursor and the gesture in progress.
     pointer: pointer::Pointer,
     /// What a click would change, under the cursor.
@@ -284,8 +281,7 @@ impl Editor {
             edits,
             backlog: Vec::new(),
             saves: saves::Saves::new(),
-            view,
-            slots: Default::default(),
+            viewing: viewing::Viewing::new(view),
             ui_touched: None,
             flight: flight::Flight::new(headless),
             motion: motion::Motion::new(),
@@ -293,8 +289,6 @@ impl Editor {
             quitting: false,
             outcome: Ok(()),
             keymap: Default::default(),
-            window_size: (16, 9),
-            view_area: (0, 0, 16, 9),
             preview: preview::Preview::new(wake_preview),
             pointer: pointer::Pointer::default(),
             report: report::Report::from_env(),
@@ -358,8 +352,7 @@ impl Editor {
 
     /// The viewport's aspect ratio.
     fn aspect(&self) -> f64 {
-        let (_, _, w, h) = self.view_area;
-        w.max(1) as f64 / h.max(1) as f64
+        self.viewing.aspect()
     }
 
     /// Normalized device coordinates of the cursor in the viewport (v up).
@@ -368,18 +361,13 @@ impl Editor {
     }
 
     /// Normalized device coordinates of a window point in the viewport (v up).
-    fn ndc(&self, (x, y): (f64, f64)) -> (f64, f64) {
-        let (x0, y0, w, h) = self.view_area;
-        (
-            2.0 * (x - f64::from(x0)) / w.max(1) as f64 - 1.0,
-            1.0 - 2.0 * (y - f64::from(y0)) / h.max(1) as f64,
-        )
+    fn ndc(&self, p: (f64, f64)) -> (f64, f64) {
+        self.viewing.ndc(p)
     }
 
     /// The cursor's ray.
     fn cursor_ray(&self) -> (DVec3, DVec3) {
-        let (u, v) = self.cursor_ndc();
-        self.view.ray(u, v, self.aspect())
+        self.viewing.ray_at(self.pointer.cursor)
     }
 }
 

@@ -179,7 +179,7 @@ impl Editor {
         if self.read().scene.selection.is_none() {
             return;
         }
-        let step = nudge_offset(n, self.view.camera.forward());
+        let step = nudge_offset(n, self.viewing.camera.camera.forward());
         let step = if self.pointer.mods.shift {
             step * 8
         } else {
