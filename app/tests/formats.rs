@@ -259,6 +259,56 @@ fn every_sample_vox_imports_and_the_invalid_one_is_an_error() {
     assert_eq!(imported, 17);
 }
 
+/// Positions made relative to the lowest corner of the content (imports may shift
+/// differently), sorted.
+fn relative(
+    mut cells: Vec<(IVec3, MaterialKind, u32, [u8; 3])>,
+) -> Vec<(IVec3, MaterialKind, u32, [u8; 3])> {
+    let lo = cells.iter().fold(IVec3::MAX, |m, c| m.min(c.0));
+    for c in &mut cells {
+        c.0 -= lo;
+    }
+    cells.sort_by_key(|v| (v.0.x, v.0.y, v.0.z));
+    cells
+}
+
+#[test]
+fn every_sample_vox_imported_as_objects_composites_to_the_flattened_import() {
+    let mut compared = 0;
+    for entry in std::fs::read_dir(assets()).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("vox")
+            || path.file_name().unwrap() == "dotvox_not_a.vox"
+        {
+            continue;
+        }
+        let bytes = std::fs::read(&path).unwrap();
+        let (flat, report) =
+            vox::import_bytes(&bytes, &path, &vox::ImportOptions::default(), 2).unwrap();
+        let objects = vox::import_objects(&bytes, &path, 2).unwrap();
+        let name = path.display();
+        assert_eq!(
+            relative(resolved(&objects.scene.world)),
+            relative(resolved(&flat.world)),
+            "{name}"
+        );
+        assert_eq!(objects.report.instances, report.instances, "{name}");
+        assert_eq!(objects.report.voxels, report.voxels, "{name}");
+        objects.scene.world.read().validate().unwrap();
+        // Every object's model is one of the file's, shared where the file shares it.
+        let tree = objects.objects.tree();
+        let placed: usize = objects
+            .objects
+            .models()
+            .keys()
+            .map(|m| tree.instances(*m).len())
+            .sum();
+        assert_eq!(placed, report.instances, "{name}: objects = instances");
+        compared += 1;
+    }
+    assert_eq!(compared, 17);
+}
+
 #[test]
 fn multi_model_scene_graph_places_every_instance() {
     let path = assets().join("ogt_test_multiple_model_scene.vox");
@@ -598,6 +648,12 @@ fn hostile_vox_files_are_refused_and_nothing_left_out_silently() {
             "{file}: {e}"
         );
         assert!(e.to_string().contains(want), "{file}: {e}");
+        // Imported as objects: the same checks, the same error.
+        let bytes = std::fs::read(seeds.join(file)).unwrap();
+        let as_objects = vox::import_objects(&bytes, &seeds.join(file), 1)
+            .map(|_| ())
+            .unwrap_err();
+        assert_eq!(as_objects.to_string(), e.to_string(), "{file}");
         // The command line: a one-line error, exit non-zero, nothing written.
         let out = dir.join(format!("{file}.ron"));
         let run = std::process::Command::new(env!("CARGO_BIN_EXE_voxbrick"))

@@ -189,7 +189,15 @@ fn imported(data: &DotVoxData) -> BTreeSet<([i32; 3], [u8; 3])> {
     let mut bytes = Vec::new();
     data.write_vox(&mut bytes).unwrap();
     let (scene, _) = common::import(&bytes, "t.vox");
-    cells_of(&scene.world)
+    let flat = cells_of(&scene.world);
+    // Imported as objects, the composite is the same world.
+    let objects = vox::import_objects(&bytes, Path::new("t.vox"), 1).unwrap();
+    assert_eq!(
+        cells_of(&objects.scene.world),
+        flat,
+        "the objects' composite differs from the flattened import"
+    );
+    flat
 }
 
 fn cells_of(world: &brickmap::World) -> BTreeSet<([i32; 3], [u8; 3])> {

@@ -1,4 +1,5 @@
-//! Any bytes given to the .vox importer: an error or a scene, never a panic or a hang.
+//! Any bytes given to the .vox importer (flattened, and as objects): an error or a scene,
+//! never a panic or a hang.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -9,5 +10,9 @@ fuzz_target!(|data: &[u8]| {
         let view = scene.world.read();
         view.validate().expect("imported world keeps its invariants");
         assert_eq!(view.solid_count(), report.voxels);
+    }
+    // Imported as objects: an error or objects whose composite keeps the invariants.
+    if let Ok(import) = app::formats::vox::import_objects(data, std::path::Path::new("fuzz.vox"), 1) {
+        import.scene.world.read().validate().expect("the composite keeps the world's invariants");
     }
 });

@@ -35,11 +35,13 @@ mod error;
 mod export;
 mod graph;
 mod materials;
+mod objects;
 
 pub use error::VoxError;
 pub use export::*;
 use graph::*;
 use materials::*;
+pub use objects::{ObjectImport, import_objects};
 
 /// How to import.
 #[derive(Clone, Debug, Default)]
