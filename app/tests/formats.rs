@@ -309,6 +309,135 @@ fn every_sample_vox_imported_as_objects_composites_to_the_flattened_import() {
     assert_eq!(compared, 17);
 }
 
+/// A tree in pre-order: each node's name, kind (for an object its model's voxels with their
+/// resolved materials, which two imports may number differently), visibility, layer and
+/// world placement.
+fn outline(objects: &brickmap::objects::Objects, table: &brickmap::MaterialTable) -> Vec<String> {
+    use brickmap::objects::{NodeKind, ObjectTree};
+    use std::hash::{Hash, Hasher};
+    let content = |m: &brickmap::objects::Model| {
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        m.size().to_array().hash(&mut h);
+        for (b, brick) in m.bricks() {
+            for bit in brick.mask.ones() {
+                let mat = table.get(brick.material(bit)).unwrap();
+                (b.to_array(), bit, mat.kind as u8, table.colour(mat.colour)).hash(&mut h);
+                table
+                    .param(mat.kind, mat.param)
+                    .unwrap()
+                    .to_bits()
+                    .hash(&mut h);
+            }
+        }
+        h.finish()
+    };
+    let tree = objects.tree();
+    tree.subtree(ObjectTree::ROOT)
+        .unwrap()
+        .into_iter()
+        .map(|id| {
+            let n = tree.node(id).unwrap();
+            let what = match n.kind {
+                NodeKind::Group { .. } => format!("group of {}", n.children().len()),
+                NodeKind::Object { model, layer } => format!(
+                    "model {:x} on layer {}",
+                    content(objects.model(model).unwrap()),
+                    layer.0
+                ),
+            };
+            format!(
+                "{} {what} visible {} at {:?}",
+                n.name,
+                n.visible,
+                tree.world_placement(id).unwrap()
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn objects_survive_export_and_import_with_names_hidden_flags_layers_and_shared_models() {
+    use brickmap::objects::{LayerId, NodeKind, ObjectOp, ObjectTree};
+    let dir = scratch("objects-round-trip");
+    let mut compared = 0;
+    for entry in std::fs::read_dir(assets()).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("vox")
+            || path.file_name().unwrap() == "dotvox_not_a.vox"
+        {
+            continue;
+        }
+        let name = path.display().to_string();
+        let mut first = vox::import_objects(&std::fs::read(&path).unwrap(), &path, 2).unwrap();
+        // Hide the last object and its layer's neighbour, so flags travel too.
+        let table = first.scene.world.materials().clone();
+        let last = *first
+            .objects
+            .tree()
+            .subtree(ObjectTree::ROOT)
+            .unwrap()
+            .last()
+            .unwrap();
+        if matches!(
+            first.objects.tree().node(last).unwrap().kind,
+            NodeKind::Object { .. }
+        ) {
+            let hide = ObjectOp::Show {
+                node: last,
+                visible: false,
+            };
+            first
+                .objects
+                .apply(&first.scene.world, hide, &table)
+                .unwrap();
+        }
+        let second_layer = first.objects.tree().layers().len() > 1;
+        if second_layer {
+            let hide = ObjectOp::ShowLayer {
+                layer: LayerId(1),
+                visible: false,
+            };
+            first
+                .objects
+                .apply(&first.scene.world, hide, &table)
+                .unwrap();
+        }
+        let out = dir.join("round.vox");
+        let report = vox::export_objects(&first.objects, &table, &out).unwrap();
+        let second = vox::import_objects(&std::fs::read(&out).unwrap(), &out, 2).unwrap();
+        assert_eq!(
+            outline(&second.objects, &second.scene.world.materials()),
+            outline(&first.objects, &table),
+            "{name}"
+        );
+        assert_eq!(
+            second.objects.tree().layers(),
+            first.objects.tree().layers(),
+            "{name}"
+        );
+        assert_eq!(second.objects.models().len(), report.models, "{name}");
+        // Shared models stay shared: the same numbers of instances per model.
+        let sharing = |o: &brickmap::objects::Objects| {
+            let mut n: Vec<usize> = o
+                .models()
+                .keys()
+                .map(|m| o.tree().instances(*m).len())
+                .filter(|n| *n > 0)
+                .collect();
+            n.sort_unstable();
+            n
+        };
+        assert_eq!(sharing(&second.objects), sharing(&first.objects), "{name}");
+        assert_eq!(
+            resolved(&second.scene.world),
+            resolved(&first.scene.world),
+            "{name}: the same voxels in the same places"
+        );
+        compared += 1;
+    }
+    assert_eq!(compared, 17);
+}
+
 #[test]
 fn multi_model_scene_graph_places_every_instance() {
     let path = assets().join("ogt_test_multiple_model_scene.vox");

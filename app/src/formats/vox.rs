@@ -41,7 +41,7 @@ pub use error::VoxError;
 pub use export::*;
 use graph::*;
 use materials::*;
-pub use objects::{ObjectImport, import_objects};
+pub use objects::{ObjectImport, export_objects, export_objects_data, import_objects};
 
 /// How to import.
 #[derive(Clone, Debug, Default)]

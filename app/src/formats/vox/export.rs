@@ -8,8 +8,7 @@ use super::*;
 pub fn export_data(world: &World) -> Result<DotVoxData, VoxError> {
     let view = world.read();
     let table = view.materials();
-    let mut slot_of = [u8::MAX; 256];
-    let mut used: Vec<u8> = Vec::new();
+    let mut slots = Slots::default();
     let mut chunks: BTreeMap<(i32, i32, i32), Vec<Voxel>> = BTreeMap::new();
     let mut failure = None;
     view.for_each_brick(|b, mask, mats| {
@@ -19,14 +18,13 @@ pub fn export_data(world: &World) -> Result<DotVoxData, VoxError> {
                 BrickMaterials::Uniform(m) => m,
                 BrickMaterials::PerVoxel(v) => v[k],
             };
-            if slot_of[m as usize] == u8::MAX {
-                if used.len() == 255 {
-                    failure.get_or_insert(VoxError::TooManyMaterials);
+            let i = match slots.slot(m) {
+                Ok(i) => i,
+                Err(e) => {
+                    failure.get_or_insert(e);
                     return;
                 }
-                slot_of[m as usize] = used.len() as u8;
-                used.push(m);
-            }
+            };
             let p = base + IVec3::new((bit % 8) as i32, (bit / 8 % 8) as i32, (bit / 64) as i32);
             let vox = IVec3::new(p.x, -p.z - 1, p.y);
             let chunk = (
@@ -39,50 +37,14 @@ pub fn export_data(world: &World) -> Result<DotVoxData, VoxError> {
                 x: local.x as u8,
                 y: local.y as u8,
                 z: local.z as u8,
-                i: slot_of[m as usize],
+                i,
             });
         }
     });
     if let Some(f) = failure {
         return Err(f);
     }
-    let mut palette = dot_vox::DEFAULT_PALETTE.to_vec();
-    let mut materials = Vec::new();
-    for (slot, &m) in used.iter().enumerate() {
-        let mat = table.get(m)?;
-        let [r, g, b] = table.colour(mat.colour);
-        palette[slot] = Color { r, g, b, a: 255 };
-        let param = table.param(mat.kind, mat.param)?;
-        let mut props = dot_vox::Dict::new();
-        let mut set = |k: &str, v: String| {
-            props.insert(k.to_string(), v);
-        };
-        match mat.kind {
-            MaterialKind::Lambertian => set("_type", "_diffuse".into()),
-            MaterialKind::Metal => {
-                set("_type", "_metal".into());
-                set("_metal", "1".into());
-                set("_rough", format!("{param}"));
-            }
-            MaterialKind::Dielectric => {
-                set("_type", "_glass".into());
-                set("_trans", "1".into());
-                set("_ior", format!("{}", param - 1.0));
-                set("_ri", format!("{param}"));
-            }
-            MaterialKind::Emissive => {
-                set("_type", "_emit".into());
-                let emit = param.min(1.0);
-                let flux = if param > 1.0 { param.log2() } else { 0.0 };
-                set("_emit", format!("{emit}"));
-                set("_flux", format!("{flux}"));
-            }
-        }
-        materials.push(dot_vox::Material {
-            id: slot as u32 + 1,
-            properties: props,
-        });
-    }
+    let (palette, materials) = slots.palette_and_materials(table)?;
     // Scene graph: 0 root transform → 1 group → (transform → shape) per model.
     let mut scenes = vec![
         SceneNode::Transform {
@@ -143,9 +105,84 @@ pub fn export_data(world: &World) -> Result<DotVoxData, VoxError> {
     })
 }
 
+/// Palette slots handed to materials as voxels are written (at most 255), and the palette
+/// and MATL chunks they make.
+#[derive(Default)]
+pub(super) struct Slots {
+    used: Vec<u8>,
+    slot_of: HashMap<u8, u8>,
+}
+
+impl Slots {
+    /// The palette slot (0-based) of material `m`, given on first use.
+    pub(super) fn slot(&mut self, m: u8) -> Result<u8, VoxError> {
+        if let Some(s) = self.slot_of.get(&m) {
+            return Ok(*s);
+        }
+        if self.used.len() == 255 {
+            return Err(VoxError::TooManyMaterials);
+        }
+        let s = self.used.len() as u8;
+        self.used.push(m);
+        self.slot_of.insert(m, s);
+        Ok(s)
+    }
+
+    /// The palette (the default one with the used slots overwritten) and a MATL per slot
+    /// that inverts the import.
+    pub(super) fn palette_and_materials(
+        &self,
+        table: &brickmap::MaterialTable,
+    ) -> Result<(Vec<Color>, Vec<dot_vox::Material>), VoxError> {
+        let mut palette = dot_vox::DEFAULT_PALETTE.to_vec();
+        let mut materials = Vec::new();
+        for (slot, &m) in self.used.iter().enumerate() {
+            let mat = table.get(m)?;
+            let [r, g, b] = table.colour(mat.colour);
+            palette[slot] = Color { r, g, b, a: 255 };
+            let param = table.param(mat.kind, mat.param)?;
+            let mut props = dot_vox::Dict::new();
+            let mut set = |k: &str, v: String| {
+                props.insert(k.to_string(), v);
+            };
+            match mat.kind {
+                MaterialKind::Lambertian => set("_type", "_diffuse".into()),
+                MaterialKind::Metal => {
+                    set("_type", "_metal".into());
+                    set("_metal", "1".into());
+                    set("_rough", format!("{param}"));
+                }
+                MaterialKind::Dielectric => {
+                    set("_type", "_glass".into());
+                    set("_trans", "1".into());
+                    set("_ior", format!("{}", param - 1.0));
+                    set("_ri", format!("{param}"));
+                }
+                MaterialKind::Emissive => {
+                    set("_type", "_emit".into());
+                    let emit = param.min(1.0);
+                    let flux = if param > 1.0 { param.log2() } else { 0.0 };
+                    set("_emit", format!("{emit}"));
+                    set("_flux", format!("{flux}"));
+                }
+            }
+            materials.push(dot_vox::Material {
+                id: slot as u32 + 1,
+                properties: props,
+            });
+        }
+        Ok((palette, materials))
+    }
+}
+
 /// Exports a scene to a `.vox` file, atomically.
 pub fn export_file(scene: &Scene, path: &Path) -> Result<ExportReport, FormatError> {
     let data = export_data(&scene.world).map_err(|e| FormatError::vox(path, e))?;
+    write_data(&data, path)
+}
+
+/// Writes `.vox` data to a file, atomically, and says what it wrote.
+pub(super) fn write_data(data: &DotVoxData, path: &Path) -> Result<ExportReport, FormatError> {
     let mut bytes = Vec::new();
     data.write_vox(&mut bytes)
         .map_err(|e| FormatError::io(path, e))?;

@@ -27,7 +27,7 @@ pub(super) enum Hidden {
 }
 
 /// MagicaVoxel's axes to voxbrick's, on cell centres.
-fn axes() -> Orientation {
+pub(super) fn axes() -> Orientation {
     Orientation::from_matrix([[1, 0, 0], [0, 0, 1], [0, -1, 0]]).expect("a rotation")
 }
 

@@ -1,13 +1,13 @@
-//! `.vox` import as a scene of objects: the file's groups, objects (names, hidden flags,
+//! `.vox` import and export as a scene of objects: the file's groups, objects (names, hidden flags,
 //! layers) and shared models kept as `brickmap::objects` — hidden ones too, hidden — and the
 //! visible ones composited into the new scene's world. The grid fits every object, shown or
 //! hidden, so showing one later needs no larger grid. Colours and materials are installed as
 //! the flattening import installs them; its checks on hostile files apply unchanged (the
 //! same parse, the same scene-graph walk).
 
-use super::graph::{Hidden, model_size, model_voxel, read_tree};
+use super::graph::{Hidden, axes, model_size, model_voxel, read_tree};
 use super::*;
-use brickmap::objects::{Model as VoxelModel, NodeKind, ObjectTree, Objects};
+use brickmap::objects::{Model as VoxelModel, ModelId, NodeId, NodeKind, ObjectTree, Objects};
 use std::collections::BTreeSet;
 
 /// A `.vox` file imported as objects: the scene (its world holds the composite) and the
@@ -146,4 +146,150 @@ fn model_of(
         table,
     )?;
     Ok(model)
+}
+
+/// The `.vox` data of a scene of objects: one nTRN + nGRP per group and nTRN + nSHP per
+/// object (names, hidden flags, rotations, layers), one model per placed model (shared
+/// between its instances), a palette slot per used material (at most 255) with MATL chunks.
+/// MagicaVoxel's models are at most 256 on a side: a larger model is refused, named.
+pub fn export_objects_data(
+    objects: &Objects,
+    table: &brickmap::MaterialTable,
+) -> Result<DotVoxData, VoxError> {
+    let tree = objects.tree();
+    let mut slots = super::export::Slots::default();
+    let mut index: BTreeMap<ModelId, u32> = BTreeMap::new();
+    let mut models = Vec::new();
+    for (id, m) in objects.models() {
+        if tree.instances(*id).is_empty() {
+            continue;
+        }
+        let s = m.size();
+        let mv = IVec3::new(s.x, s.z, s.y);
+        if mv.cmpgt(IVec3::splat(256)).any() {
+            return Err(VoxError::ModelTooLarge(s));
+        }
+        let mut voxels = Vec::with_capacity(m.solid_count() as usize);
+        for (b, brick) in m.bricks() {
+            for bit in brick.mask.ones() {
+                let u = b.as_ivec3() * 8
+                    + IVec3::new((bit % 8) as i32, (bit / 8 % 8) as i32, (bit / 64) as i32);
+                voxels.push(Voxel {
+                    x: u.x as u8,
+                    y: (s.z - 1 - u.z) as u8,
+                    z: u.y as u8,
+                    i: slots.slot(brick.material(bit))?,
+                });
+            }
+        }
+        index.insert(*id, models.len() as u32);
+        models.push(Model {
+            size: Size {
+                x: mv.x as u32,
+                y: mv.y as u32,
+                z: mv.z as u32,
+            },
+            voxels,
+        });
+    }
+    let mut scenes = Vec::new();
+    write_node(objects, ObjectTree::ROOT, &index, &mut scenes);
+    let (palette, materials) = slots.palette_and_materials(table)?;
+    let layers = tree
+        .layers()
+        .iter()
+        .map(|l| {
+            let mut a = dot_vox::Dict::new();
+            a.insert("_name".into(), l.name.clone());
+            if !l.visible {
+                a.insert("_hidden".into(), "1".into());
+            }
+            dot_vox::Layer { attributes: a }
+        })
+        .collect();
+    Ok(DotVoxData {
+        version: 150,
+        index_map: dot_vox::DEFAULT_INDEX_MAP.to_vec(),
+        models,
+        palette,
+        materials,
+        scenes,
+        layers,
+    })
+}
+
+/// Writes a node (nTRN, then its nGRP or nSHP) and its subtree; returns its nTRN's index.
+fn write_node(
+    objects: &Objects,
+    id: NodeId,
+    index: &BTreeMap<ModelId, u32>,
+    scenes: &mut Vec<SceneNode>,
+) -> u32 {
+    let tree = objects.tree();
+    let node = tree.node(id).expect("a node of the tree");
+    let back = axes().inverse();
+    let rot = node.placement.rot.conjugate(&back);
+    // An object's translation takes back the half-voxel pivot shift of an odd model height.
+    let t = match node.kind {
+        NodeKind::Object { model, .. } => {
+            let odd = objects.model(model).expect("placed models exist").size().z % 2;
+            node.placement.t + node.placement.rot.apply(IVec3::new(0, 0, odd))
+        }
+        NodeKind::Group { .. } => node.placement.t,
+    };
+    let t = back.apply(t);
+    let mut frame = dot_vox::Dict::new();
+    frame.insert("_t".into(), format!("{} {} {}", t.x, t.y, t.z));
+    if rot != brickmap::objects::Orientation::IDENTITY {
+        frame.insert("_r".into(), rot.to_vox_byte().to_string());
+    }
+    let mut attributes = dot_vox::Dict::new();
+    attributes.insert("_name".into(), node.name.clone());
+    if !node.visible {
+        attributes.insert("_hidden".into(), "1".into());
+    }
+    let at = scenes.len() as u32;
+    let layer_id = match node.kind {
+        NodeKind::Object { layer, .. } => u32::from(layer.0),
+        NodeKind::Group { .. } => u32::MAX,
+    };
+    scenes.push(SceneNode::Transform {
+        attributes,
+        frames: vec![dot_vox::Frame::new(frame)],
+        child: at + 1,
+        layer_id,
+    });
+    match &node.kind {
+        NodeKind::Group { children } => {
+            scenes.push(SceneNode::Group {
+                attributes: Default::default(),
+                children: Vec::new(),
+            });
+            let mut kids = Vec::with_capacity(children.len());
+            for c in children {
+                kids.push(write_node(objects, *c, index, scenes));
+            }
+            if let SceneNode::Group { children, .. } = &mut scenes[at as usize + 1] {
+                *children = kids;
+            }
+        }
+        NodeKind::Object { model, .. } => scenes.push(SceneNode::Shape {
+            attributes: Default::default(),
+            models: vec![dot_vox::ShapeModel {
+                model_id: index[model],
+                attributes: Default::default(),
+            }],
+        }),
+    }
+    at
+}
+
+/// Exports a scene of objects to a `.vox` file, atomically.
+pub fn export_objects(
+    objects: &Objects,
+    table: &brickmap::MaterialTable,
+    path: &Path,
+) -> Result<ExportReport, FormatError> {
+    let data = export_objects_data(objects, table).map_err(|e| FormatError::vox(path, e))?;
+    super::export::write_data(&data, path)
 }
