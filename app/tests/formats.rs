@@ -259,6 +259,20 @@ fn every_sample_vox_imports_and_the_invalid_one_is_an_error() {
     assert_eq!(imported, 17);
 }
 
+/// The valid sample `.vox` files.
+fn sample_vox_files() -> Vec<PathBuf> {
+    let mut out: Vec<PathBuf> = std::fs::read_dir(assets())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            p.extension().and_then(|e| e.to_str()) == Some("vox")
+                && p.file_name().unwrap() != "dotvox_not_a.vox"
+        })
+        .collect();
+    out.sort();
+    out
+}
+
 /// Positions made relative to the lowest corner of the content (imports may shift
 /// differently), sorted.
 fn relative(
@@ -275,13 +289,7 @@ fn relative(
 #[test]
 fn every_sample_vox_imported_as_objects_composites_to_the_flattened_import() {
     let mut compared = 0;
-    for entry in std::fs::read_dir(assets()).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().and_then(|e| e.to_str()) != Some("vox")
-            || path.file_name().unwrap() == "dotvox_not_a.vox"
-        {
-            continue;
-        }
+    for path in sample_vox_files() {
         let bytes = std::fs::read(&path).unwrap();
         let (flat, report) =
             vox::import_bytes(&bytes, &path, &vox::ImportOptions::default(), 2).unwrap();
@@ -360,13 +368,7 @@ fn objects_survive_export_and_import_with_names_hidden_flags_layers_and_shared_m
     use brickmap::objects::{LayerId, NodeKind, ObjectOp, ObjectTree};
     let dir = scratch("objects-round-trip");
     let mut compared = 0;
-    for entry in std::fs::read_dir(assets()).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().and_then(|e| e.to_str()) != Some("vox")
-            || path.file_name().unwrap() == "dotvox_not_a.vox"
-        {
-            continue;
-        }
+    for path in sample_vox_files() {
         let name = path.display().to_string();
         let mut first = vox::import_objects(&std::fs::read(&path).unwrap(), &path, 2).unwrap();
         // Hide the last object and its layer's neighbour, so flags travel too.

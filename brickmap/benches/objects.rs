@@ -63,6 +63,17 @@ fn one_object(rot: Orientation, size: IVec3) -> ObjectTree {
     tree
 }
 
+/// The benchmark's brush: a sphere in the terrain's middle, added or removed in turn.
+fn brush(radius: f64, add: bool) -> EditOp {
+    EditOp::Shape {
+        shape: Shape::Sphere {
+            centre: DVec3::new(256.0, 100.0, 256.0),
+            radius,
+        },
+        mode: if add { Mode::Add(1) } else { Mode::Remove },
+    }
+}
+
 fn main() {
     let (model, source) = terrain_model();
     let bricks = model.bricks().count();
@@ -122,13 +133,7 @@ fn model_edit_then_composite(bencher: Bencher, (radius, how): (f64, &str)) {
         .unwrap();
     let mut add = true;
     bencher.bench_local(|| {
-        let op = EditOp::Shape {
-            shape: Shape::Sphere {
-                centre: DVec3::new(256.0, 100.0, 256.0),
-                radius,
-            },
-            mode: if add { Mode::Add(1) } else { Mode::Remove },
-        };
+        let op = brush(radius, add);
         add = !add;
         let m = models.get_mut(&ModelId(0)).unwrap();
         let out = m.apply(&op, &table).unwrap();
@@ -221,13 +226,7 @@ fn model_edit_alone(bencher: Bencher, radius: f64) {
     let table = source.materials().clone();
     let mut add = true;
     bencher.bench_local(|| {
-        let op = EditOp::Shape {
-            shape: Shape::Sphere {
-                centre: DVec3::new(256.0, 100.0, 256.0),
-                radius,
-            },
-            mode: if add { Mode::Add(1) } else { Mode::Remove },
-        };
+        let op = brush(radius, add);
         add = !add;
         model.apply(&op, &table).unwrap()
     });

@@ -83,14 +83,7 @@ pub fn export_data(world: &World) -> Result<DotVoxData, VoxError> {
         if let SceneNode::Group { children, .. } = &mut scenes[1] {
             children.push(transform_id);
         }
-        models.push(Model {
-            size: Size {
-                x: size.x as u32,
-                y: size.y as u32,
-                z: size.z as u32,
-            },
-            voxels,
-        });
+        models.push(vox_model(size, voxels));
     }
     let mut layer = dot_vox::Dict::new();
     layer.insert("_name".into(), "voxbrick".into());
@@ -103,6 +96,18 @@ pub fn export_data(world: &World) -> Result<DotVoxData, VoxError> {
         scenes,
         layers: vec![dot_vox::Layer { attributes: layer }],
     })
+}
+
+/// A `.vox` model of a size (in the file's axes, each side 1..=256) and its voxels.
+pub(super) fn vox_model(size: IVec3, voxels: Vec<Voxel>) -> Model {
+    Model {
+        size: Size {
+            x: size.x as u32,
+            y: size.y as u32,
+            z: size.z as u32,
+        },
+        voxels,
+    }
 }
 
 /// Palette slots handed to materials as voxels are written (at most 255), and the palette

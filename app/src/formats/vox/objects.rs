@@ -183,14 +183,7 @@ pub fn export_objects_data(
             }
         }
         index.insert(*id, models.len() as u32);
-        models.push(Model {
-            size: Size {
-                x: mv.x as u32,
-                y: mv.y as u32,
-                z: mv.z as u32,
-            },
-            voxels,
-        });
+        models.push(super::export::vox_model(mv, voxels));
     }
     let mut scenes = Vec::new();
     write_node(objects, ObjectTree::ROOT, &index, &mut scenes);
