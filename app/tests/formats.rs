@@ -128,7 +128,7 @@ fn versions_and_hostile_files_are_clear_errors() {
     let newer = text.replacen("format_version: 1", "format_version: 7", 1);
     match project::from_bytes(newer.as_bytes(), p, 2) {
         Err(FormatError::NewerVersion {
-            found: 7, known: 1, ..
+            found: 7, known: 2, ..
         }) => {}
         other => panic!("{:?}", other.err()),
     }
@@ -888,4 +888,118 @@ fn hostile_vox_files_are_refused_and_nothing_left_out_silently() {
     assert!(matches!(e, vox::VoxError::OutsideGrid { .. }), "{e}");
     assert!(e.to_string().contains("outside the"), "{e}");
     assert_eq!(world.read().content_hash(), before);
+}
+
+#[test]
+fn a_scene_of_objects_survives_a_version_2_project_and_version_1_opens_as_one_object() {
+    use brickmap::objects::{Axis, ObjectOp, ObjectTree, Orientation, Placement};
+    let dir = scratch("objects-project");
+    let park = assets().join("ogt_test_multiple_model_scene.vox");
+    let mut first = vox::import_objects(&std::fs::read(&park).unwrap(), &park, 2).unwrap();
+    let table = first.scene.world.materials().clone();
+    // Turn, hide and lock a few objects so every field travels.
+    let nodes = first.objects.tree().subtree(ObjectTree::ROOT).unwrap();
+    let (a, b, c) = (nodes[1], nodes[2], nodes[nodes.len() - 1]);
+    let p = first.objects.tree().node(a).unwrap().placement;
+    let turned = Placement {
+        rot: Orientation::quarter_turn(Axis::Y, 1).after(&p.rot),
+        t: p.t,
+    };
+    let world = &first.scene.world;
+    for op in [
+        ObjectOp::Place {
+            node: a,
+            placement: turned,
+        },
+        ObjectOp::Show {
+            node: b,
+            visible: false,
+        },
+        ObjectOp::Lock {
+            node: c,
+            locked: true,
+        },
+    ] {
+        first.objects.apply(world, op, &table).unwrap();
+    }
+    let file = dir.join("park.ron");
+    project::save_objects(&first.scene, &first.objects, &file).unwrap();
+    let text = std::fs::read_to_string(&file).unwrap();
+    assert!(text.contains("format_version: 2,"), "{}", &text[..200]);
+    let (scene, objects) = project::load_objects(&file, 2).unwrap();
+    assert_eq!(
+        outline(&objects, &scene.world.materials()),
+        outline(&first.objects, &table)
+    );
+    assert_eq!(objects.tree().layers(), first.objects.tree().layers());
+    assert!(objects.tree().node(c).unwrap().locked);
+    assert_eq!(resolved(&scene.world), resolved(&first.scene.world));
+    assert_eq!(scene.params, first.scene.params);
+    // Saved again, the same text.
+    assert_eq!(project::objects_to_string(&scene, &objects), text);
+    // One grid (version 1) is one object placing all of it.
+    let flat = default_scene(SceneSize::Small, 2).unwrap();
+    let v1 = dir.join("flat.ron");
+    project::save(&flat, &v1).unwrap();
+    let (one, objects) = project::load_objects(&v1, 2).unwrap();
+    assert_eq!(objects.tree().len(), 2, "the root and the object");
+    assert_eq!(objects.tree().drawn().len(), 1);
+    assert_eq!(
+        one.world.read().content_hash(),
+        flat.world.read().content_hash()
+    );
+    // The grid loader refuses a scene of objects, saying how it opens.
+    let e = project::load(&file, 1).unwrap_err().to_string();
+    assert!(e.contains("version 2 project holds objects"), "{e}");
+}
+
+#[test]
+fn hostile_version_2_projects_are_clear_errors() {
+    let park = assets().join("ogt_test_multiple_model_scene.vox");
+    let import = vox::import_objects(&std::fs::read(&park).unwrap(), &park, 1).unwrap();
+    let text = project::objects_to_string(&import.scene, &import.objects);
+    assert!(import.objects.tree().len() >= 2);
+    let p = Path::new("hostile.ron");
+    let err = |t: &str| {
+        project::objects_from_bytes(t.as_bytes(), p, 1)
+            .map(|_| ())
+            .unwrap_err()
+            .to_string()
+    };
+    for (bad, want) in [
+        (
+            text.replacen("(parent: Some(0)", "(parent: Some(5)", 1),
+            "does not come before it",
+        ),
+        (
+            text.replacen("(parent: Some(0)", "(parent: None", 1),
+            "only node 0 has no parent",
+        ),
+        (
+            text.replacen("(parent: None", "(parent: Some(0)", 1),
+            "node 0 must be the root group",
+        ),
+        (
+            text.replacen("placement: (rot: 4,", "placement: (rot: 3,", 1),
+            "rotation byte",
+        ),
+        (
+            text.replacen("object: Some((model: ", "object: Some((model: 9", 1),
+            "does not exist",
+        ),
+        (
+            text.replacen("layers: [", "layers: [(name: \"x\", visible: true), ", 1)
+                .replacen("layer: 0", "layer: 77", 1),
+            "no layer 77",
+        ),
+        (text.replacen("size: (", "size: (-", 1), "model"),
+        (text.replacen("data: \"VlhCMQ", "data: \"VlhCMg", 1), "VXB1"),
+    ] {
+        let e = err(&bad);
+        assert!(e.contains(want), "want {want:?} in: {e}");
+    }
+    // Every truncation fails cleanly (sampled).
+    for cut in (0..text.trim_end().len()).step_by(211) {
+        assert!(project::objects_from_bytes(&text.as_bytes()[..cut], p, 1).is_err());
+    }
 }

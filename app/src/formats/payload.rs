@@ -24,12 +24,21 @@ const MAGIC: &[u8; 4] = b"VXB1";
 
 /// Encodes every non-empty brick of a world.
 pub fn encode(view: &WorldView<'_>) -> Vec<u8> {
-    let dims = view.dims();
+    encode_bricks(&view.dims(), |f| view.for_each_brick(f))
+}
+
+/// Encodes the non-empty bricks `each` visits, in ascending cell order of `dims` (a world's
+/// grid, or a model's grid of bricks).
+pub fn encode_bricks(
+    dims: &GridDims,
+    each: impl FnOnce(&mut dyn FnMut(UVec3, &Mask, BrickMaterials<'_>)),
+) -> Vec<u8> {
     let mut records = Vec::new();
     let mut count = 0u64;
     let mut previous: i64 = -1;
-    view.for_each_brick(|b, mask, mats| {
+    each(&mut |b, mask, mats| {
         let cell = dims.cell_index(b) as i64;
+        debug_assert!(cell > previous, "bricks in ascending cell order");
         put_varint(&mut records, (cell - previous - 1) as u64);
         previous = cell;
         count += 1;

@@ -15,9 +15,13 @@
 //!     voxels: (encoding: "vxb1-base64", bricks: .., solid_voxels: .., data: "VlhCMQ.."),
 //! )
 //! ```
-//! Loading checks the version first (newer: a clear error; there is no older version yet,
-//! version 1 is the first), then every field, then every brick; nothing is allocated beyond
+//! Loading checks the version first (newer: a clear error; version 2, a scene of objects,
+//! is read by `objects.rs`), then every field, then every brick; nothing is allocated beyond
 //! what the file's length justifies, except the dense grid of the declared (supported) size.
+
+mod objects;
+
+pub use objects::{load_objects, objects_from_bytes, objects_to_string, save_objects};
 
 use super::{FormatError, payload};
 use crate::scene::Scene;
@@ -27,8 +31,10 @@ use render::{Camera, RenderSettings, SceneParams, Sky, Sun};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// The version this program writes and the newest it reads.
+/// The version of a project of one grid, which `save` writes and `load` reads.
 pub const FORMAT_VERSION: u32 = 1;
+/// The version of a project of objects (`objects.rs`), the newest this program reads.
+pub const OBJECTS_VERSION: u32 = 2;
 const ENCODING: &str = "vxb1-base64";
 
 #[derive(Deserialize)]
@@ -100,82 +106,80 @@ impl From<Kind> for MaterialKind {
 /// The project text of a scene.
 pub fn to_string(scene: &Scene) -> String {
     let view = scene.world.read();
-    let table = view.materials();
-    let dims = scene.world.dims();
-    let b = dims.bricks();
     let data = payload::encode(&view);
-    let bricks = view.brick_count() + view.memory().full_cells;
-    let file = ProjectFile {
-        format_version: FORMAT_VERSION,
-        grid_bricks: (b.x, b.y, b.z),
-        camera: scene.params.camera.clone(),
-        sun: scene.params.sun.clone(),
-        sky: scene.params.sky.clone(),
-        settings: scene.params.settings.clone(),
-        materials: (0..table.len())
-            .map(|i| {
-                let m = table.get(i as u8).expect("index within the table");
-                MaterialRecord {
-                    kind: m.kind.into(),
-                    param: m.param,
-                    colour: m.colour,
-                }
-            })
-            .collect(),
-        colours: (0..=255u8)
-            .map(|i| {
-                let [r, g, b] = table.colour(i);
-                format!("#{r:02x}{g:02x}{b:02x}")
-            })
-            .collect(),
-        roughness: table.gpu().roughness.to_vec(),
-        ior: table.gpu().ior.to_vec(),
-        strength: table.gpu().strength.to_vec(),
-        voxels: VoxelRecord {
-            encoding: ENCODING.into(),
-            bricks,
-            solid_voxels: view.solid_count(),
-            data: base64::engine::general_purpose::STANDARD.encode(data),
-        },
+    let voxels = VoxelRecord {
+        encoding: ENCODING.into(),
+        bricks: view.brick_count() + view.memory().full_cells,
+        solid_voxels: view.solid_count(),
+        data: base64::engine::general_purpose::STANDARD.encode(data),
     };
-    layout(&file)
+    drop(view);
+    let mut fields = header(scene, FORMAT_VERSION);
+    fields.push(("voxels", ron(&voxels)));
+    layout(&fields)
+}
+
+/// A value in ron's compact form.
+fn ron<T: Serialize>(v: &T) -> String {
+    let compact = ron::ser::PrettyConfig::new()
+        .compact_structs(true)
+        .compact_arrays(true);
+    ron::ser::to_string_pretty(v, compact).expect("project data always serializes")
+}
+
+/// A list, `per_line` items a line.
+fn list<T: Serialize>(items: &[T], per_line: usize) -> String {
+    let lines: Vec<String> = items
+        .chunks(per_line)
+        .map(|c| {
+            format!(
+                "        {},",
+                c.iter().map(ron).collect::<Vec<_>>().join(", ")
+            )
+        })
+        .collect();
+    format!("[\n{}\n    ]", lines.join("\n"))
+}
+
+/// The fields every version shares: version, grid, camera, sun, sky, settings and the
+/// material, colour and parameter tables.
+fn header(scene: &Scene, version: u32) -> Vec<(&'static str, String)> {
+    let table = scene.world.materials();
+    let b = scene.world.dims().bricks();
+    let materials: Vec<MaterialRecord> = (0..table.len())
+        .map(|i| {
+            let m = table.get(i as u8).expect("index within the table");
+            MaterialRecord {
+                kind: m.kind.into(),
+                param: m.param,
+                colour: m.colour,
+            }
+        })
+        .collect();
+    let colours: Vec<String> = (0..=255u8)
+        .map(|i| {
+            let [r, g, b] = table.colour(i);
+            format!("#{r:02x}{g:02x}{b:02x}")
+        })
+        .collect();
+    vec![
+        ("format_version", ron(&version)),
+        ("grid_bricks", ron(&(b.x, b.y, b.z))),
+        ("camera", ron(&scene.params.camera)),
+        ("sun", ron(&scene.params.sun)),
+        ("sky", ron(&scene.params.sky)),
+        ("settings", ron(&scene.params.settings)),
+        ("materials", list(&materials, 1)),
+        ("colours", list(&colours, 8)),
+        ("roughness", list(&table.gpu().roughness, 16)),
+        ("ior", list(&table.gpu().ior, 16)),
+        ("strength", list(&table.gpu().strength, 16)),
+    ]
 }
 
 /// Lays the file out for people and diffs: one line per field, per material, per eight
 /// colours; every value in ron's compact form (so the result is plain RON).
-fn layout(file: &ProjectFile) -> String {
-    fn ron<T: Serialize>(v: &T) -> String {
-        let compact = ron::ser::PrettyConfig::new()
-            .compact_structs(true)
-            .compact_arrays(true);
-        ron::ser::to_string_pretty(v, compact).expect("project data always serializes")
-    }
-    fn list<T: Serialize>(items: &[T], per_line: usize) -> String {
-        let lines: Vec<String> = items
-            .chunks(per_line)
-            .map(|c| {
-                format!(
-                    "        {},",
-                    c.iter().map(ron).collect::<Vec<_>>().join(", ")
-                )
-            })
-            .collect();
-        format!("[\n{}\n    ]", lines.join("\n"))
-    }
-    let fields = [
-        ("format_version", ron(&file.format_version)),
-        ("grid_bricks", ron(&file.grid_bricks)),
-        ("camera", ron(&file.camera)),
-        ("sun", ron(&file.sun)),
-        ("sky", ron(&file.sky)),
-        ("settings", ron(&file.settings)),
-        ("materials", list(&file.materials, 1)),
-        ("colours", list(&file.colours, 8)),
-        ("roughness", list(&file.roughness, 16)),
-        ("ior", list(&file.ior, 16)),
-        ("strength", list(&file.strength, 16)),
-        ("voxels", ron(&file.voxels)),
-    ];
+fn layout(fields: &[(&str, String)]) -> String {
     let body: Vec<String> = fields
         .iter()
         .map(|(k, v)| format!("    {k}: {v},"))
@@ -200,47 +204,32 @@ pub fn load(path: &Path, workers: usize) -> Result<Scene, FormatError> {
 pub fn from_bytes(text: &[u8], path: &Path, workers: usize) -> Result<Scene, FormatError> {
     let invalid = |m: String| FormatError::invalid(path, m);
     let text = std::str::from_utf8(text).map_err(|e| invalid(format!("not UTF-8 text: {e}")))?;
-    // The probe's own name never reaches the user: the file is not a project, and where.
-    let probe: Probe = ron::from_str(text).map_err(|e| {
-        invalid(format!(
-            "not a voxbrick project (a project begins with `(format_version: {FORMAT_VERSION},`; \
-             this file does not, line {} column {})",
-            e.span.start.line, e.span.start.col
-        ))
-    })?;
-    match probe.format_version {
-        v if v > FORMAT_VERSION => {
-            return Err(FormatError::NewerVersion {
-                path: path.display().to_string(),
-                found: v,
-                known: FORMAT_VERSION,
-            });
-        }
+    match version(text, path)? {
         FORMAT_VERSION => {}
         v => {
-            return Err(invalid(format!(
-                "format version {v} never existed (versions start at 1)"
-            )));
+            return Err(FormatError::invalid(
+                path,
+                format!(
+                    "a version {v} project holds objects: it opens as a scene of objects \
+                     (`project::load_objects`), not as one grid"
+                ),
+            ));
         }
     }
     let file: ProjectFile = ron::from_str(text).map_err(|e| invalid(format!("{e}")))?;
-    let params = SceneParams {
+    let (params, dims, table) = Header {
+        grid_bricks: file.grid_bricks,
         camera: file.camera,
         sun: file.sun,
         sky: file.sky,
         settings: file.settings,
-    };
-    params.validate().map_err(|e| invalid(e.to_string()))?;
-    let (x, y, z) = file.grid_bricks;
-    let dims = GridDims::new(x, y, z).map_err(|e| FormatError::world(path, e))?;
-    let table = material_table(
-        path,
-        &file.materials,
-        &file.colours,
-        &file.roughness,
-        &file.ior,
-        &file.strength,
-    )?;
+        materials: &file.materials,
+        colours: &file.colours,
+        roughness: &file.roughness,
+        ior: &file.ior,
+        strength: &file.strength,
+    }
+    .read(path)?;
     if file.voxels.encoding != ENCODING {
         return Err(invalid(format!(
             "unknown voxel encoding {:?} (expected {ENCODING:?})",
@@ -276,6 +265,71 @@ pub fn from_bytes(text: &[u8], path: &Path, workers: usize) -> Result<Scene, For
     }
     world.take_dirty();
     Ok(Scene::new(world, params))
+}
+
+/// The project version a text declares: refused when newer than this program reads, or one
+/// that never existed.
+fn version(text: &str, path: &Path) -> Result<u32, FormatError> {
+    let invalid = |m: String| FormatError::invalid(path, m);
+    // The probe's own name never reaches the user: the file is not a project, and where.
+    let probe: Probe = ron::from_str(text).map_err(|e| {
+        invalid(format!(
+            "not a voxbrick project (a project begins with `(format_version: {FORMAT_VERSION},`; \
+             this file does not, line {} column {})",
+            e.span.start.line, e.span.start.col
+        ))
+    })?;
+    match probe.format_version {
+        v if v > OBJECTS_VERSION => Err(FormatError::NewerVersion {
+            path: path.display().to_string(),
+            found: v,
+            known: OBJECTS_VERSION,
+        }),
+        v @ (FORMAT_VERSION | OBJECTS_VERSION) => Ok(v),
+        v => Err(invalid(format!(
+            "format version {v} never existed (versions start at 1)"
+        ))),
+    }
+}
+
+/// The fields every version shares, as read, before they are checked.
+struct Header<'a> {
+    grid_bricks: (u32, u32, u32),
+    camera: Camera,
+    sun: Sun,
+    sky: Sky,
+    settings: RenderSettings,
+    materials: &'a [MaterialRecord],
+    colours: &'a [String],
+    roughness: &'a [f32],
+    ior: &'a [f32],
+    strength: &'a [f32],
+}
+
+impl Header<'_> {
+    /// The scene parameters, the grid and the material table, each checked.
+    fn read(self, path: &Path) -> Result<(SceneParams, GridDims, MaterialTable), FormatError> {
+        let params = SceneParams {
+            camera: self.camera,
+            sun: self.sun,
+            sky: self.sky,
+            settings: self.settings,
+        };
+        params
+            .validate()
+            .map_err(|e| FormatError::invalid(path, e.to_string()))?;
+        let (x, y, z) = self.grid_bricks;
+        let dims = GridDims::new(x, y, z).map_err(|e| FormatError::world(path, e))?;
+        let table = material_table(
+            path,
+            self.materials,
+            self.colours,
+            self.roughness,
+            self.ior,
+            self.strength,
+        )?;
+        Ok((params, dims, table))
+    }
 }
 
 /// The scene's material table from the file's records; an error says which entry is wrong.

@@ -1,0 +1,339 @@
+//! Version 2 projects: a scene of objects. The header is version 1's (grid, camera, sun,
+//! sky, settings, the material, colour and parameter tables); instead of the world's voxels
+//! come the layers, the tree and the models; the world is their composite, rebuilt on load.
+//!
+//! ```text
+//!     layers: [(name: "ground", visible: true), ..],
+//!     nodes: [                                   // pre-order; a node's parent comes before it
+//!         (parent: None, name: "scene", visible: true, locked: false, placement: (rot: 4, t: (0, 0, 0)), object: None),
+//!         (parent: Some(0), name: "tree", visible: true, locked: false, placement: (rot: 4, t: (30, 8, 12)), object: Some((model: 3, layer: 0))),
+//!     ],
+//!     models: [(id: 3, size: (9, 16, 9), voxels: (encoding: "vxb1-base64", bricks: .., solid_voxels: .., data: "..")), ..],
+//! ```
+//! Rotations are MagicaVoxel's byte. A model's voxels are the VXB1 payload over the model's
+//! own grid of bricks. Node ids are the nodes' places in that list, on load and so after it.
+//! Loading checks every field, every parent link, every model's voxels, and that the objects
+//! fit the grid; a version 1 project loads as one object ("scene") at identity, brick-aligned.
+
+use super::{
+    ENCODING, FormatError, Header, MaterialRecord, OBJECTS_VERSION, VoxelRecord, header, layout,
+    list, payload, version,
+};
+use crate::scene::Scene;
+use base64::Engine;
+use brickmap::objects::{
+    Layer, LayerId, Model, ModelId, NewNode, NodeId, NodeKind, ObjectTree, Objects, Placement,
+};
+use brickmap::{BrickMaterials, GridDims, MaterialTable, World, WorldConfig};
+use glam::IVec3;
+use render::{Camera, RenderSettings, Sky, Sun};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+#[derive(Deserialize)]
+struct ObjectsFile {
+    #[allow(dead_code)]
+    format_version: u32,
+    grid_bricks: (u32, u32, u32),
+    camera: Camera,
+    sun: Sun,
+    sky: Sky,
+    settings: RenderSettings,
+    materials: Vec<MaterialRecord>,
+    colours: Vec<String>,
+    roughness: Vec<f32>,
+    ior: Vec<f32>,
+    strength: Vec<f32>,
+    layers: Vec<Layer>,
+    nodes: Vec<NodeRecord>,
+    models: Vec<ModelRecord>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct NodeRecord {
+    parent: Option<u32>,
+    name: String,
+    visible: bool,
+    locked: bool,
+    placement: Placement,
+    object: Option<ObjectRecord>,
+}
+
+#[derive(Serialize, Deserialize)]
+struct ObjectRecord {
+    model: u32,
+    layer: u8,
+}
+
+#[derive(Serialize, Deserialize)]
+struct ModelRecord {
+    id: u32,
+    size: (i32, i32, i32),
+    voxels: VoxelRecord,
+}
+
+/// The grid of bricks a model's payload is written over.
+fn model_dims(size: IVec3) -> Result<GridDims, brickmap::BrickmapError> {
+    let b = (size + 7) / 8;
+    GridDims::new(b.x as u32, b.y as u32, b.z as u32)
+}
+
+/// The project text of a scene of objects.
+pub fn objects_to_string(scene: &Scene, objects: &Objects) -> String {
+    let tree = objects.tree();
+    let order = tree
+        .subtree(ObjectTree::ROOT)
+        .expect("the root is always there");
+    let place: BTreeMap<NodeId, u32> = order
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (*n, i as u32))
+        .collect();
+    let nodes: Vec<NodeRecord> = order
+        .iter()
+        .map(|id| {
+            let n = tree.node(*id).expect("a node of the tree");
+            NodeRecord {
+                parent: n.parent().map(|p| place[&p]),
+                name: n.name.clone(),
+                visible: n.visible,
+                locked: n.locked,
+                placement: n.placement,
+                object: match n.kind {
+                    NodeKind::Object { model, layer } => Some(ObjectRecord {
+                        model: model.0,
+                        layer: layer.0,
+                    }),
+                    NodeKind::Group { .. } => None,
+                },
+            }
+        })
+        .collect();
+    let models: Vec<ModelRecord> = objects
+        .models()
+        .iter()
+        .map(|(id, m)| model_record(*id, m))
+        .collect();
+    let mut fields = header(scene, OBJECTS_VERSION);
+    fields.push(("layers", list(tree.layers(), 1)));
+    fields.push(("nodes", list(&nodes, 1)));
+    fields.push(("models", list(&models, 1)));
+    layout(&fields)
+}
+
+fn model_record(id: ModelId, m: &Model) -> ModelRecord {
+    let dims = model_dims(m.size()).expect("a model's size is within the grid limits");
+    let mut bricks: Vec<_> = m.bricks().collect();
+    bricks.sort_by_key(|(b, _)| dims.cell_index(*b));
+    let data = payload::encode_bricks(&dims, |f| {
+        for (b, brick) in &bricks {
+            match brick.uniform() {
+                Some(u) => f(*b, &brick.mask, BrickMaterials::Uniform(u)),
+                None => {
+                    let v: Vec<u8> = brick.mask.ones().map(|bit| brick.material(bit)).collect();
+                    f(*b, &brick.mask, BrickMaterials::PerVoxel(&v));
+                }
+            }
+        }
+    });
+    let s = m.size();
+    ModelRecord {
+        id: id.0,
+        size: (s.x, s.y, s.z),
+        voxels: VoxelRecord {
+            encoding: ENCODING.into(),
+            bricks: bricks.len() as u64,
+            solid_voxels: m.solid_count(),
+            data: base64::engine::general_purpose::STANDARD.encode(data),
+        },
+    }
+}
+
+/// Saves a scene of objects atomically (version 2).
+pub fn save_objects(scene: &Scene, objects: &Objects, path: &Path) -> Result<(), FormatError> {
+    let text = objects_to_string(scene, objects);
+    crate::atomic::write_atomic(path, |w| w.write_all(text.as_bytes()))
+        .map_err(|e| FormatError::io(path, e))
+}
+
+/// Loads a project as a scene of objects: version 2 as written, version 1 as one object.
+pub fn load_objects(path: &Path, workers: usize) -> Result<(Scene, Objects), FormatError> {
+    let text = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
+    objects_from_bytes(&text, path, workers)
+}
+
+/// Parses project text as a scene of objects (`path` only names it in errors).
+pub fn objects_from_bytes(
+    text: &[u8],
+    path: &Path,
+    workers: usize,
+) -> Result<(Scene, Objects), FormatError> {
+    let invalid = |m: String| FormatError::invalid(path, m);
+    let world_error = |e: brickmap::BrickmapError| FormatError::world(path, e);
+    let s = std::str::from_utf8(text).map_err(|e| invalid(format!("not UTF-8 text: {e}")))?;
+    if version(s, path)? == super::FORMAT_VERSION {
+        return one_object(super::from_bytes(text, path, workers)?, path);
+    }
+    let file: ObjectsFile = ron::from_str(s).map_err(|e| invalid(format!("{e}")))?;
+    let (params, dims, table) = Header {
+        grid_bricks: file.grid_bricks,
+        camera: file.camera,
+        sun: file.sun,
+        sky: file.sky,
+        settings: file.settings,
+        materials: &file.materials,
+        colours: &file.colours,
+        roughness: &file.roughness,
+        ior: &file.ior,
+        strength: &file.strength,
+    }
+    .read(path)?;
+    let tree = read_tree(&file.layers, &file.nodes).map_err(invalid)?;
+    let mut models = BTreeMap::new();
+    for r in &file.models {
+        let at = |m: String| invalid(format!("model {}: {m}", r.id));
+        let model = read_model(r, &table, path).map_err(|e| at(e.to_string()))?;
+        if models.insert(ModelId(r.id), model).is_some() {
+            return Err(at("listed twice".into()));
+        }
+    }
+    let world = World::new(dims, WorldConfig::with_workers(workers)).map_err(world_error)?;
+    world.replace_materials(table).map_err(world_error)?;
+    let objects = Objects::new(tree, models, &world).map_err(|e| invalid(e.to_string()))?;
+    world.take_dirty();
+    Ok((Scene::new(world, params), objects))
+}
+
+/// The tree from the layer and node records (pre-order, parents first).
+fn read_tree(layers: &[Layer], nodes: &[NodeRecord]) -> Result<ObjectTree, String> {
+    let mut tree = ObjectTree::new();
+    match layers.split_first() {
+        None => return Err("no layers: a scene has at least one".into()),
+        Some((first, rest)) => {
+            *tree.layer_mut(LayerId(0)).expect("layer 0") = first.clone();
+            for l in rest {
+                tree.add_layer(l.clone()).map_err(|e| e.to_string())?;
+            }
+        }
+    }
+    let Some((root, rest)) = nodes.split_first() else {
+        return Err("no nodes: the first node is the scene's root group".into());
+    };
+    if root.parent.is_some() || root.object.is_some() {
+        return Err("node 0 must be the root group (no parent, no object)".into());
+    }
+    let r = tree.node_mut(ObjectTree::ROOT).expect("the root");
+    r.name = root.name.clone();
+    r.visible = root.visible;
+    r.locked = root.locked;
+    r.placement = root.placement;
+    for (i, n) in rest.iter().enumerate() {
+        let i = i + 1;
+        let parent = match n.parent {
+            Some(p) if (p as usize) < i => NodeId(p),
+            Some(p) => return Err(format!("node {i}: parent {p} does not come before it")),
+            None => return Err(format!("node {i}: only node 0 has no parent")),
+        };
+        let new = match &n.object {
+            Some(o) => NewNode::Object {
+                model: ModelId(o.model),
+                layer: LayerId(o.layer),
+            },
+            None => NewNode::Group,
+        };
+        let id = tree
+            .add(parent, None, n.name.clone(), n.placement, new)
+            .map_err(|e| format!("node {i}: {e}"))?;
+        debug_assert_eq!(id, NodeId(i as u32), "ids follow the list");
+        let node = tree.node_mut(id).expect("just added");
+        node.visible = n.visible;
+        node.locked = n.locked;
+    }
+    Ok(tree)
+}
+
+/// A model from its record, every brick checked against the model's size and the table.
+fn read_model(r: &ModelRecord, table: &MaterialTable, path: &Path) -> Result<Model, FormatError> {
+    let invalid = |m: String| FormatError::invalid(path, m);
+    let size = IVec3::new(r.size.0, r.size.1, r.size.2);
+    let mut model = Model::new(size).map_err(|e| FormatError::world(path, e))?;
+    if r.voxels.encoding != ENCODING {
+        return Err(invalid(format!(
+            "unknown voxel encoding {:?} (expected {ENCODING:?})",
+            r.voxels.encoding
+        )));
+    }
+    let data = base64::engine::general_purpose::STANDARD
+        .decode(r.voxels.data.as_bytes())
+        .map_err(|e| invalid(format!("voxel payload is not base64: {e}")))?;
+    let dims = model_dims(size).map_err(|e| FormatError::world(path, e))?;
+    let bricks =
+        payload::decode(&data, &dims, table.len()).map_err(|e| FormatError::payload(path, e))?;
+    if bricks.len() as u64 != r.voxels.bricks {
+        return Err(invalid(format!(
+            "voxel payload holds {} bricks, the header says {}",
+            bricks.len(),
+            r.voxels.bricks
+        )));
+    }
+    let list = bricks
+        .into_iter()
+        .map(|(brick, mask, prior)| brickmap::BrickUndo {
+            brick,
+            prior_mask: mask,
+            touched: mask,
+            prior,
+        })
+        .collect();
+    let restore = brickmap::EditOp::Restore(brickmap::EditInverse { bricks: list });
+    model
+        .apply(&restore, table)
+        .map_err(|e| FormatError::world(path, e))?;
+    if model.solid_count() != r.voxels.solid_voxels {
+        return Err(invalid(format!(
+            "voxels hold {} solid voxels, the header says {}",
+            model.solid_count(),
+            r.voxels.solid_voxels
+        )));
+    }
+    Ok(model)
+}
+
+/// A scene of one grid as one object ("scene") placing all of it, brick-aligned at identity.
+fn one_object(scene: Scene, path: &Path) -> Result<(Scene, Objects), FormatError> {
+    let world_error = |e: brickmap::BrickmapError| FormatError::world(path, e);
+    let size = scene.world.dims().voxels();
+    let mut model = Model::new(size).map_err(world_error)?;
+    let mut list = Vec::new();
+    scene.world.read().for_each_brick(|b, mask, mats| {
+        let held: Vec<u8> = (0..mask.count() as usize).map(|k| mats.at(k)).collect();
+        list.push(brickmap::BrickUndo {
+            brick: b,
+            prior_mask: *mask,
+            touched: *mask,
+            prior: brickmap::PriorMaterials::PerVoxel(held),
+        });
+    });
+    let table = scene.world.materials().clone();
+    let restore = brickmap::EditOp::Restore(brickmap::EditInverse { bricks: list });
+    model.apply(&restore, &table).map_err(world_error)?;
+    let mut tree = ObjectTree::new();
+    let object = NewNode::Object {
+        model: ModelId(0),
+        layer: LayerId(0),
+    };
+    tree.add(
+        ObjectTree::ROOT,
+        None,
+        "scene",
+        Placement::at(size / 2),
+        object,
+    )
+    .expect("a new tree takes an object");
+    let models = BTreeMap::from([(ModelId(0), model)]);
+    let objects = Objects::new(tree, models, &scene.world)
+        .map_err(|e| FormatError::invalid(path, e.to_string()))?;
+    scene.world.take_dirty();
+    Ok((scene, objects))
+}
