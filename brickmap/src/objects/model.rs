@@ -1,7 +1,8 @@
 //! A model: a voxel grid of its own size, in its own frame, that objects place. Stored sparse
-//! as 8³ bricks (a mask and one material byte per voxel, kept dense: a model is edited
-//! through the composite, so its store favours simple exact edits over the world's packed
-//! GPU layout). Edits are the world's `EditOp`s, checked first by the same validation
+//! as 8³ bricks: a mask and either one material for all its solid voxels or one byte per
+//! voxel (a model is edited through the composite, so its store favours simple exact edits
+//! over the world's packed GPU layout). A shape over many bricks is computed on every core
+//! and committed in order. Edits are the world's `EditOp`s, checked first by the same validation
 //! (`edit::validate`) and answered with the same `EditInverse`, so a model edit undoes and
 //! redoes exactly as a world edit does; voxels outside the model's box are clipped (shapes)
 //! or refused (single voxels, restores).
