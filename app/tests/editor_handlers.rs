@@ -285,6 +285,30 @@ fn a_held_fly_key_moves_by_the_time_held(s: &mut Session) {
     s.quiet();
 }
 
+/// Ctrl + 3 stores the view; after an orbit, 3 brings it back exactly.
+fn a_stored_view_comes_back(s: &mut Session) {
+    s.quiet();
+    s.ctrl(KeyCode::Digit3);
+    let stored = s.ed.view().clone();
+    let (x, y, w, h) = s.ed.view_area();
+    let centre = (f64::from(x + w / 2), f64::from(y + h / 2));
+    s.to(centre);
+    s.ed.input(Input::Button {
+        button: MouseButton::Right,
+        pressed: true,
+    });
+    s.to((centre.0 + 60.0, centre.1 + 20.0));
+    s.ed.input(Input::Button {
+        button: MouseButton::Right,
+        pressed: false,
+    });
+    assert_ne!(*s.ed.view(), stored, "the drag orbits");
+    s.key(KeyCode::Digit3, true);
+    s.key(KeyCode::Digit3, false);
+    assert_eq!(*s.ed.view(), stored, "the stored view is back");
+    s.quiet();
+}
+
 /// An undo with nothing to undo (a key burst's) is a passing status-line message,
 /// not an error; a save says so on the status line.
 fn no_ops_and_saves_are_said_on_the_status_line(s: &mut Session) {
@@ -683,6 +707,7 @@ fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     a_press_right_after_leaving_a_window_draws(&mut s);
     a_drag_from_a_window_into_the_viewport_edits_nothing(&mut s);
     a_held_fly_key_moves_by_the_time_held(&mut s);
+    a_stored_view_comes_back(&mut s);
     no_ops_and_saves_are_said_on_the_status_line(&mut s);
     a_paste_being_placed_shows_its_voxels(&mut s);
     a_dielectric_asks_for_the_bounces_it_needs(&mut s);
