@@ -7,6 +7,7 @@
 //! The composite (the visible objects written into the one `World` the renderers trace)
 //! builds on these: see docs/DESIGN.md, "Objects".
 
+pub mod arrange;
 pub mod composite;
 pub mod frame;
 pub mod model;

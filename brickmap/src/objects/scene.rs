@@ -73,6 +73,18 @@ pub enum ObjectOp {
         /// The position among its children.
         index: Option<usize>,
     },
+    /// Moves a node under `parent` at `index` and gives it a new placement, in one step
+    /// (ungrouping keeps a node where it is by composing its old parent's placement in).
+    Reparent {
+        /// The node.
+        node: NodeId,
+        /// The new parent group.
+        parent: NodeId,
+        /// The position among its children (the end when `None`).
+        index: Option<usize>,
+        /// Its placement under the new parent.
+        placement: Placement,
+    },
     /// Adds a node (it takes the lowest free id).
     Add {
         /// The parent group.
@@ -273,6 +285,28 @@ impl Objects {
                     node,
                     parent: old_parent,
                     index: Some(old_index),
+                })
+            }
+            ObjectOp::Reparent {
+                node,
+                parent,
+                index,
+                placement,
+            } => {
+                self.unlocked(node)?;
+                let before = self.tree.node(node)?.placement;
+                let (old_parent, old_index) = self.tree.move_node(node, parent, index)?;
+                self.tree.node_mut(node)?.placement = placement;
+                let moved = self.tree.subtree(node)?;
+                self.settle(world, &moved, |t| {
+                    t.move_node(node, old_parent, Some(old_index))?;
+                    t.node_mut(node).map(|n| n.placement = before)
+                })?;
+                Ok(ObjectOp::Reparent {
+                    node,
+                    parent: old_parent,
+                    index: Some(old_index),
+                    placement: before,
                 })
             }
             ObjectOp::Add {

@@ -5,7 +5,9 @@
 use crate::edit::{EditOp, VoxelEdit, VoxelOp};
 use crate::material::{Material, MaterialKind, MaterialTable};
 use crate::objects::model::Model;
-use crate::objects::tree::{ModelId, ObjectTree};
+use crate::objects::orient::Placement;
+use crate::objects::scene::Objects;
+use crate::objects::tree::{Layer, LayerId, ModelId, NewNode, ObjectTree};
 use crate::{GridDims, World, WorldConfig};
 use glam::IVec3;
 use std::collections::{BTreeMap, HashMap};
@@ -85,4 +87,59 @@ pub fn model(size: IVec3, seed: i32) -> Model {
     }
     m.apply(&EditOp::Voxels(list), &table()).unwrap();
     m
+}
+
+/// A session's first scene: a group holding two objects of models 0 and 1, model 1 placed
+/// again at the top level, a second layer.
+pub fn start(workers: usize) -> (Objects, World) {
+    let mut tree = ObjectTree::new();
+    tree.add_layer(Layer {
+        name: "second".into(),
+        visible: true,
+    })
+    .unwrap();
+    let g = tree
+        .add(
+            ObjectTree::ROOT,
+            None,
+            "g",
+            Placement::at(IVec3::new(24, 12, 20)),
+            NewNode::Group,
+        )
+        .unwrap();
+    let object = |m: u32, layer: u8| NewNode::Object {
+        model: ModelId(m),
+        layer: LayerId(layer),
+    };
+    tree.add(
+        g,
+        None,
+        "a",
+        Placement::at(IVec3::new(-6, 0, 0)),
+        object(0, 0),
+    )
+    .unwrap();
+    tree.add(
+        g,
+        None,
+        "b",
+        Placement::at(IVec3::new(6, 2, 4)),
+        object(1, 1),
+    )
+    .unwrap();
+    tree.add(
+        ObjectTree::ROOT,
+        None,
+        "c",
+        Placement::at(IVec3::new(44, 14, 30)),
+        object(1, 0),
+    )
+    .unwrap();
+    let models = BTreeMap::from([
+        (ModelId(0), model(IVec3::new(9, 6, 5), 0)),
+        (ModelId(1), model(IVec3::new(7, 8, 10), 1)),
+    ]);
+    let w = world(workers);
+    let objects = Objects::new(tree, models, &w).unwrap();
+    (objects, w)
 }

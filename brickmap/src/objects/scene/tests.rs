@@ -5,66 +5,10 @@
 use super::*;
 use crate::edit::Mode;
 use crate::objects::orient::Orientation;
-use crate::objects::testing::{GRID, assert_matches, model, reference, table, world};
-use crate::objects::tree::Layer;
+use crate::objects::testing::{GRID, assert_matches, model, reference, start, table};
 use crate::shape::Shape;
 use glam::DVec3;
 use proptest::prelude::*;
-
-/// A session's first scene: a group holding two objects of models 0 and 1, model 1 placed
-/// again at the top level, a second layer.
-fn start(workers: usize) -> (Objects, World) {
-    let mut tree = ObjectTree::new();
-    tree.add_layer(Layer {
-        name: "second".into(),
-        visible: true,
-    })
-    .unwrap();
-    let g = tree
-        .add(
-            ObjectTree::ROOT,
-            None,
-            "g",
-            Placement::at(IVec3::new(24, 12, 20)),
-            NewNode::Group,
-        )
-        .unwrap();
-    let object = |m: u32, layer: u8| NewNode::Object {
-        model: ModelId(m),
-        layer: LayerId(layer),
-    };
-    tree.add(
-        g,
-        None,
-        "a",
-        Placement::at(IVec3::new(-6, 0, 0)),
-        object(0, 0),
-    )
-    .unwrap();
-    tree.add(
-        g,
-        None,
-        "b",
-        Placement::at(IVec3::new(6, 2, 4)),
-        object(1, 1),
-    )
-    .unwrap();
-    tree.add(
-        ObjectTree::ROOT,
-        None,
-        "c",
-        Placement::at(IVec3::new(44, 14, 30)),
-        object(1, 0),
-    )
-    .unwrap();
-    let models = BTreeMap::from([
-        (ModelId(0), model(IVec3::new(9, 6, 5), 0)),
-        (ModelId(1), model(IVec3::new(7, 8, 10), 1)),
-    ]);
-    let w = world(workers);
-    let objects = Objects::new(tree, models, &w).unwrap();
-    (objects, w)
-}
 
 /// A random op over the nodes 0..6 and models 0..3 (many are refused: a test of that too).
 fn op() -> impl Strategy<Value = ObjectOp> {
@@ -98,7 +42,7 @@ fn op() -> impl Strategy<Value = ObjectOp> {
             parent,
             index: Some(i)
         }),
-        (node.clone(), p, 0u32..3).prop_map(|(parent, placement, m)| ObjectOp::Add {
+        (node.clone(), p.clone(), 0u32..3).prop_map(|(parent, placement, m)| ObjectOp::Add {
             parent,
             index: None,
             name: "new".into(),
@@ -109,6 +53,14 @@ fn op() -> impl Strategy<Value = ObjectOp> {
             },
         }),
         node.clone().prop_map(|node| ObjectOp::Remove { node }),
+        (node.clone(), node.clone(), p.clone()).prop_map(|(node, parent, placement)| {
+            ObjectOp::Reparent {
+                node,
+                parent,
+                index: None,
+                placement,
+            }
+        }),
         (node.clone(), 0u32..3).prop_map(|(node, model)| ObjectOp::SetModel {
             node,
             model: ModelId(model)

@@ -1,0 +1,445 @@
+//! The arrange-mode operations as [`ObjectOp`] batches, built from the scene as it is: apply
+//! one with [`Objects::apply`] and its inverse undoes it exactly, like any op. Each checks
+//! what it needs first and returns an error naming it, building nothing.
+//!
+//! - **instance**: another object placing the same model, offset by `offset`;
+//! - **duplicate**: a copy of the model placed by a new object, offset;
+//! - **make unique**: the object gets its own copy of its model;
+//! - **group**: a new group (identity) where the first node was, holding the nodes;
+//! - **ungroup**: the group's children take its place (their world placements kept), the
+//!   group goes;
+//! - **merge**: one new object (identity, a model the size of the objects' joint box) holding
+//!   what the objects show, where they overlap the later one's voxel (the drawing order);
+//!   the objects go;
+//! - **split**: the voxels of an object inside a world voxel set move to a new object with
+//!   the same placement and a model of the same size.
+
+use super::model::Model;
+use super::orient::{Orientation, Placement};
+use super::scene::{ObjectError, ObjectOp, Objects};
+use super::tree::{ModelId, NewNode, NodeId, NodeKind, ObjectTree, TreeError};
+use crate::edit::{BrickUndo, EditInverse, EditOp, Mode, PriorMaterials};
+use crate::material::MaterialTable;
+use crate::shape::Shape;
+use crate::voxel_set::VoxelSet;
+use glam::IVec3;
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// A brick being built: its mask and a material per voxel.
+type Dense = (crate::brick::Mask, Box<[u8; 512]>);
+
+/// The object's model and layer.
+fn object(o: &Objects, node: NodeId) -> Result<(ModelId, super::tree::LayerId), ObjectError> {
+    match o.tree().node(node)?.kind {
+        NodeKind::Object { model, layer } => Ok((model, layer)),
+        NodeKind::Group { .. } => Err(ObjectError::NotAnObject(node)),
+    }
+}
+
+/// Where a node sits: its parent and its index there.
+fn slot(tree: &ObjectTree, node: NodeId) -> Result<(NodeId, usize), ObjectError> {
+    let parent = tree.node(node)?.parent().ok_or(TreeError::Root)?;
+    let index = tree
+        .node(parent)?
+        .children()
+        .iter()
+        .position(|c| *c == node)
+        .expect("a node is among its parent's children");
+    Ok((parent, index))
+}
+
+/// The node added right after `node`, with a placement moved by `offset`.
+fn add_after(
+    o: &Objects,
+    node: NodeId,
+    name: String,
+    model: ModelId,
+    offset: IVec3,
+) -> Result<ObjectOp, ObjectError> {
+    let (parent, index) = slot(o.tree(), node)?;
+    let n = o.tree().node(node)?;
+    let (_, layer) = object(o, node)?;
+    Ok(ObjectOp::Add {
+        parent,
+        index: Some(index + 1),
+        name,
+        placement: Placement {
+            rot: n.placement.rot,
+            t: n.placement.t + offset,
+        },
+        new: NewNode::Object { model, layer },
+    })
+}
+
+/// Another object placing the same model, after it, moved by `offset`.
+pub fn instance(o: &Objects, node: NodeId, offset: IVec3) -> Result<ObjectOp, ObjectError> {
+    let (model, _) = object(o, node)?;
+    let name = o.tree().node(node)?.name.clone();
+    add_after(o, node, name, model, offset)
+}
+
+/// A copy of the object's model, placed by a new object after it, moved by `offset`.
+pub fn duplicate(o: &Objects, node: NodeId, offset: IVec3) -> Result<ObjectOp, ObjectError> {
+    let (model, _) = object(o, node)?;
+    let copy = o.free_model_id();
+    let voxels = o.model(model).ok_or(ObjectError::NoModel(model))?.clone();
+    let name = format!("{} copy", o.tree().node(node)?.name);
+    Ok(ObjectOp::Batch(vec![
+        ObjectOp::AddModel {
+            model: copy,
+            voxels: Box::new(voxels),
+        },
+        add_after(o, node, name, copy, offset)?,
+    ]))
+}
+
+/// The object gets its own copy of its model (its former instances keep the original).
+pub fn make_unique(o: &Objects, node: NodeId) -> Result<ObjectOp, ObjectError> {
+    let (model, _) = object(o, node)?;
+    let copy = o.free_model_id();
+    let voxels = o.model(model).ok_or(ObjectError::NoModel(model))?.clone();
+    Ok(ObjectOp::Batch(vec![
+        ObjectOp::AddModel {
+            model: copy,
+            voxels: Box::new(voxels),
+        },
+        ObjectOp::SetModel { node, model: copy },
+    ]))
+}
+
+/// A new group where the first node is, holding the nodes in their order (all must share
+/// that parent; the group's placement is the identity, so nothing moves).
+pub fn group(o: &Objects, nodes: &[NodeId], name: &str) -> Result<ObjectOp, ObjectError> {
+    let first = *nodes.first().ok_or(TreeError::Root)?;
+    let (parent, index) = slot(o.tree(), first)?;
+    for n in nodes {
+        if slot(o.tree(), *n)?.0 != parent {
+            return Err(ObjectError::Tree(TreeError::IntoItself {
+                node: *n,
+                parent,
+            }));
+        }
+    }
+    // The group takes the lowest free id, as the add will give it.
+    let group = lowest_free(o.tree());
+    let mut ops = vec![ObjectOp::Add {
+        parent,
+        index: Some(index),
+        name: name.to_string(),
+        placement: Placement::IDENTITY,
+        new: NewNode::Group,
+    }];
+    ops.extend(nodes.iter().map(|n| ObjectOp::Move {
+        node: *n,
+        parent: group,
+        index: None,
+    }));
+    Ok(ObjectOp::Batch(ops))
+}
+
+/// The group's children move to its parent where it was (their world placements kept: the
+/// group's placement composed into each), then the group goes.
+pub fn ungroup(o: &Objects, group: NodeId) -> Result<ObjectOp, ObjectError> {
+    let tree = o.tree();
+    let g = tree.node(group)?;
+    let NodeKind::Group { children } = &g.kind else {
+        return Err(ObjectError::NotAnObject(group));
+    };
+    let (parent, index) = slot(tree, group)?;
+    let mut ops = Vec::new();
+    for (k, c) in children.iter().enumerate() {
+        ops.push(ObjectOp::Reparent {
+            node: *c,
+            parent,
+            index: Some(index + 1 + k),
+            placement: g.placement.then(&tree.node(*c)?.placement),
+        });
+    }
+    ops.push(ObjectOp::Remove { node: group });
+    Ok(ObjectOp::Batch(ops))
+}
+
+/// One object holding what the objects show (the later one's voxel where they overlap),
+/// where the first of them was; the objects go. Hidden ones contribute nothing.
+pub fn merge(
+    o: &Objects,
+    nodes: &[NodeId],
+    name: &str,
+    table: &MaterialTable,
+) -> Result<ObjectOp, ObjectError> {
+    let first = *nodes.first().ok_or(TreeError::Root)?;
+    let (parent, index) = slot(o.tree(), first)?;
+    let (_, layer) = object(o, first)?;
+    // The visible ones among them, in drawing order.
+    let drawn: Vec<_> = o
+        .tree()
+        .drawn()
+        .into_iter()
+        .filter(|d| nodes.contains(&d.node))
+        .collect();
+    let mut voxels: BTreeMap<[i32; 3], u8> = BTreeMap::new();
+    for d in &drawn {
+        let m = o.model(d.model).ok_or(ObjectError::NoModel(d.model))?;
+        for (b, brick) in m.bricks() {
+            for bit in brick.mask.ones() {
+                let v = b.as_ivec3() * 8
+                    + IVec3::new((bit & 7) as i32, (bit >> 3 & 7) as i32, (bit >> 6) as i32);
+                voxels.insert(
+                    d.placement.place(v, m.size()).to_array(),
+                    brick.material(bit),
+                );
+            }
+        }
+    }
+    let (lo, hi) = voxels.keys().fold((IVec3::MAX, IVec3::MIN), |(lo, hi), k| {
+        let p = IVec3::from_array(*k);
+        (lo.min(p), hi.max(p))
+    });
+    let size = if voxels.is_empty() {
+        IVec3::ONE
+    } else {
+        hi - lo + 1
+    };
+    let lo = if voxels.is_empty() { IVec3::ZERO } else { lo };
+    // In the merged model's frame: v = world − lo. The object is placed at identity in the
+    // world: its parent's placement is undone (exact: placements are invertible).
+    let mut bricks: BTreeMap<[u32; 3], Dense> = BTreeMap::new();
+    for (k, m) in &voxels {
+        let v = IVec3::from_array(*k) - lo;
+        let bit = crate::brick::voxel_bit(v.x & 7, v.y & 7, v.z & 7);
+        let e = bricks
+            .entry((v / 8).as_uvec3().to_array())
+            .or_insert_with(|| (crate::brick::Mask::EMPTY, Box::new([0; 512])));
+        e.0.set(bit);
+        e.1[bit] = *m;
+    }
+    let list = bricks
+        .into_iter()
+        .map(|(k, (mask, mats))| BrickUndo {
+            brick: glam::UVec3::from_array(k),
+            prior_mask: mask,
+            touched: mask,
+            prior: PriorMaterials::PerVoxel(mask.ones().map(|bit| mats[bit]).collect()),
+        })
+        .collect();
+    let mut model = Model::new(size)?;
+    model.apply(&EditOp::Restore(EditInverse { bricks: list }), table)?;
+    let world = Placement::at(lo + size / 2);
+    let above = o.tree().world_placement(parent)?;
+    let local = inverse(&above).then(&world);
+    let id = o.free_model_id();
+    let mut ops = vec![
+        ObjectOp::AddModel {
+            model: id,
+            voxels: Box::new(model),
+        },
+        ObjectOp::Add {
+            parent,
+            index: Some(index),
+            name: name.to_string(),
+            placement: local,
+            new: NewNode::Object { model: id, layer },
+        },
+    ];
+    ops.extend(nodes.iter().map(|n| ObjectOp::Remove { node: *n }));
+    Ok(ObjectOp::Batch(ops))
+}
+
+/// The voxels of the object inside `selection` (world voxels) move to a new object with
+/// the same placement, after it.
+pub fn split(
+    o: &Objects,
+    node: NodeId,
+    selection: &VoxelSet,
+    table: &MaterialTable,
+) -> Result<ObjectOp, ObjectError> {
+    let (model, layer) = object(o, node)?;
+    let m = o.model(model).ok_or(ObjectError::NoModel(model))?;
+    let p = o.tree().world_placement(node)?;
+    let inside = p.set_to_model(selection, m.size());
+    // The new model: the original's voxels inside the selection.
+    let mut part = Model::new(m.size())?;
+    let mut list = Vec::new();
+    for v in inside.voxels() {
+        if let Some(mat) = m.voxel(v) {
+            list.push(crate::edit::VoxelEdit {
+                pos: v,
+                op: crate::edit::VoxelOp::Set(mat),
+            });
+        }
+    }
+    part.apply(&EditOp::Voxels(list), table)?;
+    let id = o.free_model_id();
+    let (parent, index) = slot(o.tree(), node)?;
+    let n = o.tree().node(node)?;
+    Ok(ObjectOp::Batch(vec![
+        ObjectOp::AddModel {
+            model: id,
+            voxels: Box::new(part),
+        },
+        ObjectOp::Add {
+            parent,
+            index: Some(index + 1),
+            name: format!("{} part", n.name),
+            placement: n.placement,
+            new: NewNode::Object { model: id, layer },
+        },
+        ObjectOp::Edit {
+            node,
+            edit: EditOp::Shape {
+                shape: Shape::Set(Arc::new(selection.clone())),
+                mode: Mode::Remove,
+            },
+        },
+    ]))
+}
+
+/// The inverse of a placement (on points: p ↦ R⁻¹·(p − t)).
+fn inverse(p: &Placement) -> Placement {
+    let rot: Orientation = p.rot.inverse();
+    Placement {
+        rot,
+        t: -rot.apply(p.t),
+    }
+}
+
+/// The id the tree's next new node takes.
+fn lowest_free(tree: &ObjectTree) -> NodeId {
+    (0..)
+        .map(NodeId)
+        .find(|n| tree.node(*n).is_err())
+        .expect("fewer than 2^32 nodes")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::World;
+    use crate::objects::orient::Axis;
+    use crate::objects::testing::{assert_matches, reference, start, table};
+
+    /// Applies an op, checks the world against the reference, undoes it and checks that
+    /// everything is as before; returns the objects after a redo.
+    fn round(o: &mut Objects, w: &World, op: ObjectOp) -> ObjectOp {
+        let t = table();
+        let before = (o.tree().clone(), w.read().content_hash());
+        let inverse = o.apply(w, op, &t).unwrap();
+        assert_matches(w, &reference(o.tree(), o.models()));
+        let redo = o.apply(w, inverse, &t).unwrap();
+        assert_eq!((o.tree().clone(), w.read().content_hash()), before);
+        o.apply(w, redo, &t).unwrap()
+    }
+
+    #[test]
+    fn instances_duplicates_and_unique_copies() {
+        let (mut o, w) = start(2);
+        let a = NodeId(2);
+        let op = instance(&o, a, IVec3::new(0, 0, 9)).unwrap();
+        round(&mut o, &w, op);
+        let (m, _) = object(&o, a).unwrap();
+        assert_eq!(o.tree().instances(m).len(), 2);
+        let op = duplicate(&o, a, IVec3::new(0, 8, 0)).unwrap();
+        round(&mut o, &w, op);
+        assert_eq!(o.models().len(), 3, "a new model");
+        let copy = *o.models().keys().last().unwrap();
+        assert_eq!(o.model(copy).unwrap(), o.model(m).unwrap());
+        let op = make_unique(&o, a).unwrap();
+        round(&mut o, &w, op);
+        assert_ne!(object(&o, a).unwrap().0, m, "a owns a copy now");
+        assert_eq!(
+            o.tree().instances(m).len(),
+            1,
+            "the instance keeps the original"
+        );
+    }
+
+    #[test]
+    fn group_and_ungroup_move_nothing_even_under_a_turned_group() {
+        let (mut o, w) = start(2);
+        let t = table();
+        let hash = w.read().content_hash();
+        // Turn the group holding a and b about y, then ungroup it: a and b stay put.
+        let g = NodeId(1);
+        let p = o.tree().node(g).unwrap().placement;
+        let turned = Placement {
+            rot: Orientation::quarter_turn(Axis::Y, 1),
+            t: p.t,
+        };
+        o.apply(
+            &w,
+            ObjectOp::Place {
+                node: g,
+                placement: turned,
+            },
+            &t,
+        )
+        .unwrap();
+        let turned_hash = w.read().content_hash();
+        assert_ne!(turned_hash, hash);
+        let op = ungroup(&o, g).unwrap();
+        round(&mut o, &w, op);
+        assert_eq!(w.read().content_hash(), turned_hash, "nothing moved");
+        assert!(o.tree().node(g).is_err(), "the group is gone");
+        let root = o.tree().node(ObjectTree::ROOT).unwrap().children().to_vec();
+        let op = group(&o, &root[..2], "pair").unwrap();
+        round(&mut o, &w, op);
+        assert_eq!(w.read().content_hash(), turned_hash, "nothing moved");
+        let pair = o.tree().node(ObjectTree::ROOT).unwrap().children()[0];
+        assert_eq!(o.tree().node(pair).unwrap().children(), &root[..2]);
+    }
+
+    #[test]
+    fn merge_keeps_what_shows_and_split_takes_a_part_out() {
+        let (mut o, w) = start(3);
+        let t = table();
+        let hash = w.read().content_hash();
+        // Merge a (in the turned-free group) and c (top level): the merged object goes
+        // where a was.
+        let (a, c) = (NodeId(2), NodeId(4));
+        let op = merge(&o, &[a, c], "merged", &t).unwrap();
+        round(&mut o, &w, op);
+        assert_eq!(w.read().content_hash(), hash, "the same voxels show");
+        assert!(o.tree().node(a).is_err() && o.tree().node(c).is_err());
+        // Split the merged object along a box of world voxels.
+        let merged = *o
+            .tree()
+            .drawn()
+            .iter()
+            .map(|d| d.node)
+            .find(|n| o.tree().node(*n).unwrap().name == "merged")
+            .iter()
+            .next()
+            .unwrap();
+        let mut half = VoxelSet::new();
+        for x in 0..40 {
+            for y in 0..32 {
+                for z in 0..48 {
+                    half.insert(IVec3::new(x, y, z));
+                }
+            }
+        }
+        let (m, _) = object(&o, merged).unwrap();
+        let solid = o.model(m).unwrap().solid_count();
+        let op = split(&o, merged, &half, &t).unwrap();
+        round(&mut o, &w, op);
+        assert_eq!(w.read().content_hash(), hash, "the same voxels show");
+        let part = o
+            .tree()
+            .node(o.tree().node(merged).unwrap().parent().unwrap())
+            .unwrap()
+            .children()
+            .iter()
+            .copied()
+            .find(|n| o.tree().node(*n).unwrap().name == "merged part")
+            .unwrap();
+        let (pm, _) = object(&o, part).unwrap();
+        let left = o.model(m).unwrap().solid_count();
+        let taken = o.model(pm).unwrap().solid_count();
+        assert!(
+            taken > 0 && left > 0,
+            "both halves hold voxels: {taken} + {left}"
+        );
+        assert_eq!(taken + left, solid);
+    }
+}
