@@ -10,7 +10,9 @@
 use super::composite::{Composite, CompositeError};
 use super::model::Model;
 use super::orient::Placement;
-use super::tree::{Detached, LayerId, ModelId, NewNode, NodeId, NodeKind, ObjectTree, TreeError};
+use super::tree::{
+    Detached, Layer, LayerId, ModelId, NewNode, NodeId, NodeKind, ObjectTree, TreeError,
+};
 use crate::edit::{EditInverse, EditOp};
 use crate::error::BrickmapError;
 use crate::material::MaterialTable;
@@ -131,6 +133,24 @@ pub enum ObjectOp {
         /// Visible.
         visible: bool,
     },
+    /// Puts an object on a layer.
+    SetLayer {
+        /// The object.
+        node: NodeId,
+        /// The layer.
+        layer: LayerId,
+    },
+    /// Renames a layer.
+    RenameLayer {
+        /// The layer.
+        layer: LayerId,
+        /// The name.
+        name: String,
+    },
+    /// Adds a layer at the end.
+    AddLayer(Layer),
+    /// Removes the last layer (no object may be on it).
+    RemoveLastLayer,
     /// Several ops as one: all or none (on an error the ones done are undone).
     Batch(Vec<ObjectOp>),
 }
@@ -385,6 +405,35 @@ impl Objects {
                     visible: before,
                 })
             }
+            ObjectOp::SetLayer { node, layer } => {
+                self.unlocked(node)?;
+                self.object_model(node)?;
+                if layer.0 as usize >= self.tree.layers().len() {
+                    return Err(TreeError::NoLayer(layer).into());
+                }
+                let before = Self::set_layer_in(&mut self.tree, node, layer)?;
+                self.settle(world, &[], |t| {
+                    Self::set_layer_in(t, node, before).map(|_| ())
+                })?;
+                Ok(ObjectOp::SetLayer {
+                    node,
+                    layer: before,
+                })
+            }
+            ObjectOp::RenameLayer { layer, name } => {
+                let l = self.tree.layer_mut(layer)?;
+                let before = std::mem::replace(&mut l.name, name);
+                Ok(ObjectOp::RenameLayer {
+                    layer,
+                    name: before,
+                })
+            }
+            ObjectOp::AddLayer(layer) => {
+                // A new layer holds no object: the composite does not change.
+                self.tree.add_layer(layer)?;
+                Ok(ObjectOp::RemoveLastLayer)
+            }
+            ObjectOp::RemoveLastLayer => Ok(ObjectOp::AddLayer(self.tree.remove_last_layer()?)),
             ObjectOp::Batch(ops) => {
                 let mut done: Vec<ObjectOp> = Vec::with_capacity(ops.len());
                 for op in ops {
@@ -416,6 +465,18 @@ impl Objects {
         match self.tree.node(node)?.kind {
             NodeKind::Object { model, .. } => Ok(model),
             NodeKind::Group { .. } => Err(ObjectError::NotAnObject(node)),
+        }
+    }
+
+    /// Puts an object on a layer; returns the layer it was on.
+    fn set_layer_in(
+        tree: &mut ObjectTree,
+        node: NodeId,
+        layer: LayerId,
+    ) -> Result<LayerId, TreeError> {
+        match &mut tree.node_mut(node)?.kind {
+            NodeKind::Object { layer: l, .. } => Ok(std::mem::replace(l, layer)),
+            NodeKind::Group { .. } => Ok(layer),
         }
     }
 

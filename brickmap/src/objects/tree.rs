@@ -140,6 +140,9 @@ pub enum TreeError {
     /// No layer has this id.
     #[error("no layer {}", .0.0)]
     NoLayer(LayerId),
+    /// The layer holds objects, or is the only one.
+    #[error("layer {} holds objects or is the only layer", .0.0)]
+    LayerInUse(LayerId),
     /// 256 layers exist already.
     #[error("a scene has at most 256 layers")]
     TooManyLayers,
@@ -257,6 +260,20 @@ impl ObjectTree {
         }
         self.layers.push(layer);
         Ok(LayerId((self.layers.len() - 1) as u8))
+    }
+
+    /// Removes the last layer, which no object may be on (the inverse of `add_layer`).
+    pub fn remove_last_layer(&mut self) -> Result<Layer, TreeError> {
+        let last = LayerId((self.layers.len() - 1) as u8);
+        let used = self
+            .nodes
+            .iter()
+            .flatten()
+            .any(|n| matches!(n.kind, NodeKind::Object { layer, .. } if layer == last));
+        if self.layers.len() == 1 || used {
+            return Err(TreeError::LayerInUse(last));
+        }
+        Ok(self.layers.pop().expect("more than one layer"))
     }
 
     /// Adds a node under `parent` at `index` (the end when `None`); it takes the lowest free

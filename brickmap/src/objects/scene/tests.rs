@@ -6,6 +6,7 @@ use super::*;
 use crate::edit::Mode;
 use crate::objects::orient::Orientation;
 use crate::objects::testing::{GRID, assert_matches, model, reference, start, table};
+use crate::objects::tree::Layer;
 use crate::shape::Shape;
 use glam::DVec3;
 use proptest::prelude::*;
@@ -74,6 +75,19 @@ fn op() -> impl Strategy<Value = ObjectOp> {
             layer: LayerId(1),
             visible
         }),
+        (node.clone(), 0u8..3).prop_map(|(node, l)| ObjectOp::SetLayer {
+            node,
+            layer: LayerId(l)
+        }),
+        (0u8..3).prop_map(|l| ObjectOp::RenameLayer {
+            layer: LayerId(l),
+            name: format!("renamed {l}")
+        }),
+        any::<bool>().prop_map(|visible| ObjectOp::AddLayer(Layer {
+            name: "added".into(),
+            visible
+        })),
+        Just(ObjectOp::RemoveLastLayer),
     ]
 }
 
