@@ -231,3 +231,49 @@ fn model_edit_alone(bencher: Bencher, radius: f64) {
         model.apply(&op, &table).unwrap()
     });
 }
+
+/// Noise terrain (the editor's Terrain window, 5 octaves of Perlin) generated into the
+/// 512 × 256 × 512 world and into a model of that size: what the Terrain window will cost
+/// once it generates into the active object.
+#[divan::bench(args = ["world", "model"], sample_count = 5, sample_size = 1)]
+fn noise_terrain(bencher: Bencher, into: &str) {
+    let w = world();
+    let materials = brickmap::terrain::TerrainMaterials {
+        grass: vec![1],
+        dirt: vec![2],
+        rock: vec![3],
+        sand: vec![2],
+        snow: vec![1],
+        water: 0,
+    };
+    let params = brickmap::terrain::TerrainParams {
+        seed: 2022,
+        noise: brickmap::terrain::NoiseKind::Perlin,
+        scale: 180.0,
+        octaves: 5,
+        height_range: (40, 200),
+        water_level: 0,
+        rock_line: 0.62,
+        snow_line: 0.86,
+        soil_depth: 3,
+        materials,
+    };
+    let table = w.materials().clone();
+    match into {
+        "world" => bencher.bench_local(|| {
+            let op = brickmap::terrain::NoiseTerrain::new(params.clone(), dims())
+                .unwrap()
+                .edit();
+            w.apply(op).unwrap()
+        }),
+        _ => {
+            let mut m = Model::new(dims().voxels()).unwrap();
+            bencher.bench_local(|| {
+                let op = brickmap::terrain::NoiseTerrain::new(params.clone(), dims())
+                    .unwrap()
+                    .edit();
+                m.apply(&op, &table).unwrap()
+            })
+        }
+    }
+}

@@ -206,26 +206,7 @@ impl Model {
                     let touched = shape.mask(b.as_ivec3() * 8).and(&self.inside(*b));
                     self.rewrite(*b, &touched, value, paint)
                 };
-                // Bricks are independent: a large shape is computed on every core in
-                // contiguous chunks joined in order, then committed in that order.
-                let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-                let rewrites: Vec<Rewrite> = if list.len() < PARALLEL_BRICKS || threads < 2 {
-                    list.iter().filter_map(one).collect()
-                } else {
-                    let chunk = list.len().div_ceil(threads);
-                    std::thread::scope(|s| {
-                        let parts: Vec<_> = list
-                            .chunks(chunk)
-                            .map(|part| {
-                                s.spawn(move || part.iter().filter_map(one).collect::<Vec<_>>())
-                            })
-                            .collect();
-                        parts
-                            .into_iter()
-                            .flat_map(|h| h.join().expect("model threads do not panic"))
-                            .collect()
-                    })
-                };
+                let rewrites = self.on_cores(&list, |b| one(b).into_iter().collect());
                 rewrites
                     .into_iter()
                     .map(|r| self.commit(r, &mut undo))
@@ -253,44 +234,47 @@ impl Model {
             }
             EditOp::Generate(g) => {
                 let n = self.bricks_size();
-                let mut emitted: BTreeMap<[u32; 3], (Mask, PriorMaterials)> = BTreeMap::new();
-                for bz in 0..n.z {
-                    for bx in 0..n.x {
-                        g.0.column(bx, bz, &mut |by, mask, mats| {
-                            if by < n.y {
-                                emitted.insert([bx, by, bz], (mask, mats));
+                let columns: Vec<(u32, u32)> = (0..n.z)
+                    .flat_map(|bz| (0..n.x).map(move |bx| (bx, bz)))
+                    .collect();
+                // A column's bricks: what is emitted, and empty where it emits nothing
+                // (clipped to the model; materials ranked in the emitted mask).
+                let column = |&(bx, bz): &(u32, u32)| {
+                    let mut emitted: BTreeMap<u32, (Mask, PriorMaterials)> = BTreeMap::new();
+                    g.0.column(bx, bz, &mut |by, mask, mats| {
+                        if by < n.y {
+                            emitted.insert(by, (mask, mats));
+                        }
+                    });
+                    (0..n.y)
+                        .filter_map(|by| {
+                            let b = UVec3::new(bx, by, bz);
+                            let (full, mats) = emitted
+                                .remove(&by)
+                                .unwrap_or((Mask::EMPTY, PriorMaterials::Uniform(0)));
+                            if full.is_empty() && !self.bricks.contains_key(&key(b)) {
+                                return None;
                             }
-                        });
-                    }
-                }
-                // Every brick: what was there or what is emitted, whichever is non-empty.
-                let mut cells: Vec<[u32; 3]> = self.bricks.keys().copied().collect();
-                cells.extend(emitted.keys().copied());
-                cells.sort_unstable();
-                cells.dedup();
-                let mut changed = 0;
-                for c in cells {
-                    let b = UVec3::from_array(c);
-                    let inside = self.inside(b);
-                    let (mask, mats) = emitted
-                        .remove(&c)
-                        .unwrap_or((Mask::EMPTY, PriorMaterials::Uniform(0)));
-                    let mask = mask.and(&inside);
-                    let probe = BrickUndo {
-                        brick: b,
-                        prior_mask: mask,
-                        touched: Mask::FULL,
-                        prior: mats,
-                    };
-                    changed += self.write(
-                        b,
-                        &inside,
-                        &mut undo,
-                        |bit, _| mask.get(bit).then(|| probe.prior_material(mask.rank(bit))),
-                        false,
-                    );
-                }
-                changed
+                            let inside = self.inside(b);
+                            let mask = full.and(&inside);
+                            let probe = BrickUndo {
+                                brick: b,
+                                prior_mask: full,
+                                touched: Mask::FULL,
+                                prior: mats,
+                            };
+                            let value = |bit: usize, _: Option<u8>| {
+                                mask.get(bit).then(|| probe.prior_material(full.rank(bit)))
+                            };
+                            self.rewrite(b, &inside, value, false)
+                        })
+                        .collect::<Vec<_>>()
+                };
+                let rewrites = self.on_cores(&columns, column);
+                rewrites
+                    .into_iter()
+                    .map(|r| self.commit(r, &mut undo))
+                    .sum()
             }
         };
         Ok(EditOutcome {
@@ -348,6 +332,32 @@ impl Model {
             Some(r) => self.commit(r, undo),
             None => 0,
         }
+    }
+
+    /// Rewrites computed for each item (independent bricks or columns), on every core when
+    /// there are at least [`PARALLEL_BRICKS`] items: contiguous chunks joined in order, so
+    /// the result is the same whatever the core count.
+    fn on_cores<T: Sync>(
+        &self,
+        items: &[T],
+        each: impl Fn(&T) -> Vec<Rewrite> + Sync,
+    ) -> Vec<Rewrite> {
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+        if items.len() < PARALLEL_BRICKS || threads < 2 {
+            return items.iter().flat_map(&each).collect();
+        }
+        let chunk = items.len().div_ceil(threads);
+        let each = &each;
+        std::thread::scope(|s| {
+            let parts: Vec<_> = items
+                .chunks(chunk)
+                .map(|part| s.spawn(move || part.iter().flat_map(each).collect::<Vec<_>>()))
+                .collect();
+            parts
+                .into_iter()
+                .flat_map(|h| h.join().expect("model threads do not panic"))
+                .collect()
+        })
     }
 
     /// What [`Model::write`] would do to brick `b`, computed without changing anything
@@ -430,7 +440,7 @@ impl Model {
     }
 }
 
-/// Shapes over at least this many bricks are computed on every core.
+/// Shapes over at least this many bricks (generators: columns) are computed on every core.
 const PARALLEL_BRICKS: usize = 256;
 
 /// One brick's new content, its undo and the voxels it changes.
