@@ -542,6 +542,45 @@ impl Objects {
     pub fn grid(&self) -> IVec3 {
         self.grid
     }
+
+    /// The box every object covers, shown or hidden (lowest cell, one past the highest), in
+    /// world voxels; `None` without objects. A grid that holds it (after a shift by
+    /// max(0, −lowest)) lets every object be shown and nothing is refused for the grid.
+    pub fn extent(&self) -> Option<(IVec3, IVec3)> {
+        let mut out: Option<(IVec3, IVec3)> = None;
+        for id in self.tree.subtree(ObjectTree::ROOT).expect("the root") {
+            let Ok(node) = self.tree.node(id) else {
+                continue;
+            };
+            let NodeKind::Object { model, .. } = node.kind else {
+                continue;
+            };
+            let Some(m) = self.models.get(&model) else {
+                continue;
+            };
+            let p = self.tree.world_placement(id).expect("a node of the tree");
+            let (lo, hi) = p.bounds(m.size());
+            out = Some(out.map_or((lo, hi), |(a, b)| (a.min(lo), b.max(hi))));
+        }
+        out
+    }
+
+    /// Moves the scene into another world (a larger grid, for objects that grew past the
+    /// old one): every object shifted by `shift` (through the root's placement), the
+    /// composite written into `world`, which must be empty. On an error (an object outside
+    /// the new grid too) nothing changed. The caller swaps the worlds and shifts its camera
+    /// by the same voxels.
+    pub fn regrid(&mut self, world: &World, shift: IVec3) -> Result<(), ObjectError> {
+        let mut tree = self.tree.clone();
+        tree.node_mut(ObjectTree::ROOT)?.placement.t += shift;
+        let grid = world.dims().voxels();
+        let composite = Composite::new(&tree, &self.models, grid)?;
+        composite.write(world, &composite.all_bricks(), &self.models)?;
+        self.tree = tree;
+        self.composite = composite;
+        self.grid = grid;
+        Ok(())
+    }
 }
 
 #[cfg(test)]

@@ -225,3 +225,53 @@ fn locked_objects_refuse_edits_and_moves_and_a_shared_model_edit_shows_in_both()
     ));
     assert_eq!(state(&o, &w), before);
 }
+
+#[test]
+fn a_scene_that_outgrows_its_grid_moves_into_a_larger_one() {
+    let t = table();
+    let (mut o, w) = start(2);
+    let c = NodeId(4);
+    // Past the grid's far corner: refused, naming the grid.
+    let far = ObjectOp::Place {
+        node: c,
+        placement: Placement::at(IVec3::new(74, 14, 30)),
+    };
+    let e = o.apply(&w, far.clone(), &t).unwrap_err();
+    assert!(e.to_string().contains("[64, 32, 48] voxel grid"), "{e}");
+    // Below the origin too: the extent says how much grid is needed.
+    let low = ObjectOp::Place {
+        node: NodeId(2),
+        placement: Placement::at(IVec3::new(-40, 0, 0)),
+    };
+    assert!(o.apply(&w, low.clone(), &t).is_err());
+    let (lo, hi) = o.extent().unwrap();
+    assert!(lo.cmpge(IVec3::ZERO).all() && hi.cmple(GRID).all());
+    // A grid with room on both sides: the scene moves in, shifted, the same voxels.
+    let shift = IVec3::new(32, 0, 0);
+    let big = World::new(
+        crate::GridDims::from_voxels((GRID + IVec3::new(64, 0, 0)).as_uvec3()).unwrap(),
+        crate::WorldConfig::with_workers(2),
+    )
+    .unwrap();
+    big.replace_materials(t.clone()).unwrap();
+    let before = reference(o.tree(), o.models());
+    o.regrid(&big, shift).unwrap();
+    assert_eq!(o.grid(), GRID + IVec3::new(64, 0, 0));
+    let shifted: std::collections::HashMap<IVec3, u8> =
+        before.into_iter().map(|(p, m)| (p + shift, m)).collect();
+    assert_matches(&big, &shifted);
+    // Now both places fit (relative to the shifted root: t − shift keeps the world spot).
+    o.apply(&big, far, &t).unwrap();
+    o.apply(&big, low, &t).unwrap();
+    assert_matches(&big, &reference(o.tree(), o.models()));
+    // A grid too small for the scene is refused and nothing changes.
+    let tiny = World::new(
+        crate::GridDims::new(1, 1, 1).unwrap(),
+        crate::WorldConfig::with_workers(1),
+    )
+    .unwrap();
+    let tree = o.tree().clone();
+    assert!(o.regrid(&tiny, IVec3::ZERO).is_err());
+    assert_eq!(o.tree(), &tree);
+    assert_eq!(tiny.read().solid_count(), 0);
+}
