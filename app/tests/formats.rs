@@ -1003,3 +1003,67 @@ fn hostile_version_2_projects_are_clear_errors() {
         assert!(project::objects_from_bytes(&text.as_bytes()[..cut], p, 1).is_err());
     }
 }
+
+#[test]
+fn a_model_over_256_leaves_as_chunks_under_a_group_and_comes_back_in_place() {
+    use brickmap::objects::{
+        Axis, LayerId, Model, ModelId, NewNode, NodeKind, ObjectTree, Objects, Orientation,
+        Placement,
+    };
+    let dir = scratch("vox-chunks");
+    let scene = Scene::empty(GridDims::new(48, 40, 40).unwrap(), 2).unwrap();
+    let table = scene.world.materials().clone();
+    // An odd-sized model, longer than 256, with an asymmetric hollow.
+    let size = IVec3::new(300, 21, 13);
+    let mut model = Model::new(size).unwrap();
+    for (shape, mode) in [
+        (
+            Shape::Box {
+                min: IVec3::ZERO,
+                max: size - 1,
+            },
+            Mode::Add(0),
+        ),
+        (
+            Shape::Sphere {
+                centre: DVec3::new(40.0, 15.0, 3.0),
+                radius: 9.0,
+            },
+            Mode::Remove,
+        ),
+    ] {
+        model.apply(&EditOp::Shape { shape, mode }, &table).unwrap();
+    }
+    let mut tree = ObjectTree::new();
+    let turned = Placement {
+        rot: Orientation::quarter_turn(Axis::Y, 1).after(&Orientation::flip(Axis::X)),
+        t: IVec3::new(150, 160, 160),
+    };
+    let object = NewNode::Object {
+        model: ModelId(0),
+        layer: LayerId(0),
+    };
+    tree.add(ObjectTree::ROOT, None, "long", turned, object)
+        .unwrap();
+    let models = std::collections::BTreeMap::from([(ModelId(0), model)]);
+    let objects = Objects::new(tree, models, &scene.world).unwrap();
+    let out = dir.join("long.vox");
+    let report = vox::export_objects(&objects, &table, &out).unwrap();
+    assert_eq!(report.models, 2, "two chunks");
+    let back = vox::import_objects(&std::fs::read(&out).unwrap(), &out, 2).unwrap();
+    // The original lies in the positive octant, so the import shifts nothing: the same
+    // places, not only the same shape.
+    assert_eq!(
+        resolved(&back.scene.world),
+        resolved(&scene.world),
+        "the chunks land where the model's voxels were"
+    );
+    let tree = back.objects.tree();
+    let group = tree.node(ObjectTree::ROOT).unwrap().children()[0];
+    assert_eq!(tree.node(group).unwrap().name, "long");
+    assert!(matches!(
+        tree.node(group).unwrap().kind,
+        NodeKind::Group { .. }
+    ));
+    assert_eq!(tree.node(group).unwrap().children().len(), 2);
+}

@@ -82,9 +82,6 @@ pub enum VoxError {
         /// How many one import can add.
         max: usize,
     },
-    /// Export of objects: a model larger than MagicaVoxel's 256 on a side.
-    #[error("a model of {0} voxels: MagicaVoxel's models are at most 256 on each side")]
-    ModelTooLarge(IVec3),
     /// Export: .vox holds at most 255 materials.
     #[error("the scene uses more than 255 materials; .vox holds at most 255")]
     TooManyMaterials,

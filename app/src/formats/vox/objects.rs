@@ -151,14 +151,15 @@ fn model_of(
 /// The `.vox` data of a scene of objects: one nTRN + nGRP per group and nTRN + nSHP per
 /// object (names, hidden flags, rotations, layers), one model per placed model (shared
 /// between its instances), a palette slot per used material (at most 255) with MATL chunks.
-/// MagicaVoxel's models are at most 256 on a side: a larger model is refused, named.
+/// MagicaVoxel's models are at most 256 on a side: a larger model is written as chunks of
+/// at most 256 under a group that takes the object's place (so it comes back as a group).
 pub fn export_objects_data(
     objects: &Objects,
     table: &brickmap::MaterialTable,
 ) -> Result<DotVoxData, VoxError> {
     let tree = objects.tree();
     let mut slots = super::export::Slots::default();
-    let mut index: BTreeMap<ModelId, u32> = BTreeMap::new();
+    let mut index: BTreeMap<ModelId, (IVec3, Vec<Chunk>)> = BTreeMap::new();
     let mut models = Vec::new();
     for (id, m) in objects.models() {
         if tree.instances(*id).is_empty() {
@@ -166,24 +167,40 @@ pub fn export_objects_data(
         }
         let s = m.size();
         let mv = IVec3::new(s.x, s.z, s.y);
-        if mv.cmpgt(IVec3::splat(256)).any() {
-            return Err(VoxError::ModelTooLarge(s));
-        }
-        let mut voxels = Vec::with_capacity(m.solid_count() as usize);
+        // A model over 256 on a side is written as chunks of at most 256 (MagicaVoxel's
+        // limit), each placed in a group where its voxels were.
+        let mut chunks: BTreeMap<[i32; 3], Vec<Voxel>> = BTreeMap::new();
         for (b, brick) in m.bricks() {
             for bit in brick.mask.ones() {
                 let u = b.as_ivec3() * 8
                     + IVec3::new((bit % 8) as i32, (bit / 8 % 8) as i32, (bit / 64) as i32);
-                voxels.push(Voxel {
-                    x: u.x as u8,
-                    y: (s.z - 1 - u.z) as u8,
-                    z: u.y as u8,
+                let v = IVec3::new(u.x, s.z - 1 - u.z, u.y);
+                let c = v.div_euclid(IVec3::splat(256));
+                let l = v - c * 256;
+                chunks.entry(c.to_array()).or_default().push(Voxel {
+                    x: l.x as u8,
+                    y: l.y as u8,
+                    z: l.z as u8,
                     i: slots.slot(brick.material(bit))?,
                 });
             }
         }
-        index.insert(*id, models.len() as u32);
-        models.push(super::export::vox_model(mv, voxels));
+        if chunks.is_empty() && mv.cmple(IVec3::splat(256)).all() {
+            // An empty model stays one (empty) model.
+            chunks.insert([0, 0, 0], Vec::new());
+        }
+        let mut list = Vec::new();
+        for (c, voxels) in chunks {
+            let offset = IVec3::from_array(c) * 256;
+            let size = (mv - offset).min(IVec3::splat(256));
+            list.push(Chunk {
+                model: models.len() as u32,
+                offset,
+                size,
+            });
+            models.push(super::export::vox_model(size, voxels));
+        }
+        index.insert(*id, (mv, list));
     }
     let mut scenes = Vec::new();
     write_node(objects, ObjectTree::ROOT, &index, &mut scenes);
@@ -211,11 +228,43 @@ pub fn export_objects_data(
     })
 }
 
+/// One ≤ 256³ piece of a model: its `.vox` model, its offset in the whole model and its
+/// size (both in the file's axes).
+struct Chunk {
+    model: u32,
+    offset: IVec3,
+    size: IVec3,
+}
+
+/// The transform node of a shape, with a name, a translation and a layer.
+fn shape_transform(name: String, t: IVec3, child: u32, layer_id: u32) -> SceneNode {
+    let mut frame = dot_vox::Dict::new();
+    frame.insert("_t".into(), format!("{} {} {}", t.x, t.y, t.z));
+    let mut attributes = dot_vox::Dict::new();
+    attributes.insert("_name".into(), name);
+    SceneNode::Transform {
+        attributes,
+        frames: vec![dot_vox::Frame::new(frame)],
+        child,
+        layer_id,
+    }
+}
+
+fn shape(model: u32) -> SceneNode {
+    SceneNode::Shape {
+        attributes: Default::default(),
+        models: vec![dot_vox::ShapeModel {
+            model_id: model,
+            attributes: Default::default(),
+        }],
+    }
+}
+
 /// Writes a node (nTRN, then its nGRP or nSHP) and its subtree; returns its nTRN's index.
 fn write_node(
     objects: &Objects,
     id: NodeId,
-    index: &BTreeMap<ModelId, u32>,
+    index: &BTreeMap<ModelId, (IVec3, Vec<Chunk>)>,
     scenes: &mut Vec<SceneNode>,
 ) -> u32 {
     let tree = objects.tree();
@@ -266,13 +315,36 @@ fn write_node(
                 *children = kids;
             }
         }
-        NodeKind::Object { model, .. } => scenes.push(SceneNode::Shape {
-            attributes: Default::default(),
-            models: vec![dot_vox::ShapeModel {
-                model_id: index[model],
-                attributes: Default::default(),
-            }],
-        }),
+        NodeKind::Object { model, .. } => match &index[model] {
+            (whole, chunks) if chunks.len() == 1 && chunks[0].size == *whole => {
+                scenes.push(shape(chunks[0].model))
+            }
+            (whole, chunks) => {
+                // x = v + ½ − ⌊s/2⌋ of the whole model = u + ½ − ⌊s_c/2⌋ + T_c of a chunk.
+                let whole = *whole;
+                let group = scenes.len();
+                scenes.push(SceneNode::Group {
+                    attributes: Default::default(),
+                    children: Vec::new(),
+                });
+                let mut kids = Vec::new();
+                for (i, c) in chunks.iter().enumerate() {
+                    let t = c.offset + c.size / 2 - whole / 2;
+                    let at = scenes.len() as u32;
+                    kids.push(at);
+                    scenes.push(shape_transform(
+                        format!("{} {i}", node.name),
+                        t,
+                        at + 1,
+                        layer_id,
+                    ));
+                    scenes.push(shape(c.model));
+                }
+                if let SceneNode::Group { children, .. } = &mut scenes[group] {
+                    *children = kids;
+                }
+            }
+        },
     }
     at
 }
