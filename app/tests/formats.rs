@@ -998,9 +998,33 @@ fn hostile_version_2_projects_are_clear_errors() {
         let e = err(&bad);
         assert!(e.contains(want), "want {want:?} in: {e}");
     }
-    // Every truncation fails cleanly (sampled).
+    let far = {
+        let key = "placement: (rot: 4, t: (";
+        let at = text.find(key).unwrap() + key.len();
+        let end = at + text[at..].find(',').unwrap();
+        format!("{}2000000000{}", &text[..at], &text[end..])
+    };
+    let e = err(&far);
+    assert!(e.contains("beyond ±1048576"), "{e}");
+    // Every truncation fails cleanly (sampled); bytes changed at random give an error or a
+    // scene, never a panic.
     for cut in (0..text.trim_end().len()).step_by(211) {
         assert!(project::objects_from_bytes(&text.as_bytes()[..cut], p, 1).is_err());
+    }
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    for _ in 0..200 {
+        let mut bytes = text.as_bytes().to_vec();
+        for _ in 0..3 {
+            let at = (next() % bytes.len() as u64) as usize;
+            bytes[at] = b"0123456789-(),:[] aeSomeNn\"#"[(next() % 28) as usize];
+        }
+        let _ = project::objects_from_bytes(&bytes, p, 1);
     }
 }
 

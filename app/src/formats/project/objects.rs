@@ -73,6 +73,10 @@ struct ModelRecord {
     voxels: VoxelRecord,
 }
 
+/// The largest translation a node may have on any axis (as in `.vox` files): 64 nested
+/// levels of it stay far inside `i32`.
+const MAX_TRANSLATION: i32 = 1 << 20;
+
 /// The grid of bricks a model's payload is written over.
 fn model_dims(size: IVec3) -> Result<GridDims, brickmap::BrickmapError> {
     let b = (size + 7) / 8;
@@ -228,6 +232,19 @@ fn read_tree(layers: &[Layer], nodes: &[NodeRecord]) -> Result<ObjectTree, Strin
     r.visible = root.visible;
     r.locked = root.locked;
     r.placement = root.placement;
+    for (i, n) in nodes.iter().enumerate() {
+        if n.placement
+            .t
+            .abs()
+            .cmpgt(IVec3::splat(MAX_TRANSLATION))
+            .any()
+        {
+            return Err(format!(
+                "node {i}: translation {} is beyond ±{MAX_TRANSLATION}",
+                n.placement.t
+            ));
+        }
+    }
     for (i, n) in rest.iter().enumerate() {
         let i = i + 1;
         let parent = match n.parent {
