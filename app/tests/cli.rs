@@ -131,6 +131,20 @@ fn new_terrain_is_deterministic_and_converts_both_ways() {
     ok(&["convert", s(&v), s(&back)]);
     let again = ok(&["info", s(&back)]);
     assert_eq!(field(&info, "solid"), field(&again, "solid"));
+    // A grid is one object; a MagicaVoxel scene shows its objects.
+    assert!(
+        field(&info, "objects")
+            .starts_with("objects      1 objects of 1 models (0 shared), 0 groups"),
+        "{info}"
+    );
+    let ogt = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets/vox/ogt_test_multiple_model_scene.vox");
+    let scene = ok(&["info", s(&ogt)]);
+    assert!(
+        field(&scene, "objects").contains("104 objects of 41 models (16 shared)"),
+        "{scene}"
+    );
+    assert!(field(&scene, "objects").contains("8 layers"), "{scene}");
 }
 
 #[test]

@@ -149,16 +149,48 @@ pub(crate) struct InfoArgs {
     file: PathBuf,
 }
 
-/// Prints the file's statistics, camera and render settings.
+/// One line on a scene's objects: how many, the models they place and how many of them
+/// are shared, groups, hidden ones, layers.
+fn objects_text(o: &brickmap::objects::Objects) -> String {
+    use brickmap::objects::{NodeKind, ObjectTree};
+    let tree = o.tree();
+    let (mut objects, mut groups, mut hidden) = (0, 0, 0);
+    for id in tree.subtree(ObjectTree::ROOT).unwrap_or_default() {
+        let Ok(n) = tree.node(id) else { continue };
+        match n.kind {
+            NodeKind::Object { .. } => objects += 1,
+            NodeKind::Group { .. } if id != ObjectTree::ROOT => groups += 1,
+            NodeKind::Group { .. } => {}
+        }
+        hidden += usize::from(!n.visible);
+    }
+    let placed: Vec<usize> = o
+        .models()
+        .keys()
+        .map(|m| tree.instances(*m).len())
+        .filter(|n| *n > 0)
+        .collect();
+    let shared = placed.iter().filter(|n| **n > 1).count();
+    let layers = tree.layers();
+    format!(
+        "objects      {objects} objects of {} models ({shared} shared), {groups} groups, {hidden} hidden; {} layers ({} hidden)\n",
+        placed.len(),
+        layers.len(),
+        layers.iter().filter(|l| !l.visible).count()
+    )
+}
+
+/// Prints the file's statistics, objects, camera and render settings.
 pub(crate) fn info(a: InfoArgs, workers: usize) -> Result<()> {
     let file = a.file;
     let started = Instant::now();
-    let scene = with_progress(format!("reading {}", file.display()), || {
-        Ok(app::formats::load(&file, workers)?)
+    let (scene, objects) = with_progress(format!("reading {}", file.display()), || {
+        Ok(app::formats::load_objects(&file, workers)?)
     })?;
     let p = &scene.params;
     let mut text = format!("file         {}\n", file.display());
     text += &stats_text(&scene.world, started.elapsed().as_secs_f64());
+    text += &objects_text(&objects);
     let lens = match p.camera.projection {
         render::Projection::Perspective => format!("fov {:.1}", p.camera.fov_y_deg),
         render::Projection::Orthographic { height } => {

@@ -20,6 +20,22 @@ pub fn load(path: &Path, workers: usize) -> Result<Scene, FormatError> {
     }
 }
 
+/// Loads a file as a scene of objects: a `.ron` project (version 2 as written, version 1 as
+/// one object) or a `.vox` file with its groups, objects, layers and shared models.
+pub fn load_objects(
+    path: &Path,
+    workers: usize,
+) -> Result<(Scene, brickmap::objects::Objects), FormatError> {
+    match Format::of(path)? {
+        Format::Project => project::load_objects(path, workers),
+        Format::Vox => {
+            let bytes = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
+            let import = vox::import_objects(&bytes, path, workers)?;
+            Ok((import.scene, import.objects))
+        }
+    }
+}
+
 /// Saves as a `.ron` project or exports `.vox`, atomically, choosing by the extension.
 pub fn save(scene: &Scene, path: &Path) -> Result<(), FormatError> {
     match Format::of(path)? {
