@@ -217,37 +217,8 @@ pub fn from_bytes(text: &[u8], path: &Path, workers: usize) -> Result<Scene, For
         }
     }
     let file: ProjectFile = ron::from_str(text).map_err(|e| invalid(format!("{e}")))?;
-    let (params, dims, table) = Header {
-        grid_bricks: file.grid_bricks,
-        camera: file.camera,
-        sun: file.sun,
-        sky: file.sky,
-        settings: file.settings,
-        materials: &file.materials,
-        colours: &file.colours,
-        roughness: &file.roughness,
-        ior: &file.ior,
-        strength: &file.strength,
-    }
-    .read(path)?;
-    if file.voxels.encoding != ENCODING {
-        return Err(invalid(format!(
-            "unknown voxel encoding {:?} (expected {ENCODING:?})",
-            file.voxels.encoding
-        )));
-    }
-    let data = base64::engine::general_purpose::STANDARD
-        .decode(file.voxels.data.as_bytes())
-        .map_err(|e| invalid(format!("voxel payload is not base64: {e}")))?;
-    let bricks =
-        payload::decode(&data, &dims, table.len()).map_err(|e| FormatError::payload(path, e))?;
-    if bricks.len() as u64 != file.voxels.bricks {
-        return Err(invalid(format!(
-            "voxel payload holds {} bricks, the header says {}",
-            bricks.len(),
-            file.voxels.bricks
-        )));
-    }
+    let (params, dims, table) = header_of!(file).read(path)?;
+    let bricks = file.voxels.bricks(&dims, table.len(), path)?;
     let world = World::new(dims, WorldConfig::with_workers(workers))
         .map_err(|e| FormatError::world(path, e))?;
     world
@@ -289,6 +260,57 @@ fn version(text: &str, path: &Path) -> Result<u32, FormatError> {
         v => Err(invalid(format!(
             "format version {v} never existed (versions start at 1)"
         ))),
+    }
+}
+
+/// The shared fields of a file struct of any version, as a [`Header`].
+macro_rules! header_of {
+    ($file:expr) => {
+        Header {
+            grid_bricks: $file.grid_bricks,
+            camera: $file.camera,
+            sun: $file.sun,
+            sky: $file.sky,
+            settings: $file.settings,
+            materials: &$file.materials,
+            colours: &$file.colours,
+            roughness: &$file.roughness,
+            ior: &$file.ior,
+            strength: &$file.strength,
+        }
+    };
+}
+use header_of;
+
+impl VoxelRecord {
+    /// The record's bricks over a grid of `dims` with a table of `materials` entries: the
+    /// encoding, the base64, the payload and the brick count checked.
+    fn bricks(
+        &self,
+        dims: &GridDims,
+        materials: usize,
+        path: &Path,
+    ) -> Result<Vec<(glam::UVec3, brickmap::Mask, brickmap::PriorMaterials)>, FormatError> {
+        let invalid = |m: String| FormatError::invalid(path, m);
+        if self.encoding != ENCODING {
+            return Err(invalid(format!(
+                "unknown voxel encoding {:?} (expected {ENCODING:?})",
+                self.encoding
+            )));
+        }
+        let data = base64::engine::general_purpose::STANDARD
+            .decode(self.data.as_bytes())
+            .map_err(|e| invalid(format!("voxel payload is not base64: {e}")))?;
+        let bricks =
+            payload::decode(&data, dims, materials).map_err(|e| FormatError::payload(path, e))?;
+        if bricks.len() as u64 != self.bricks {
+            return Err(invalid(format!(
+                "voxel payload holds {} bricks, the header says {}",
+                bricks.len(),
+                self.bricks
+            )));
+        }
+        Ok(bricks)
     }
 }
 

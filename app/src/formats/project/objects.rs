@@ -16,8 +16,8 @@
 //! fit the grid; a version 1 project loads as one object ("scene") at identity, brick-aligned.
 
 use super::{
-    ENCODING, FormatError, Header, MaterialRecord, OBJECTS_VERSION, VoxelRecord, header, layout,
-    list, payload, version,
+    ENCODING, FormatError, Header, MaterialRecord, OBJECTS_VERSION, VoxelRecord, header, header_of,
+    layout, list, payload, version,
 };
 use crate::scene::Scene;
 use base64::Engine;
@@ -180,19 +180,7 @@ pub fn objects_from_bytes(
         return one_object(super::from_bytes(text, path, workers)?, path);
     }
     let file: ObjectsFile = ron::from_str(s).map_err(|e| invalid(format!("{e}")))?;
-    let (params, dims, table) = Header {
-        grid_bricks: file.grid_bricks,
-        camera: file.camera,
-        sun: file.sun,
-        sky: file.sky,
-        settings: file.settings,
-        materials: &file.materials,
-        colours: &file.colours,
-        roughness: &file.roughness,
-        ior: &file.ior,
-        strength: &file.strength,
-    }
-    .read(path)?;
+    let (params, dims, table) = header_of!(file).read(path)?;
     let tree = read_tree(&file.layers, &file.nodes).map_err(invalid)?;
     let mut models = BTreeMap::new();
     for r in &file.models {
@@ -275,25 +263,8 @@ fn read_model(r: &ModelRecord, table: &MaterialTable, path: &Path) -> Result<Mod
     let invalid = |m: String| FormatError::invalid(path, m);
     let size = IVec3::new(r.size.0, r.size.1, r.size.2);
     let mut model = Model::new(size).map_err(|e| FormatError::world(path, e))?;
-    if r.voxels.encoding != ENCODING {
-        return Err(invalid(format!(
-            "unknown voxel encoding {:?} (expected {ENCODING:?})",
-            r.voxels.encoding
-        )));
-    }
-    let data = base64::engine::general_purpose::STANDARD
-        .decode(r.voxels.data.as_bytes())
-        .map_err(|e| invalid(format!("voxel payload is not base64: {e}")))?;
     let dims = model_dims(size).map_err(|e| FormatError::world(path, e))?;
-    let bricks =
-        payload::decode(&data, &dims, table.len()).map_err(|e| FormatError::payload(path, e))?;
-    if bricks.len() as u64 != r.voxels.bricks {
-        return Err(invalid(format!(
-            "voxel payload holds {} bricks, the header says {}",
-            bricks.len(),
-            r.voxels.bricks
-        )));
-    }
+    let bricks = r.voxels.bricks(&dims, table.len(), path)?;
     let list = bricks
         .into_iter()
         .map(|(brick, mask, prior)| brickmap::BrickUndo {
