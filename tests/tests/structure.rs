@@ -30,19 +30,49 @@ fn product_text(p: &Path) -> String {
     }
 }
 
+/// The modules a folder's `mod.rs` / `lib.rs` declares under `#[cfg(test)]` (test helpers:
+/// not product code, so not part of the product's import graph).
+fn test_only(dir: &Path) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    for root in ["mod.rs", "lib.rs"] {
+        let Ok(text) = std::fs::read_to_string(dir.join(root)) else {
+            continue;
+        };
+        let mut lines = text.lines().map(str::trim);
+        while let Some(l) = lines.next() {
+            if l == "#[cfg(test)]"
+                && let Some(next) = lines.next()
+                && let Some(name) = next
+                    .strip_prefix("mod ")
+                    .or_else(|| next.strip_prefix("pub mod "))
+                    .and_then(|n| n.strip_suffix(';'))
+            {
+                out.insert(name.to_string());
+            }
+        }
+    }
+    out
+}
+
 /// The sibling modules of a folder (files and subfolders, `mod.rs` / `lib.rs` / `main.rs`
-/// left out) with every file each holds.
+/// and test-only modules left out) with every file each holds, test files (`tests.rs`)
+/// left out.
 fn modules(dir: &Path) -> BTreeMap<String, Vec<PathBuf>> {
+    let skip = test_only(dir);
     let mut out = BTreeMap::new();
     for e in std::fs::read_dir(dir).unwrap() {
         let p = e.unwrap().path();
         let name = p.file_stem().unwrap().to_string_lossy().to_string();
+        if skip.contains(&name) {
+            continue;
+        }
         if p.is_dir() {
             let mut files = Vec::new();
             rust_files(&p, &mut files);
+            files.retain(|f| f.file_name().is_none_or(|n| n != "tests.rs"));
             out.entry(name).or_insert_with(Vec::new).extend(files);
         } else if p.extension().is_some_and(|x| x == "rs")
-            && !["mod", "lib", "main"].contains(&name.as_str())
+            && !["mod", "lib", "main", "tests"].contains(&name.as_str())
         {
             out.entry(name).or_insert_with(Vec::new).push(p);
         }
@@ -154,6 +184,12 @@ fn the_loop_finder_finds_a_loop() {
         "use super::ab;\n#[cfg(test)]\nmod tests { use super::a; }\n",
     )
     .unwrap();
+    // Test-only code does not count: a cfg(test) module using d, and a tests.rs file in d
+    // using it back.
+    std::fs::write(dir.join("mod.rs"), "mod a;\n#[cfg(test)]\nmod helpers;\n").unwrap();
+    std::fs::write(dir.join("helpers.rs"), "use super::d::D;\n").unwrap();
+    std::fs::create_dir_all(dir.join("d")).unwrap();
+    std::fs::write(dir.join("d/tests.rs"), "use crate::f::helpers::H;\n").unwrap();
     let found = loops(&dir, "f");
     std::fs::remove_dir_all(&dir).unwrap();
     assert_eq!(found, vec![vec!["a".to_string(), "b".into(), "c".into()]]);
