@@ -36,15 +36,7 @@ fn world() -> World {
 fn terrain_model() -> (Model, World) {
     let source = world();
     source.apply(terrain::rolling_hills(dims())).unwrap();
-    let mut bricks = Vec::new();
-    source.read().for_each_brick(|b, mask, mats| {
-        let held: Vec<u8> = (0..mask.count() as usize).map(|k| mats.at(k)).collect();
-        bricks.push((b, *mask, brickmap::PriorMaterials::PerVoxel(held)));
-    });
-    let mut model = Model::new(dims().voxels()).unwrap();
-    let table = source.materials().clone();
-    model.apply(&terrain::set_bricks(bricks), &table).unwrap();
-    (model, source)
+    (Model::from_world(&source).unwrap(), source)
 }
 
 fn one_object(rot: Orientation, size: IVec3) -> ObjectTree {

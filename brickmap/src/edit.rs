@@ -112,6 +112,17 @@ pub struct BrickUndo {
     pub prior: PriorMaterials,
 }
 
+impl PriorMaterials {
+    /// Materials in popcount order, kept as one when they are all the same (or none).
+    pub fn packed(held: Vec<u8>) -> Self {
+        match held.first() {
+            Some(&m) if held.iter().all(|x| *x == m) => PriorMaterials::Uniform(m),
+            None => PriorMaterials::Uniform(0),
+            _ => PriorMaterials::PerVoxel(held),
+        }
+    }
+}
+
 impl BrickUndo {
     /// The prior material of the `k`-th voxel of `touched ∩ prior_mask`.
     #[inline]

@@ -18,16 +18,13 @@ use super::model::Model;
 use super::orient::{Orientation, Placement};
 use super::scene::{ObjectError, ObjectOp, Objects};
 use super::tree::{ModelId, NewNode, NodeId, NodeKind, ObjectTree, TreeError};
-use crate::edit::{BrickUndo, EditInverse, EditOp, Mode, PriorMaterials};
+use crate::edit::{EditOp, Mode};
 use crate::material::MaterialTable;
 use crate::shape::Shape;
 use crate::voxel_set::VoxelSet;
 use glam::IVec3;
 use std::collections::BTreeMap;
 use std::sync::Arc;
-
-/// A brick being built: its mask and a material per voxel.
-type Dense = (crate::brick::Mask, Box<[u8; 512]>);
 
 /// The object's model and layer.
 fn object(o: &Objects, node: NodeId) -> Result<(ModelId, super::tree::LayerId), ObjectError> {
@@ -204,27 +201,8 @@ pub fn merge(
     let lo = if voxels.is_empty() { IVec3::ZERO } else { lo };
     // In the merged model's frame: v = world − lo. The object is placed at identity in the
     // world: its parent's placement is undone (exact: placements are invertible).
-    let mut bricks: BTreeMap<[u32; 3], Dense> = BTreeMap::new();
-    for (k, m) in &voxels {
-        let v = IVec3::from_array(*k) - lo;
-        let bit = crate::brick::voxel_bit(v.x & 7, v.y & 7, v.z & 7);
-        let e = bricks
-            .entry((v / 8).as_uvec3().to_array())
-            .or_insert_with(|| (crate::brick::Mask::EMPTY, Box::new([0; 512])));
-        e.0.set(bit);
-        e.1[bit] = *m;
-    }
-    let list = bricks
-        .into_iter()
-        .map(|(k, (mask, mats))| BrickUndo {
-            brick: glam::UVec3::from_array(k),
-            prior_mask: mask,
-            touched: mask,
-            prior: PriorMaterials::PerVoxel(mask.ones().map(|bit| mats[bit]).collect()),
-        })
-        .collect();
-    let mut model = Model::new(size)?;
-    model.apply(&EditOp::Restore(EditInverse { bricks: list }), table)?;
+    let relative = voxels.iter().map(|(k, m)| (IVec3::from_array(*k) - lo, *m));
+    let model = Model::from_voxels(size, relative, table)?;
     let world = Placement::at(lo + size / 2);
     let above = o.tree().world_placement(parent)?;
     let local = inverse(&above).then(&world);

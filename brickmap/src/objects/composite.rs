@@ -235,12 +235,7 @@ impl Composite {
         if now_mask == mask && mask.ones().all(|bit| now[bit] == mats[bit]) {
             return None;
         }
-        let held: Vec<u8> = mask.ones().map(|bit| mats[bit]).collect();
-        let prior = match held.first() {
-            Some(&m) if held.iter().all(|x| *x == m) => PriorMaterials::Uniform(m),
-            None => PriorMaterials::Uniform(0),
-            _ => PriorMaterials::PerVoxel(held),
-        };
+        let prior = PriorMaterials::packed(mask.ones().map(|bit| mats[bit]).collect());
         Some((b, mask, prior))
     }
 

@@ -117,6 +117,66 @@ impl Model {
         })
     }
 
+    /// A model of `size` holding these bricks (solid voxels with their materials in popcount
+    /// order), checked against the model's box and `table` like any edit.
+    pub fn from_bricks(
+        size: IVec3,
+        bricks: impl IntoIterator<Item = (UVec3, Mask, PriorMaterials)>,
+        table: &MaterialTable,
+    ) -> Result<Self> {
+        let mut model = Self::new(size)?;
+        // Each brick restored over exactly its solid voxels (a whole-brick restore would reach
+        // past a model whose size is not a multiple of 8).
+        let list = bricks
+            .into_iter()
+            .map(|(brick, mask, prior)| BrickUndo {
+                brick,
+                prior_mask: mask,
+                touched: mask,
+                prior,
+            })
+            .collect();
+        model.apply(&EditOp::Restore(EditInverse { bricks: list }), table)?;
+        Ok(model)
+    }
+
+    /// A model of `size` holding these solid voxels (position in the model, material; a
+    /// later one at the same position wins).
+    pub fn from_voxels(
+        size: IVec3,
+        voxels: impl IntoIterator<Item = (IVec3, u8)>,
+        table: &MaterialTable,
+    ) -> Result<Self> {
+        let mut bricks: BTreeMap<[u32; 3], (Mask, Box<[u8; 512]>)> = BTreeMap::new();
+        for (v, m) in voxels {
+            if v.cmplt(IVec3::ZERO).any() || v.cmpge(size).any() {
+                return Err(BrickmapError::OutOfRange(v, size));
+            }
+            let bit = voxel_bit(v.x & 7, v.y & 7, v.z & 7);
+            let (mask, mats) = bricks
+                .entry(key((v / 8).as_uvec3()))
+                .or_insert_with(|| (Mask::EMPTY, Box::new([0; 512])));
+            mask.set(bit);
+            mats[bit] = m;
+        }
+        let bricks = bricks.into_iter().map(|(k, (mask, mats))| {
+            let held = mask.ones().map(|bit| mats[bit]).collect();
+            (UVec3::from_array(k), mask, PriorMaterials::PerVoxel(held))
+        });
+        Self::from_bricks(size, bricks, table)
+    }
+
+    /// A world's voxels as one model of the world's size (a grid becoming one object).
+    pub fn from_world(world: &crate::World) -> Result<Self> {
+        let view = world.read();
+        let mut bricks = Vec::new();
+        view.for_each_brick(|b, mask, mats| {
+            let held = (0..mask.count() as usize).map(|k| mats.at(k)).collect();
+            bricks.push((b, *mask, PriorMaterials::PerVoxel(held)));
+        });
+        Self::from_bricks(view.dims().voxels(), bricks, view.materials())
+    }
+
     /// Its size in voxels.
     pub fn size(&self) -> IVec3 {
         self.size
@@ -407,14 +467,7 @@ impl Model {
         let held = old.mask.and(touched);
         let prior = match old.uniform() {
             Some(m) => PriorMaterials::Uniform(m),
-            None => {
-                let held: Vec<u8> = held.ones().map(|bit| old.material(bit)).collect();
-                match held.first() {
-                    Some(&m) if held.iter().all(|x| *x == m) => PriorMaterials::Uniform(m),
-                    None => PriorMaterials::Uniform(0),
-                    _ => PriorMaterials::PerVoxel(held),
-                }
-            }
+            None => PriorMaterials::packed(held.ones().map(|bit| old.material(bit)).collect()),
         };
         Some(Rewrite {
             undo: BrickUndo {

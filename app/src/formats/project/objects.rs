@@ -262,22 +262,12 @@ fn read_tree(layers: &[Layer], nodes: &[NodeRecord]) -> Result<ObjectTree, Strin
 fn read_model(r: &ModelRecord, table: &MaterialTable, path: &Path) -> Result<Model, FormatError> {
     let invalid = |m: String| FormatError::invalid(path, m);
     let size = IVec3::new(r.size.0, r.size.1, r.size.2);
-    let mut model = Model::new(size).map_err(|e| FormatError::world(path, e))?;
-    let dims = model_dims(size).map_err(|e| FormatError::world(path, e))?;
+    let world_error = |e: brickmap::BrickmapError| FormatError::world(path, e);
+    // The size first: a bad one is named before any payload is read.
+    Model::new(size).map_err(world_error)?;
+    let dims = model_dims(size).map_err(world_error)?;
     let bricks = r.voxels.bricks(&dims, table.len(), path)?;
-    let list = bricks
-        .into_iter()
-        .map(|(brick, mask, prior)| brickmap::BrickUndo {
-            brick,
-            prior_mask: mask,
-            touched: mask,
-            prior,
-        })
-        .collect();
-    let restore = brickmap::EditOp::Restore(brickmap::EditInverse { bricks: list });
-    model
-        .apply(&restore, table)
-        .map_err(|e| FormatError::world(path, e))?;
+    let model = Model::from_bricks(size, bricks, table).map_err(world_error)?;
     if model.solid_count() != r.voxels.solid_voxels {
         return Err(invalid(format!(
             "voxels hold {} solid voxels, the header says {}",
@@ -292,20 +282,7 @@ fn read_model(r: &ModelRecord, table: &MaterialTable, path: &Path) -> Result<Mod
 fn one_object(scene: Scene, path: &Path) -> Result<(Scene, Objects), FormatError> {
     let world_error = |e: brickmap::BrickmapError| FormatError::world(path, e);
     let size = scene.world.dims().voxels();
-    let mut model = Model::new(size).map_err(world_error)?;
-    let mut list = Vec::new();
-    scene.world.read().for_each_brick(|b, mask, mats| {
-        let held: Vec<u8> = (0..mask.count() as usize).map(|k| mats.at(k)).collect();
-        list.push(brickmap::BrickUndo {
-            brick: b,
-            prior_mask: *mask,
-            touched: *mask,
-            prior: brickmap::PriorMaterials::PerVoxel(held),
-        });
-    });
-    let table = scene.world.materials().clone();
-    let restore = brickmap::EditOp::Restore(brickmap::EditInverse { bricks: list });
-    model.apply(&restore, &table).map_err(world_error)?;
+    let model = Model::from_world(&scene.world).map_err(world_error)?;
     let mut tree = ObjectTree::new();
     let object = NewNode::Object {
         model: ModelId(0),

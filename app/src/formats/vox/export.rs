@@ -87,15 +87,26 @@ pub fn export_data(world: &World) -> Result<DotVoxData, VoxError> {
     }
     let mut layer = dot_vox::Dict::new();
     layer.insert("_name".into(), "voxbrick".into());
-    Ok(DotVoxData {
+    let layers = vec![dot_vox::Layer { attributes: layer }];
+    Ok(vox_data(models, (palette, materials), scenes, layers))
+}
+
+/// A `.vox` file's data (version 150, the default index map) of its parts.
+pub(super) fn vox_data(
+    models: Vec<Model>,
+    (palette, materials): (Vec<Color>, Vec<dot_vox::Material>),
+    scenes: Vec<SceneNode>,
+    layers: Vec<dot_vox::Layer>,
+) -> DotVoxData {
+    DotVoxData {
         version: 150,
         index_map: dot_vox::DEFAULT_INDEX_MAP.to_vec(),
         models,
         palette,
         materials,
         scenes,
-        layers: vec![dot_vox::Layer { attributes: layer }],
-    })
+        layers,
+    }
 }
 
 /// A `.vox` model of a size (in the file's axes, each side 1..=256) and its voxels.

@@ -118,34 +118,11 @@ fn model_of(
     map: &[u8; 256],
     table: &brickmap::MaterialTable,
 ) -> brickmap::Result<VoxelModel> {
-    let mut model = VoxelModel::new(model_size(m))?;
-    let mut bricks: BTreeMap<[u32; 3], (Mask, Box<[u8; 512]>)> = BTreeMap::new();
-    for v in &m.voxels {
-        let p = model_voxel(v, m);
-        let l = p % 8;
-        let bit = brickmap::brick::voxel_bit(l.x, l.y, l.z);
-        let (mask, mats) = bricks
-            .entry((p / 8).as_uvec3().to_array())
-            .or_insert_with(|| (Mask::EMPTY, Box::new([0; 512])));
-        mask.set(bit);
-        mats[bit] = map[v.i as usize];
-    }
-    // Each brick restored over exactly its solid voxels (a restore of whole bricks would
-    // reach past a model whose size is not a multiple of 8).
-    let list = bricks
-        .into_iter()
-        .map(|(k, (mask, mats))| brickmap::BrickUndo {
-            brick: glam::UVec3::from_array(k),
-            prior_mask: mask,
-            touched: mask,
-            prior: brickmap::PriorMaterials::PerVoxel(mask.ones().map(|bit| mats[bit]).collect()),
-        })
-        .collect();
-    model.apply(
-        &brickmap::EditOp::Restore(brickmap::EditInverse { bricks: list }),
-        table,
-    )?;
-    Ok(model)
+    let voxels = m
+        .voxels
+        .iter()
+        .map(|v| (model_voxel(v, m), map[v.i as usize]));
+    VoxelModel::from_voxels(model_size(m), voxels, table)
 }
 
 /// The `.vox` data of a scene of objects: one nTRN + nGRP per group and nTRN + nSHP per
@@ -204,7 +181,7 @@ pub fn export_objects_data(
     }
     let mut scenes = Vec::new();
     write_node(objects, ObjectTree::ROOT, &index, &mut scenes);
-    let (palette, materials) = slots.palette_and_materials(table)?;
+    let colours = slots.palette_and_materials(table)?;
     let layers = tree
         .layers()
         .iter()
@@ -217,15 +194,7 @@ pub fn export_objects_data(
             dot_vox::Layer { attributes: a }
         })
         .collect();
-    Ok(DotVoxData {
-        version: 150,
-        index_map: dot_vox::DEFAULT_INDEX_MAP.to_vec(),
-        models,
-        palette,
-        materials,
-        scenes,
-        layers,
-    })
+    Ok(super::export::vox_data(models, colours, scenes, layers))
 }
 
 /// One ≤ 256³ piece of a model: its `.vox` model, its offset in the whole model and its
