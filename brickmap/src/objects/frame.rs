@@ -11,10 +11,10 @@
 //! quarter-voxel positions the tools produce, it is exact.
 
 use super::orient::Placement;
-use crate::edit::{EditOp, VoxelEdit};
+use crate::edit::{BrickUndo, EditInverse, EditOp, PriorMaterials, VoxelEdit, VoxelOp};
 use crate::error::{BrickmapError, Result};
 use crate::shape::Shape;
-use crate::voxel_set::VoxelSet;
+use crate::voxel_set::{VoxelSet, box_mask};
 use glam::{DVec3, IVec3};
 use std::sync::Arc;
 
@@ -82,7 +82,9 @@ impl Placement {
 
     /// An edit in world voxels as the same edit of the model: shapes and voxel batches are
     /// carried (voxels outside the model are dropped from a batch, as a shape is clipped);
-    /// brick restores and generators only exist in the world's frame and are refused.
+    /// a brick restore is carried brick by brick where the object is unrotated and placed on
+    /// whole bricks, else voxel by voxel; a generator only where the model's frame is the
+    /// world's (else it is refused).
     pub fn edit_to_model(&self, op: &EditOp, size: IVec3) -> Result<EditOp> {
         let inside = |v: IVec3| v.cmpge(IVec3::ZERO).all() && v.cmplt(size).all();
         Ok(match op {
@@ -104,10 +106,87 @@ impl Placement {
                     .filter(|e| inside(e.pos))
                     .collect(),
             ),
-            EditOp::Restore(_) => return Err(BrickmapError::NotInModelFrame("a brick restore")),
-            EditOp::Generate(_) => return Err(BrickmapError::NotInModelFrame("a generator")),
+            EditOp::Restore(inverse) => match self.brick_shift(size) {
+                Some(shift) => EditOp::Restore(restore_shifted(inverse, shift, size)),
+                None => self.edit_to_model(&EditOp::Voxels(restore_voxels(inverse)), size)?,
+            },
+            // A generator fills the grid it was made for: the model's frame must be the
+            // world's.
+            EditOp::Generate(_) if self.brick_shift(size) == Some(IVec3::ZERO) => op.clone(),
+            EditOp::Generate(_) => {
+                return Err(BrickmapError::NotInModelFrame(
+                    "a generator outside an object placed at the world's origin",
+                ));
+            }
         })
     }
+
+    /// With no rotation and a translation of whole bricks, the world brick of model brick
+    /// `b` is `b + shift`.
+    fn brick_shift(&self, size: IVec3) -> Option<IVec3> {
+        let offset = self.place(IVec3::ZERO, size);
+        (self.rot == super::orient::Orientation::IDENTITY
+            && offset.rem_euclid(IVec3::splat(8)) == IVec3::ZERO)
+            .then_some(offset / 8)
+    }
+}
+
+/// A world restore as the model's: bricks moved by `-shift`, what lies outside the model
+/// dropped (the prior materials of the voxels kept, in the same order).
+fn restore_shifted(inverse: &EditInverse, shift: IVec3, size: IVec3) -> EditInverse {
+    let bricks = inverse
+        .bricks
+        .iter()
+        .filter_map(|u| {
+            let b = u.brick.as_ivec3() - shift;
+            let inside = box_mask(b * 8, IVec3::ZERO, size - 1);
+            let touched = u.touched.and(&inside);
+            if touched.is_empty() {
+                return None;
+            }
+            let prior = if touched == u.touched {
+                u.prior.clone()
+            } else {
+                // Repacked: the prior materials of the solid touched voxels still inside.
+                let kept = u.touched.and(&u.prior_mask);
+                PriorMaterials::packed(
+                    kept.ones()
+                        .enumerate()
+                        .filter(|(_, bit)| inside.get(*bit))
+                        .map(|(k, _)| u.prior_material(k))
+                        .collect(),
+                )
+            };
+            Some(BrickUndo {
+                brick: b.as_uvec3(),
+                prior_mask: u.prior_mask.and(&touched),
+                touched,
+                prior,
+            })
+        })
+        .collect();
+    EditInverse { bricks }
+}
+
+/// A world restore as single-voxel edits in world voxels (for an object it cannot be
+/// carried to brick by brick).
+fn restore_voxels(inverse: &EditInverse) -> Vec<VoxelEdit> {
+    let mut out = Vec::new();
+    for u in &inverse.bricks {
+        let min = u.brick.as_ivec3() * 8;
+        let mut k = 0;
+        for bit in u.touched.ones() {
+            let pos = min + IVec3::new(bit as i32 & 7, (bit as i32 >> 3) & 7, bit as i32 >> 6);
+            let op = if u.prior_mask.get(bit) {
+                k += 1;
+                VoxelOp::Set(u.prior_material(k - 1))
+            } else {
+                VoxelOp::Clear
+            };
+            out.push(VoxelEdit { pos, op });
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -153,8 +232,10 @@ mod tests {
         ]
     }
 
+    /// Any of the 48 orientations anywhere, or (a third of the cases) unrotated on whole
+    /// bricks, where a restore is carried brick by brick.
     fn placement() -> impl Strategy<Value = (Placement, IVec3)> {
-        (0usize..48, (18..30, 10..18, 18..30), (1..17, 1..13, 1..17)).prop_map(
+        let any = (0usize..48, (18..30, 10..18, 18..30), (1..17, 1..13, 1..17)).prop_map(
             |(r, (x, y, z), (sx, sy, sz))| {
                 let p = Placement {
                     rot: Orientation::all().nth(r).unwrap(),
@@ -162,7 +243,13 @@ mod tests {
                 };
                 (p, IVec3::new(sx, sy, sz))
             },
-        )
+        );
+        let aligned = ((0..3, 0..2, 0..3), (1..24, 1..16, 1..24)).prop_map(|(b, s)| {
+            let size = IVec3::new(s.0, s.1, s.2);
+            let at = IVec3::new(b.0, b.1, b.2) * 8;
+            (Placement::at(at + size / 2), size)
+        });
+        prop_oneof![2 => any, 1 => aligned]
     }
 
     proptest! {
@@ -212,18 +299,25 @@ mod tests {
                 w
             });
             let op = EditOp::Shape { shape: s, mode: if remove { Mode::Remove } else { Mode::Add(2) } };
-            worlds[1].apply(op.clone()).unwrap();
-            let carried = p.edit_to_model(&op, size).unwrap();
-            let model = models.get_mut(&ModelId(0)).unwrap();
-            let out = model.apply(&carried, &table).unwrap();
-            composite.model_edited(&worlds[0], &models, ModelId(0), &out.inverse).unwrap();
+            // The edit, then the world's restore of it carried the same way (a paste or a
+            // move of the editor is a world restore).
+            let undo = worlds[1].apply(op.clone()).unwrap().inverse;
             let (lo, hi) = p.bounds(size);
-            let (a, b) = (worlds[0].read(), worlds[1].read());
-            for z in lo.z..hi.z {
-                for y in lo.y..hi.y {
-                    for x in lo.x..hi.x {
-                        let w = IVec3::new(x, y, z);
-                        prop_assert_eq!(a.voxel(w).unwrap(), b.voxel(w).unwrap(), "{}", w);
+            for op in [op, EditOp::Restore(undo)] {
+                if let EditOp::Restore(inverse) = &op {
+                    worlds[1].apply(EditOp::Restore(inverse.clone())).unwrap();
+                }
+                let carried = p.edit_to_model(&op, size).unwrap();
+                let model = models.get_mut(&ModelId(0)).unwrap();
+                let out = model.apply(&carried, &table).unwrap();
+                composite.model_edited(&worlds[0], &models, ModelId(0), &out.inverse).unwrap();
+                let (a, b) = (worlds[0].read(), worlds[1].read());
+                for z in lo.z..hi.z {
+                    for y in lo.y..hi.y {
+                        for x in lo.x..hi.x {
+                            let w = IVec3::new(x, y, z);
+                            prop_assert_eq!(a.voxel(w).unwrap(), b.voxel(w).unwrap(), "{}", w);
+                        }
                     }
                 }
             }
@@ -231,16 +325,28 @@ mod tests {
     }
 
     #[test]
-    fn world_only_edits_are_refused_and_batches_keep_the_model_part() {
+    fn generators_outside_the_origin_are_refused_and_batches_keep_the_model_part() {
         let p = Placement {
             rot: Orientation::quarter_turn(crate::objects::Axis::Y, 1),
             t: IVec3::new(10, 0, 10),
         };
         let size = IVec3::new(4, 2, 6);
-        let restore = EditOp::Restore(Default::default());
+        struct Nothing;
+        impl crate::edit::ColumnSource for Nothing {
+            fn column(&self, _: u32, _: u32, _: &mut dyn FnMut(u32, crate::Mask, PriorMaterials)) {}
+            fn materials(&self) -> Vec<u8> {
+                Vec::new()
+            }
+        }
+        let generate = EditOp::Generate(crate::edit::Generator(Arc::new(Nothing)));
         assert!(matches!(
-            p.edit_to_model(&restore, size),
+            p.edit_to_model(&generate, size),
             Err(BrickmapError::NotInModelFrame(_))
+        ));
+        let origin = Placement::at(IVec3::splat(4));
+        assert!(matches!(
+            origin.edit_to_model(&generate, IVec3::splat(8)),
+            Ok(EditOp::Generate(_))
         ));
         let (lo, _) = p.bounds(size);
         let batch = EditOp::Voxels(vec![

@@ -155,6 +155,24 @@ pub enum ObjectOp {
     Batch(Vec<ObjectOp>),
 }
 
+impl ObjectOp {
+    /// Bytes it holds on the heap (what a history that keeps it pays): a model edit's
+    /// inverse, a removed subtree, a model set aside, the ops of a batch.
+    pub fn heap_bytes(&self) -> usize {
+        match self {
+            ObjectOp::RestoreModel { inverse, .. } => inverse.heap_bytes(),
+            ObjectOp::Restore(detached) => detached.heap_bytes(),
+            ObjectOp::AddModel { voxels, .. } => voxels.brick_bytes(),
+            ObjectOp::Rename { name, .. } | ObjectOp::RenameLayer { name, .. } => name.capacity(),
+            ObjectOp::Batch(ops) => {
+                ops.capacity() * std::mem::size_of::<ObjectOp>()
+                    + ops.iter().map(ObjectOp::heap_bytes).sum::<usize>()
+            }
+            _ => 0,
+        }
+    }
+}
+
 /// Why an op was refused; nothing changed.
 #[derive(Debug, thiserror::Error)]
 pub enum ObjectError {
@@ -213,6 +231,36 @@ impl Objects {
         })
     }
 
+    /// A grid's voxels as a scene of one object named "scene" that places a model of the
+    /// grid's size at identity, brick-aligned: its composite is the world as it is, so
+    /// nothing is written. Returns the object too.
+    pub fn of_world(world: &World) -> Result<(Self, NodeId), ObjectError> {
+        let grid = world.dims().voxels();
+        let mut tree = ObjectTree::new();
+        let object = NewNode::Object {
+            model: ModelId(0),
+            layer: LayerId(0),
+        };
+        let node = tree.add(
+            ObjectTree::ROOT,
+            None,
+            "scene",
+            Placement::at(grid / 2),
+            object,
+        )?;
+        let models = BTreeMap::from([(ModelId(0), Model::from_world(world)?)]);
+        let composite = Composite::new(&tree, &models, grid)?;
+        Ok((
+            Self {
+                tree,
+                models,
+                composite,
+                grid,
+            },
+            node,
+        ))
+    }
+
     /// The tree.
     pub fn tree(&self) -> &ObjectTree {
         &self.tree
@@ -243,6 +291,29 @@ impl Objects {
         op: ObjectOp,
         table: &MaterialTable,
     ) -> Result<ObjectOp, ObjectError> {
+        self.run(world, op, table, &mut 0)
+    }
+
+    /// Applies an op like [`Objects::apply`]; also returns how many model voxels changed
+    /// occupancy or material (a voxel of a shared model counts once).
+    pub fn apply_counted(
+        &mut self,
+        world: &World,
+        op: ObjectOp,
+        table: &MaterialTable,
+    ) -> Result<(ObjectOp, u64), ObjectError> {
+        let mut changed = 0;
+        let inverse = self.run(world, op, table, &mut changed)?;
+        Ok((inverse, changed))
+    }
+
+    fn run(
+        &mut self,
+        world: &World,
+        op: ObjectOp,
+        table: &MaterialTable,
+        changed: &mut u64,
+    ) -> Result<ObjectOp, ObjectError> {
         match op {
             ObjectOp::Edit { node, edit } => {
                 self.unlocked(node)?;
@@ -250,10 +321,10 @@ impl Objects {
                 let p = self.tree.world_placement(node)?;
                 let size = self.models[&model].size();
                 let carried = p.edit_to_model(&edit, size)?;
-                self.edit_model(world, model, &carried, table)
+                self.edit_model(world, model, &carried, table, changed)
             }
             ObjectOp::RestoreModel { model, inverse } => {
-                self.edit_model(world, model, &EditOp::Restore(inverse), table)
+                self.edit_model(world, model, &EditOp::Restore(inverse), table, changed)
             }
             ObjectOp::Place { node, placement } => {
                 self.unlocked(node)?;
@@ -437,7 +508,7 @@ impl Objects {
             ObjectOp::Batch(ops) => {
                 let mut done: Vec<ObjectOp> = Vec::with_capacity(ops.len());
                 for op in ops {
-                    match self.apply(world, op, table) {
+                    match self.run(world, op, table, changed) {
                         Ok(inverse) => done.push(inverse),
                         Err(e) => {
                             for inverse in done.into_iter().rev() {
@@ -499,6 +570,7 @@ impl Objects {
         model: ModelId,
         edit: &EditOp,
         table: &MaterialTable,
+        changed: &mut u64,
     ) -> Result<ObjectOp, ObjectError> {
         let m = self
             .models
@@ -515,6 +587,7 @@ impl Objects {
                 .expect("a model takes its own inverse");
             return Err(e.into());
         }
+        *changed += out.changed_voxels;
         Ok(ObjectOp::RestoreModel {
             model,
             inverse: out.inverse,

@@ -165,6 +165,22 @@ impl Detached {
     pub fn top(&self) -> NodeId {
         self.nodes[0].0
     }
+
+    /// Bytes it holds on the heap (the nodes and their names, child lists).
+    pub fn heap_bytes(&self) -> usize {
+        self.nodes.capacity() * std::mem::size_of::<(NodeId, Node)>()
+            + self
+                .nodes
+                .iter()
+                .map(|(_, n)| {
+                    n.name.capacity()
+                        + match &n.kind {
+                            NodeKind::Group { children } => children.capacity() * 4,
+                            NodeKind::Object { .. } => 0,
+                        }
+                })
+                .sum::<usize>()
+    }
 }
 
 /// A visible object as drawn: its world placement, in drawing order.

@@ -275,3 +275,71 @@ fn a_scene_that_outgrows_its_grid_moves_into_a_larger_one() {
     assert_eq!(o.tree(), &tree);
     assert_eq!(tiny.read().solid_count(), 0);
 }
+
+/// A grid adopted as one object: nothing written, and every edit through the object (a
+/// shape, a restore of a move, the undo) leaves the world as the same edit of the world
+/// itself; the counts are the world's.
+#[test]
+fn a_grid_adopted_as_one_object_edits_as_the_grid() {
+    let t = table();
+    let worlds = [
+        crate::objects::testing::world(2),
+        crate::objects::testing::world(1),
+    ];
+    for w in &worlds {
+        let floor = EditOp::Shape {
+            shape: Shape::Box {
+                min: IVec3::ZERO,
+                max: IVec3::new(63, 5, 47),
+            },
+            mode: Mode::Add(3),
+        };
+        w.apply(floor).unwrap();
+        w.take_dirty();
+    }
+    let (mut o, node) = Objects::of_world(&worlds[0]).unwrap();
+    assert_eq!(worlds[0].take_dirty().bytes(), 0, "adopting writes nothing");
+    assert_eq!(o.models()[&ModelId(0)].solid_count(), 64 * 6 * 48);
+    let sphere = EditOp::Shape {
+        shape: Shape::Sphere {
+            centre: DVec3::new(20.5, 6.0, 20.5),
+            radius: 7.0,
+        },
+        mode: Mode::Add(4),
+    };
+    let expect = worlds[1].apply(sphere.clone()).unwrap();
+    let (undo, changed) = o
+        .apply_counted(&worlds[0], ObjectOp::Edit { node, edit: sphere }, &t)
+        .unwrap();
+    assert_eq!(changed, expect.changed_voxels);
+    assert_eq!(
+        worlds[0].read().content_hash(),
+        worlds[1].read().content_hash()
+    );
+    // The world's restore (what a paste or a move is) goes in brick by brick.
+    let restore = EditOp::Restore(expect.inverse.clone());
+    o.apply(
+        &worlds[0],
+        ObjectOp::Edit {
+            node,
+            edit: restore,
+        },
+        &t,
+    )
+    .unwrap();
+    worlds[1].apply(EditOp::Restore(expect.inverse)).unwrap();
+    assert_eq!(
+        worlds[0].read().content_hash(),
+        worlds[1].read().content_hash()
+    );
+    // The sphere's own undo (now a no-op on voxels) applies, and the model is the world.
+    o.apply(&worlds[0], undo, &t).unwrap();
+    assert_eq!(
+        worlds[0].read().content_hash(),
+        worlds[1].read().content_hash()
+    );
+    assert_eq!(
+        o.models()[&ModelId(0)].solid_count(),
+        worlds[1].read().solid_count()
+    );
+}
