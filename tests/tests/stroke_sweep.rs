@@ -32,8 +32,7 @@ fn document(mode: BrushMode) -> Document {
     }
     if mode != BrushMode::Attach {
         scene
-            .world
-            .apply(brickmap::EditOp::Shape {
+            .edit(brickmap::EditOp::Shape {
                 shape: Shape::Box {
                     min: IVec3::ZERO,
                     max: SIZE.as_ivec3() - 1,

@@ -6,7 +6,8 @@ use anyhow::{Context, Result, bail};
 use app::Scene;
 use app::builtin::{terrain_materials, thesis_scene, thesis_terrain};
 use app::formats::{self, Format};
-use brickmap::GridDims;
+use brickmap::{GridDims, World, WorldConfig};
+use render::SceneParams;
 use brickmap::terrain::{NoiseKind, NoiseTerrain};
 use glam::IVec3;
 use std::path::PathBuf;
@@ -61,9 +62,9 @@ pub(crate) fn new(a: NewArgs, workers: usize) -> Result<()> {
             return thesis_scene(workers);
         }
         let dims = GridDims::from_voxels(a.size.as_uvec3()).context("grid size")?;
-        let scene = Scene::empty(dims, workers)?;
+        let world = World::new(dims, WorldConfig::with_workers(workers))?;
         let h = dims.voxels().y as u32;
-        let mut params = thesis_terrain(terrain_materials(&scene.world)?, h);
+        let mut params = thesis_terrain(terrain_materials(&world)?, h);
         params.seed = a.seed;
         params.noise = a.noise;
         params.octaves = a.octaves;
@@ -73,9 +74,9 @@ pub(crate) fn new(a: NewArgs, workers: usize) -> Result<()> {
             a.height_max.unwrap_or(params.height_range.1),
         );
         params.water_level = a.water_level.unwrap_or(params.water_level);
-        scene.world.apply(NoiseTerrain::new(params, dims)?.edit())?;
-        scene.world.take_dirty();
-        Ok(scene)
+        world.apply(NoiseTerrain::new(params, dims)?.edit())?;
+        world.take_dirty();
+        Ok(Scene::new(world, SceneParams::framing(dims.voxels().as_dvec3())))
     })?;
     let generated = started.elapsed().as_secs_f64();
     save(&scene, &a.output)?;
@@ -101,10 +102,11 @@ pub(crate) struct ConvertArgs {
     input: PathBuf,
     /// Output file (.ron or .vox); replaced atomically.
     output: PathBuf,
-    /// Offset added to imported .vox voxels, as X,Y,Z.
+    /// Offset added to imported .vox voxels, as X,Y,Z (the file is then flattened into one
+    /// object; without it and --include-hidden, its objects are kept).
     #[arg(long, value_parser = args::ivec3, default_value = "0,0,0")]
     offset: IVec3,
-    /// Import nodes on hidden layers too.
+    /// Import hidden nodes and layers too, shown (the file is flattened into one object).
     #[arg(long)]
     include_hidden: bool,
 }
@@ -121,7 +123,15 @@ pub(crate) fn convert(a: ConvertArgs, workers: usize) -> Result<()> {
                     offset: a.offset,
                     include_hidden: a.include_hidden,
                 };
-                let (scene, report) = formats::vox::import_file(&a.input, &options, workers)?;
+                // Flattened where asked to (an offset, hidden nodes shown); else its objects.
+                let (scene, report) = if a.include_hidden || a.offset != IVec3::ZERO {
+                    formats::vox::import_file(&a.input, &options, workers)?
+                } else {
+                    let bytes = std::fs::read(&a.input)
+                        .with_context(|| format!("reading {}", a.input.display()))?;
+                    let import = formats::vox::import_objects(&bytes, &a.input, workers)?;
+                    (import.scene, import.report)
+                };
                 eprintln!(
                     "imported {} voxels from {} instances of {} models, {} materials",
                     report.voxels, report.instances, report.models, report.materials
@@ -184,13 +194,13 @@ fn objects_text(o: &brickmap::objects::Objects) -> String {
 pub(crate) fn info(a: InfoArgs, workers: usize) -> Result<()> {
     let file = a.file;
     let started = Instant::now();
-    let (scene, objects) = with_progress(format!("reading {}", file.display()), || {
-        Ok(app::formats::load_objects(&file, workers)?)
+    let scene = with_progress(format!("reading {}", file.display()), || {
+        Ok(app::formats::load(&file, workers)?)
     })?;
     let p = &scene.params;
     let mut text = format!("file         {}\n", file.display());
     text += &stats_text(&scene.world, started.elapsed().as_secs_f64());
-    text += &objects_text(&objects);
+    text += &objects_text(&scene.objects());
     let lens = match p.camera.projection {
         render::Projection::Perspective => format!("fov {:.1}", p.camera.fov_y_deg),
         render::Projection::Orthographic { height } => {

@@ -461,14 +461,14 @@ impl Command {
                     };
                     let b = world.dims().bricks();
                     progress.start(b.x as u64 * b.z as u64);
-                    let out = world.apply(edit);
+                    let out = scene.edit(edit);
                     progress.finish();
                     Ok::<_, EditError>(out?)
                 })();
                 match result {
-                    Ok(out) => Applied {
-                        inverse: Inverse::Voxels(vec![out.inverse], Some(Box::new(before))),
-                        changed_voxels: out.changed_voxels,
+                    Ok((inverse, changed_voxels)) => Applied {
+                        inverse: Inverse::Voxels(vec![inverse], Some(Box::new(before))),
+                        changed_voxels,
                     },
                     Err(e) => {
                         world.replace_materials(before)?;
@@ -485,14 +485,17 @@ impl Command {
                     offset: *offset,
                     ..Default::default()
                 };
-                match crate::formats::vox::import_into(world, &bytes, &options, None) {
-                    Ok((report, inv)) => Applied {
-                        inverse: Inverse::Voxels(vec![inv], Some(Box::new(before))),
+                let imported = crate::formats::vox::import_into(world, &bytes, &options, None)
+                    .map_err(|e| EditError::from(crate::formats::FormatError::vox(&file, e)))
+                    .and_then(|(report, edit)| Ok((report, scene.edit(edit)?)));
+                match imported {
+                    Ok((report, (inverse, _))) => Applied {
+                        inverse: Inverse::Voxels(vec![inverse], Some(Box::new(before))),
                         changed_voxels: report.voxels,
                     },
                     Err(e) => {
                         world.replace_materials(before)?;
-                        return Err(crate::formats::FormatError::vox(&file, e).into());
+                        return Err(e);
                     }
                 }
             }
@@ -524,25 +527,24 @@ fn with_selection(scene: &mut Scene, edit: EditOp, next: Option<Selection>) -> R
     })
 }
 
-/// Drops the unused materials: the voxels of every brick with a material whose index
-/// changes are rewritten (one `Restore` edit), then the shorter table goes in. The inverse
-/// puts the old table back first, then the voxels.
+/// Drops the unused materials (used: by any model, shown or hidden): every model brick with
+/// a material whose index changes is rewritten (one batch of model restores), then the
+/// shorter table goes in. The inverse puts the old table back first, then the voxels.
 fn remove_unused_materials(scene: &Scene) -> Result<Applied> {
-    use brickmap::{BrickMaterials, BrickUndo, EditInverse, PriorMaterials};
-    let world = &scene.world;
-    let before = world.materials().clone();
+    use brickmap::objects::ObjectOp;
+    use brickmap::{BrickUndo, EditInverse, PriorMaterials};
+    let before = scene.world.materials().clone();
     let mut used = [false; 256];
-    let mut bricks = Vec::new();
-    {
-        let view = world.read();
-        view.for_each_brick(|_, mask, mats| match mats {
-            BrickMaterials::Uniform(m) => used[m as usize] = true,
-            BrickMaterials::PerVoxel(v) => {
-                for m in &v[..mask.count() as usize] {
-                    used[*m as usize] = true;
+    let ops = {
+        let objects = scene.objects();
+        for model in objects.models().values() {
+            for (_, b) in model.bricks() {
+                match b.uniform() {
+                    Some(m) => used[m as usize] = true,
+                    None => b.mask.ones().for_each(|bit| used[b.material(bit) as usize] = true),
                 }
             }
-        });
+        }
         if (0..before.len()).all(|i| used[i]) {
             return Err(super::error::EditError::NothingToDo(
                 "every material is in use",
@@ -560,41 +562,37 @@ fn remove_unused_materials(scene: &Scene) -> Result<Applied> {
                 next = next.wrapping_add(1);
             }
         }
-        view.for_each_brick(|b, mask, mats| {
-            let prior = match mats {
-                BrickMaterials::Uniform(m) if remap[m as usize] != m => {
-                    PriorMaterials::Uniform(remap[m as usize])
-                }
-                BrickMaterials::PerVoxel(v)
-                    if v[..mask.count() as usize]
-                        .iter()
-                        .any(|m| remap[*m as usize] != *m) =>
-                {
-                    PriorMaterials::PerVoxel(
-                        v[..mask.count() as usize]
-                            .iter()
-                            .map(|m| remap[*m as usize])
-                            .collect(),
-                    )
-                }
-                _ => return,
-            };
-            bricks.push(BrickUndo {
-                brick: b,
-                prior_mask: *mask,
-                touched: *mask,
-                prior,
-            });
-        });
-    }
+        let mut ops = Vec::new();
+        for (id, model) in objects.models() {
+            let bricks: Vec<BrickUndo> = model
+                .bricks()
+                .filter(|(_, b)| b.mask.ones().any(|bit| remap[b.material(bit) as usize] != b.material(bit)))
+                .map(|(brick, b)| BrickUndo {
+                    brick,
+                    prior_mask: b.mask,
+                    touched: b.mask,
+                    prior: PriorMaterials::packed(
+                        b.mask.ones().map(|bit| remap[b.material(bit) as usize]).collect(),
+                    ),
+                })
+                .collect();
+            if !bricks.is_empty() {
+                ops.push(ObjectOp::RestoreModel {
+                    model: *id,
+                    inverse: EditInverse { bricks },
+                });
+            }
+        }
+        ops
+    };
     let table = before.retain(&used)?;
-    let out = world.apply(EditOp::Restore(EditInverse { bricks }))?;
-    if let Err(e) = world.replace_materials(table) {
-        world.apply(EditOp::Restore(out.inverse))?;
+    let (inverse, changed_voxels) = scene.apply(ObjectOp::Batch(ops))?;
+    if let Err(e) = scene.world.replace_materials(table) {
+        scene.apply(inverse)?;
         return Err(e.into());
     }
     Ok(Applied {
-        inverse: Inverse::Voxels(vec![out.inverse], Some(Box::new(before))),
-        changed_voxels: out.changed_voxels,
+        inverse: Inverse::Voxels(vec![inverse], Some(Box::new(before))),
+        changed_voxels,
     })
 }

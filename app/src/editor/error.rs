@@ -22,6 +22,10 @@ pub enum EditError {
     /// The world refused (outside the grid, no such material, over the memory budget).
     #[error(transparent)]
     World(#[from] BrickmapError),
+    /// The objects refused (a locked object, no active object, an object that would leave
+    /// the grid).
+    #[error(transparent)]
+    Objects(brickmap::objects::ObjectError),
     /// A scene setting outside its range.
     #[error(transparent)]
     Param(#[from] render::ParamError),
@@ -38,6 +42,16 @@ pub enum EditError {
     /// material): harmless, said in passing rather than shown as a failure.
     #[error("{0}")]
     NothingToDo(&'static str),
+}
+
+impl From<brickmap::objects::ObjectError> for EditError {
+    /// A model's or the world's refusal of an edit stays a world error.
+    fn from(e: brickmap::objects::ObjectError) -> Self {
+        match e {
+            brickmap::objects::ObjectError::Edit(e) => Self::World(e),
+            e => Self::Objects(e),
+        }
+    }
 }
 
 impl EditError {

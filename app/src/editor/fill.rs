@@ -123,7 +123,7 @@ mod tests {
                 }
             }
         }
-        scene.world.apply(EditOp::Voxels(edits)).unwrap();
+        scene.edit(EditOp::Voxels(edits)).unwrap();
         (scene, sphere)
     }
 

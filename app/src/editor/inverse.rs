@@ -1,9 +1,9 @@
-//! How commands are undone: sparse world inverses for voxels (never snapshots), the previous
-//! table (about 2 KB) for table edits, the previous value for properties; and the helpers
-//! that apply edits all-or-nothing.
+//! How commands are undone: object ops for voxels (sparse model inverses, never snapshots),
+//! the previous table (about 2 KB) for table edits, the previous value for properties; and
+//! the helpers that apply edits all-or-nothing.
 //!
 //! In detail:
-//! `Inverse`: world inverses for voxels (never snapshots), the previous table (~2 KB) for table
+//! `Inverse`: object ops for voxels (never snapshots), the previous table (~2 KB) for table
 //! edits, the previous value for properties and the selection, `Compound` (several, undone last
 //! first; a failing part puts back the parts already applied); `apply_all` / `with_table` (all
 //! or nothing).
@@ -11,14 +11,16 @@
 use super::error::Result;
 use crate::scene::Scene;
 use crate::selection::Selection;
-use brickmap::{EditInverse, EditOp, MaterialTable};
+use brickmap::objects::ObjectOp;
+use brickmap::{EditOp, MaterialTable};
 use render::{Camera, RenderSettings, Sky, Sun};
 
 /// How to undo a command.
 #[derive(Debug)]
 pub enum Inverse {
-    /// Voxel edits to restore in reverse order, then (if any) the material table.
-    Voxels(Vec<EditInverse>, Option<Box<MaterialTable>>),
+    /// Object ops (model restores, arrangements) to apply in reverse order, then (if any)
+    /// the material table.
+    Voxels(Vec<ObjectOp>, Option<Box<MaterialTable>>),
     /// The previous material table.
     Table(Box<MaterialTable>),
     /// The previous sun.
@@ -69,7 +71,7 @@ impl Inverse {
                 }
                 let mut back = Vec::with_capacity(list.len());
                 for inv in list.into_iter().rev() {
-                    back.push(scene.world.apply(EditOp::Restore(inv))?.inverse);
+                    back.push(scene.apply(inv)?.0);
                 }
                 if !grows && let Some(t) = table {
                     old = Some(Box::new(scene.world.replace_materials(*t)?));
@@ -132,20 +134,19 @@ pub(super) fn with_table(
     })
 }
 
-/// Applies edits in order; if one fails, the ones applied are undone and the error returned.
+/// Applies edits (world voxels, to the active object) in order; if one fails, the ones
+/// applied are undone and the error returned.
 pub(super) fn apply_all(scene: &Scene, edits: Vec<EditOp>) -> Result<Applied> {
-    let mut done: Vec<EditInverse> = Vec::with_capacity(edits.len());
+    let mut done: Vec<ObjectOp> = Vec::with_capacity(edits.len());
     let mut changed = 0;
     for edit in edits {
-        match scene.world.apply(edit) {
-            Ok(out) => {
-                changed += out.changed_voxels;
-                done.push(out.inverse);
+        match scene.edit(edit) {
+            Ok((inverse, n)) => {
+                changed += n;
+                done.push(inverse);
             }
             Err(e) => {
-                for inv in done.into_iter().rev() {
-                    scene.world.apply(EditOp::Restore(inv))?;
-                }
+                undo_all(scene, done)?;
                 return Err(e.into());
             }
         }
@@ -154,4 +155,12 @@ pub(super) fn apply_all(scene: &Scene, edits: Vec<EditOp>) -> Result<Applied> {
         inverse: Inverse::Voxels(done, None),
         changed_voxels: changed,
     })
+}
+
+/// Applies the inverses of ops just applied, last first.
+pub(super) fn undo_all(scene: &Scene, done: Vec<ObjectOp>) -> Result<()> {
+    for inverse in done.into_iter().rev() {
+        scene.apply(inverse)?;
+    }
+    Ok(())
 }

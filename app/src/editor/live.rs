@@ -11,9 +11,10 @@
 
 use super::brush::{BrushShape, Stroke, stroke_edits};
 use super::error::{EditError, Result, invalid};
-use super::inverse::Inverse;
+use super::inverse::{Inverse, undo_all};
 use crate::scene::Scene;
-use brickmap::{EditInverse, EditOp};
+use brickmap::EditOp;
+use brickmap::objects::ObjectOp;
 use glam::DVec3;
 
 /// The open stroke of a document.
@@ -21,7 +22,7 @@ use glam::DVec3;
 pub struct LiveStroke {
     /// The stroke so far (every point given).
     pub stroke: Stroke,
-    inverses: Vec<EditInverse>,
+    inverses: Vec<ObjectOp>,
     /// Voxels changed so far (by the segments; a voxel changed twice counts twice).
     pub changed_voxels: u64,
 }
@@ -65,10 +66,10 @@ impl LiveStroke {
             self.stroke.points.push(last);
         }
         for edit in edits {
-            match scene.world.apply(edit) {
-                Ok(out) => {
-                    self.changed_voxels += out.changed_voxels;
-                    self.inverses.push(out.inverse);
+            match scene.edit(edit) {
+                Ok((inverse, changed)) => {
+                    self.changed_voxels += changed;
+                    self.inverses.push(inverse);
                 }
                 Err(e) => return Err(self.fail(scene, e.into())),
             }
@@ -115,10 +116,10 @@ impl LiveStroke {
         }
         if self.stroke.shape == BrushShape::Box {
             for edit in stroke_edits(&self.stroke, scene.selection.as_ref())? {
-                match scene.world.apply(edit) {
-                    Ok(out) => {
-                        self.changed_voxels += out.changed_voxels;
-                        self.inverses.push(out.inverse);
+                match scene.edit(edit) {
+                    Ok((inverse, changed)) => {
+                        self.changed_voxels += changed;
+                        self.inverses.push(inverse);
                     }
                     Err(e) => return Err(self.fail(scene, e.into())),
                 }
@@ -135,11 +136,4 @@ impl LiveStroke {
     pub fn abort(self, scene: &Scene) -> Result<()> {
         undo_all(scene, self.inverses)
     }
-}
-
-fn undo_all(scene: &Scene, inverses: Vec<EditInverse>) -> Result<()> {
-    for inv in inverses.into_iter().rev() {
-        scene.world.apply(EditOp::Restore(inv))?;
-    }
-    Ok(())
 }

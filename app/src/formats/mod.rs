@@ -9,34 +9,21 @@ pub mod vox;
 use crate::scene::Scene;
 use std::path::Path;
 
-/// Loads a `.ron` project or imports a `.vox` file (which gets the default sun and sky),
-/// choosing by the extension.
+/// Loads a `.ron` project (version 2 as written, version 1 as one object) or imports a
+/// `.vox` file with its groups, objects, layers and shared models (it gets the default sun
+/// and sky), choosing by the extension.
 pub fn load(path: &Path, workers: usize) -> Result<Scene, FormatError> {
     match Format::of(path)? {
         Format::Project => project::load(path, workers),
         Format::Vox => {
-            vox::import_file(path, &vox::ImportOptions::default(), workers).map(|(s, _)| s)
-        }
-    }
-}
-
-/// Loads a file as a scene of objects: a `.ron` project (version 2 as written, version 1 as
-/// one object) or a `.vox` file with its groups, objects, layers and shared models.
-pub fn load_objects(
-    path: &Path,
-    workers: usize,
-) -> Result<(Scene, brickmap::objects::Objects), FormatError> {
-    match Format::of(path)? {
-        Format::Project => project::load_objects(path, workers),
-        Format::Vox => {
             let bytes = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
-            let import = vox::import_objects(&bytes, path, workers)?;
-            Ok((import.scene, import.objects))
+            Ok(vox::import_objects(&bytes, path, workers)?.scene)
         }
     }
 }
 
-/// Saves as a `.ron` project or exports `.vox`, atomically, choosing by the extension.
+/// Saves as a `.ron` project or exports `.vox` (the objects either way), atomically,
+/// choosing by the extension.
 pub fn save(scene: &Scene, path: &Path) -> Result<(), FormatError> {
     match Format::of(path)? {
         Format::Project => project::save(scene, path),

@@ -135,38 +135,38 @@ pub fn import_bytes(
     let top = bounds(&placed).map_or(IVec3::ZERO, |b| b.1);
     let dims = GridDims::from_voxels((top + 1).max(IVec3::ONE).as_uvec3())
         .map_err(|_| invalid(VoxError::TooLarge(top + 1)))?;
-    let mut scene = Scene::empty(dims, workers).map_err(|e| FormatError::world(path, e))?;
+    let world_error = |e| FormatError::world(path, e);
+    let world = World::new(dims, brickmap::WorldConfig::with_workers(workers)).map_err(world_error)?;
+    let mut params = render::SceneParams::framing(dims.voxels().as_dvec3());
     if let Some((lo, hi)) = bounds(&placed) {
         // Framed whole (the default camera's direction), as the editor's "frame the scene".
-        scene.params.camera = scene
-            .params
-            .camera
-            .framing(lo.as_dvec3(), (hi + 1).as_dvec3())
-            .0;
+        params.camera = params.camera.framing(lo.as_dvec3(), (hi + 1).as_dvec3()).0;
     }
     // A new scene takes the file's palette as its colour table, index for index.
     let palette = palette_of(&data);
     for (i, c) in palette.iter().enumerate() {
-        scene.world.set_colour(i as u8, [c.r, c.g, c.b]);
+        world.set_colour(i as u8, [c.r, c.g, c.b]);
     }
-    let map = install_materials(&scene.world, &data, &placed, &mut report, Ok).map_err(invalid)?;
-    write_voxels(&scene.world, &placed, |i| map[i as usize], &mut report)
-        .map_err(|e| FormatError::world(path, e))?;
-    scene.world.take_dirty();
-    Ok((scene, report))
+    let map = install_materials(&world, &data, &placed, &mut report, Ok).map_err(invalid)?;
+    world
+        .apply(voxels_edit(&placed, |i| map[i as usize], &mut report))
+        .map_err(world_error)?;
+    world.take_dirty();
+    Ok((Scene::new(world, params), report))
 }
 
 /// Imports `.vox` bytes into an existing world. With `material`, every voxel gets that
 /// material; otherwise colours are merged into the colour table (an identical colour is
 /// reused, else a slot no material uses) and identical materials are reused. Voxels that
-/// land outside the grid are dropped and reported. One voxel edit, whose inverse is returned
-/// (the editor's undo); colours and materials it added stay.
+/// land outside the grid are dropped and reported. Returns the one voxel edit that writes
+/// the voxels, for the caller to apply (the editor: to its active object); colours and
+/// materials it added stay.
 pub fn import_into(
     world: &World,
     bytes: &[u8],
     options: &ImportOptions,
     material: Option<u8>,
-) -> Result<(ImportReport, brickmap::EditInverse), VoxError> {
+) -> Result<(ImportReport, brickmap::EditOp), VoxError> {
     let (data, mut placed, mut report) = prepare(bytes, options)?;
     let dims = world.dims();
     let before = placed.len();
@@ -196,8 +196,8 @@ pub fn import_into(
             })?
         }
     };
-    let inverse = write_voxels(world, &placed, |i| map[i as usize], &mut report)?;
-    Ok((report, inverse))
+    let edit = voxels_edit(&placed, |i| map[i as usize], &mut report);
+    Ok((report, edit))
 }
 
 /// The size in voxels (voxbrick axes) of what importing `bytes` would place.
@@ -269,15 +269,15 @@ fn prepare(bytes: &[u8], options: &ImportOptions) -> Result<Prepared, VoxError> 
     Ok((data, placed, report))
 }
 
-/// Writes the placed voxels as whole bricks: one restore per touched brick whose touched mask
-/// is exactly the imported voxels (other voxels keep what they hold; a later voxel at the
-/// same position wins). Much cheaper than single-voxel writes for large models.
-fn write_voxels(
-    world: &World,
+/// The edit that writes the placed voxels as whole bricks: one restore per touched brick
+/// whose touched mask is exactly the imported voxels (other voxels keep what they hold; a
+/// later voxel at the same position wins). Much cheaper than single-voxel writes for large
+/// models.
+fn voxels_edit(
     placed: &[(IVec3, u8)],
     material: impl Fn(u8) -> u8,
     report: &mut ImportReport,
-) -> brickmap::Result<brickmap::EditInverse> {
+) -> brickmap::EditOp {
     let mut bricks: HashMap<glam::UVec3, (Mask, Box<[u8; 512]>)> = HashMap::new();
     for &(p, i) in placed {
         let b = (p / 8).as_uvec3();
@@ -308,11 +308,7 @@ fn write_voxels(
         })
         .collect();
     list.sort_by_key(|u| (u.brick.x, u.brick.z, u.brick.y));
-    Ok(world
-        .apply(brickmap::EditOp::Restore(brickmap::EditInverse {
-            bricks: list,
-        }))?
-        .inverse)
+    brickmap::EditOp::Restore(brickmap::EditInverse { bricks: list })
 }
 
 fn palette_of(data: &DotVoxData) -> Vec<Color> {

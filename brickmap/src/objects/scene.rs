@@ -197,6 +197,9 @@ pub enum ObjectError {
     /// The id is taken by another model.
     #[error("model {} exists already", .0.0)]
     ModelTaken(ModelId),
+    /// An edit with no object to act on (the editor's active object is none).
+    #[error("no object is active to edit: choose one in the Objects window")]
+    NoActiveObject,
     /// Objects still place the model.
     #[error("model {} is placed by {} objects", .0.0, .1)]
     ModelInUse(ModelId, usize),

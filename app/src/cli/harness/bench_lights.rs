@@ -35,7 +35,7 @@ fn lamp(scene: &Scene, strength: f32, rgb: [u8; 3]) -> Result<u8> {
 }
 
 fn fill(scene: &Scene, m: u8, min: IVec3, max: IVec3) -> Result<()> {
-    scene.world.apply(EditOp::Shape {
+    scene.edit(EditOp::Shape {
         shape: Shape::Box { min, max },
         mode: Mode::Add(m),
     })?;
@@ -54,7 +54,7 @@ pub(crate) fn lamp_room(workers: usize) -> Result<Scene> {
         .world
         .push_material(brickmap::Material::lambertian(199))?;
     fill(&scene, wall, IVec3::ZERO, v)?;
-    scene.world.apply(EditOp::Shape {
+    scene.edit(EditOp::Shape {
         shape: Shape::Box {
             min: IVec3::ONE,
             max: v - 1,

@@ -21,7 +21,6 @@
 
 mod objects;
 
-pub use objects::{load_objects, objects_from_bytes, objects_to_string, save_objects};
 
 use super::{FormatError, payload};
 use crate::scene::Scene;
@@ -103,8 +102,14 @@ impl From<Kind> for MaterialKind {
     }
 }
 
-/// The project text of a scene.
+/// The project text of a scene (version 2: its objects).
 pub fn to_string(scene: &Scene) -> String {
+    objects::to_string(scene)
+}
+
+/// The version 1 project text of a scene's composite (one grid, as voxbrick wrote before
+/// objects; what older versions read).
+pub fn grid_to_string(scene: &Scene) -> String {
     let view = scene.world.read();
     let data = payload::encode(&view);
     let voxels = VoxelRecord {
@@ -200,22 +205,20 @@ pub fn load(path: &Path, workers: usize) -> Result<Scene, FormatError> {
     from_bytes(&text, path, workers)
 }
 
-/// Parses project text (`path` only names it in errors).
+/// Parses project text (`path` only names it in errors): version 2 as written, version 1
+/// as one object.
 pub fn from_bytes(text: &[u8], path: &Path, workers: usize) -> Result<Scene, FormatError> {
     let invalid = |m: String| FormatError::invalid(path, m);
     let text = std::str::from_utf8(text).map_err(|e| invalid(format!("not UTF-8 text: {e}")))?;
     match version(text, path)? {
-        FORMAT_VERSION => {}
-        v => {
-            return Err(FormatError::invalid(
-                path,
-                format!(
-                    "a version {v} project holds objects: it opens as a scene of objects \
-                     (`project::load_objects`), not as one grid"
-                ),
-            ));
-        }
+        FORMAT_VERSION => grid_from_str(text, path, workers),
+        _ => objects::from_str(text, path, workers),
     }
+}
+
+/// A version 1 project: one grid, which becomes one object.
+fn grid_from_str(text: &str, path: &Path, workers: usize) -> Result<Scene, FormatError> {
+    let invalid = |m: String| FormatError::invalid(path, m);
     let file: ProjectFile = ron::from_str(text).map_err(|e| invalid(format!("{e}")))?;
     let (params, dims, table) = header_of!(file).read(path)?;
     let bricks = file.voxels.bricks(&dims, table.len(), path)?;

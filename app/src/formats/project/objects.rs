@@ -17,7 +17,7 @@
 
 use super::{
     ENCODING, FormatError, Header, MaterialRecord, OBJECTS_VERSION, VoxelRecord, header, header_of,
-    layout, list, payload, version,
+    layout, list, payload,
 };
 use crate::scene::Scene;
 use base64::Engine;
@@ -83,8 +83,9 @@ fn model_dims(size: IVec3) -> Result<GridDims, brickmap::BrickmapError> {
     GridDims::new(b.x as u32, b.y as u32, b.z as u32)
 }
 
-/// The project text of a scene of objects.
-pub fn objects_to_string(scene: &Scene, objects: &Objects) -> String {
+/// The project text of a scene (version 2: its objects).
+pub(super) fn to_string(scene: &Scene) -> String {
+    let objects = scene.objects();
     let tree = objects.tree();
     let order = tree
         .subtree(ObjectTree::ROOT)
@@ -154,31 +155,10 @@ fn model_record(id: ModelId, m: &Model) -> ModelRecord {
     }
 }
 
-/// Saves a scene of objects atomically (version 2).
-pub fn save_objects(scene: &Scene, objects: &Objects, path: &Path) -> Result<(), FormatError> {
-    let text = objects_to_string(scene, objects);
-    crate::atomic::write_atomic(path, |w| w.write_all(text.as_bytes()))
-        .map_err(|e| FormatError::io(path, e))
-}
-
-/// Loads a project as a scene of objects: version 2 as written, version 1 as one object.
-pub fn load_objects(path: &Path, workers: usize) -> Result<(Scene, Objects), FormatError> {
-    let text = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
-    objects_from_bytes(&text, path, workers)
-}
-
-/// Parses project text as a scene of objects (`path` only names it in errors).
-pub fn objects_from_bytes(
-    text: &[u8],
-    path: &Path,
-    workers: usize,
-) -> Result<(Scene, Objects), FormatError> {
+/// Parses version 2 project text (`path` only names it in errors).
+pub(super) fn from_str(s: &str, path: &Path, workers: usize) -> Result<Scene, FormatError> {
     let invalid = |m: String| FormatError::invalid(path, m);
     let world_error = |e: brickmap::BrickmapError| FormatError::world(path, e);
-    let s = std::str::from_utf8(text).map_err(|e| invalid(format!("not UTF-8 text: {e}")))?;
-    if version(s, path)? == super::FORMAT_VERSION {
-        return one_object(super::from_bytes(text, path, workers)?, path);
-    }
     let file: ObjectsFile = ron::from_str(s).map_err(|e| invalid(format!("{e}")))?;
     let (params, dims, table) = header_of!(file).read(path)?;
     let tree = read_tree(&file.layers, &file.nodes).map_err(invalid)?;
@@ -194,7 +174,8 @@ pub fn objects_from_bytes(
     world.replace_materials(table).map_err(world_error)?;
     let objects = Objects::new(tree, models, &world).map_err(|e| invalid(e.to_string()))?;
     world.take_dirty();
-    Ok((Scene::new(world, params), objects))
+    let active = Scene::first_object(&objects);
+    Ok(Scene::with_objects(world, objects, active, params))
 }
 
 /// The tree from the layer and node records (pre-order, parents first).
@@ -278,27 +259,3 @@ fn read_model(r: &ModelRecord, table: &MaterialTable, path: &Path) -> Result<Mod
     Ok(model)
 }
 
-/// A scene of one grid as one object ("scene") placing all of it, brick-aligned at identity.
-fn one_object(scene: Scene, path: &Path) -> Result<(Scene, Objects), FormatError> {
-    let world_error = |e: brickmap::BrickmapError| FormatError::world(path, e);
-    let size = scene.world.dims().voxels();
-    let model = Model::from_world(&scene.world).map_err(world_error)?;
-    let mut tree = ObjectTree::new();
-    let object = NewNode::Object {
-        model: ModelId(0),
-        layer: LayerId(0),
-    };
-    tree.add(
-        ObjectTree::ROOT,
-        None,
-        "scene",
-        Placement::at(size / 2),
-        object,
-    )
-    .expect("a new tree takes an object");
-    let models = BTreeMap::from([(ModelId(0), model)]);
-    let objects = Objects::new(tree, models, &scene.world)
-        .map_err(|e| FormatError::invalid(path, e.to_string()))?;
-    scene.world.take_dirty();
-    Ok((scene, objects))
-}

@@ -191,10 +191,11 @@ impl Slots {
     }
 }
 
-/// Exports a scene to a `.vox` file, atomically.
+/// Exports a scene's objects to a `.vox` file (its tree, layers and shared models),
+/// atomically.
 pub fn export_file(scene: &Scene, path: &Path) -> Result<ExportReport, FormatError> {
-    let data = export_data(&scene.world).map_err(|e| FormatError::vox(path, e))?;
-    write_data(&data, path)
+    let table = scene.world.materials().clone();
+    super::objects::export_objects(&scene.objects(), &table, path)
 }
 
 /// Writes `.vox` data to a file, atomically, and says what it wrote.

@@ -10,13 +10,11 @@ use super::*;
 use brickmap::objects::{Model as VoxelModel, ModelId, NodeId, NodeKind, ObjectTree, Objects};
 use std::collections::BTreeSet;
 
-/// A `.vox` file imported as objects: the scene (its world holds the composite) and the
-/// objects that make it.
+/// A `.vox` file imported as objects: the scene (its objects, and its world holding their
+/// composite) and the report.
 pub struct ObjectImport {
     /// The new scene, framed on the visible content.
     pub scene: Scene,
-    /// The tree, the models and the composite.
-    pub objects: Objects,
     /// What was imported and what was left out.
     pub report: ImportReport,
 }
@@ -79,34 +77,35 @@ pub fn import_objects(
     let top = hi + shift;
     let dims = GridDims::from_voxels(top.max(IVec3::ONE).as_uvec3())
         .map_err(|_| invalid(VoxError::TooLarge(top)))?;
-    let mut scene = Scene::empty(dims, workers).map_err(world_error)?;
+    let world = World::new(dims, brickmap::WorldConfig::with_workers(workers)).map_err(world_error)?;
     for (i, c) in palette_of(&data).iter().enumerate() {
-        scene.world.set_colour(i as u8, [c.r, c.g, c.b]);
+        world.set_colour(i as u8, [c.r, c.g, c.b]);
     }
     let indices: Vec<(IVec3, u8)> = (0..=255u8)
         .filter(|i| used[*i as usize])
         .map(|i| (IVec3::ZERO, i))
         .collect();
-    let map = install_materials(&scene.world, &data, &indices, &mut report, Ok).map_err(invalid)?;
-    let table = scene.world.materials().clone();
+    let map = install_materials(&world, &data, &indices, &mut report, Ok).map_err(invalid)?;
+    let table = world.materials().clone();
     let mut voxels = BTreeMap::new();
     for id in models {
         let m = &data.models[id.0 as usize];
         voxels.insert(id, model_of(m, &map, &table).map_err(world_error)?);
     }
-    let objects = Objects::new(tree, voxels, &scene.world)
+    let objects = Objects::new(tree, voxels, &world)
         .map_err(|e| FormatError::invalid(path, format!("the objects do not fit together: {e}")))?;
-    scene.world.take_dirty();
-    let view = scene.world.read();
+    world.take_dirty();
+    let mut params = render::SceneParams::framing(dims.voxels().as_dvec3());
+    let view = world.read();
     report.instances = objects.tree().drawn().len();
     report.voxels = view.solid_count();
     if let Some((a, b)) = view.occupied_bounds() {
-        scene.params.camera = scene.params.camera.framing(a.as_dvec3(), b.as_dvec3()).0;
+        params.camera = params.camera.framing(a.as_dvec3(), b.as_dvec3()).0;
     }
     drop(view);
+    let active = Scene::first_object(&objects);
     Ok(ObjectImport {
-        scene,
-        objects,
+        scene: Scene::with_objects(world, objects, active, params),
         report,
     })
 }

@@ -185,9 +185,9 @@ pub(super) fn edit_run(
         let p = params_at(&scene.params, path, &preset, t, centre);
         let req: FrameRequest<'_> = edit_request(&p, size, 1.0);
         let started = Instant::now();
+        // Through the active object, as the editor's brush.
         scene
-            .world
-            .apply(EditOp::Shape {
+            .edit(EditOp::Shape {
                 shape: Shape::Sphere {
                     centre: points[i],
                     radius,
