@@ -73,13 +73,10 @@ impl Scene {
     /// edits first).
     pub fn first_object(objects: &Objects) -> Option<NodeId> {
         let tree = objects.tree();
-        tree.subtree(ObjectTree::ROOT)
-            .ok()?
-            .into_iter()
-            .find(|id| {
-                tree.node(*id)
-                    .is_ok_and(|n| matches!(n.kind, NodeKind::Object { .. }))
-            })
+        tree.subtree(ObjectTree::ROOT).ok()?.into_iter().find(|id| {
+            tree.node(*id)
+                .is_ok_and(|n| matches!(n.kind, NodeKind::Object { .. }))
+        })
     }
 
     /// The objects (held while the guard lives: keep it short).

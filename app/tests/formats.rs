@@ -520,14 +520,15 @@ fn scene_beyond_256_in_every_axis_survives_vox() {
     })
     .collect();
     scene.edit(EditOp::Voxels(corners)).unwrap();
-    scene.edit(EditOp::Shape {
-        shape: Shape::Sphere {
-            centre: DVec3::new(256.0, 256.0, 256.0),
-            radius: 12.0,
-        },
-        mode: Mode::Add(lamp),
-    })
-    .unwrap();
+    scene
+        .edit(EditOp::Shape {
+            shape: Shape::Sphere {
+                centre: DVec3::new(256.0, 256.0, 256.0),
+                radius: 12.0,
+            },
+            mode: Mode::Add(lamp),
+        })
+        .unwrap();
     let d = scratch("big");
     let out = d.join("big.vox");
     let report = vox::export_file(&scene, &out).unwrap();
@@ -896,7 +897,12 @@ fn a_scene_of_objects_survives_a_version_2_project_and_version_1_opens_as_one_ob
     let first = vox::import_objects(&std::fs::read(&park).unwrap(), &park, 2).unwrap();
     let table = first.scene.world.materials().clone();
     // Turn, hide and lock a few objects so every field travels.
-    let nodes = first.scene.objects().tree().subtree(ObjectTree::ROOT).unwrap();
+    let nodes = first
+        .scene
+        .objects()
+        .tree()
+        .subtree(ObjectTree::ROOT)
+        .unwrap();
     let (a, b, c) = (nodes[1], nodes[2], nodes[nodes.len() - 1]);
     let p = first.scene.objects().tree().node(a).unwrap().placement;
     let turned = Placement {

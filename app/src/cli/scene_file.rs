@@ -6,10 +6,10 @@ use anyhow::{Context, Result, bail};
 use app::Scene;
 use app::builtin::{terrain_materials, thesis_scene, thesis_terrain};
 use app::formats::{self, Format};
-use brickmap::{GridDims, World, WorldConfig};
-use render::SceneParams;
 use brickmap::terrain::{NoiseKind, NoiseTerrain};
+use brickmap::{GridDims, World, WorldConfig};
 use glam::IVec3;
+use render::SceneParams;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -76,7 +76,10 @@ pub(crate) fn new(a: NewArgs, workers: usize) -> Result<()> {
         params.water_level = a.water_level.unwrap_or(params.water_level);
         world.apply(NoiseTerrain::new(params, dims)?.edit())?;
         world.take_dirty();
-        Ok(Scene::new(world, SceneParams::framing(dims.voxels().as_dvec3())))
+        Ok(Scene::new(
+            world,
+            SceneParams::framing(dims.voxels().as_dvec3()),
+        ))
     })?;
     let generated = started.elapsed().as_secs_f64();
     save(&scene, &a.output)?;

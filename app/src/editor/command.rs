@@ -167,6 +167,8 @@ pub enum Command {
         /// Where the copied selection's minimum corner goes.
         at: IVec3,
     },
+    /// An object command (arrange mode, the Objects window).
+    Object(super::objects::ObjectCommand),
 }
 
 /// A material in commands and scripts.
@@ -275,6 +277,7 @@ impl Command {
             Command::Copy => "Copy".into(),
             Command::Cut => "Cut".into(),
             Command::Paste { at } => format!("Paste at {at}"),
+            Command::Object(c) => c.label(),
         }
     }
 
@@ -319,6 +322,7 @@ impl Command {
         Ok(match self {
             Command::Stroke(s) => apply_all(scene, stroke_edits(s, scene.selection.as_ref())?)?,
             Command::RemoveUnusedMaterials => remove_unused_materials(scene)?,
+            Command::Object(c) => c.apply(scene)?,
             Command::Select(op) => {
                 let next = select(scene.selection.as_ref(), *op, world.dims().voxels());
                 unchanged(Inverse::Selection(std::mem::replace(
@@ -541,7 +545,10 @@ fn remove_unused_materials(scene: &Scene) -> Result<Applied> {
             for (_, b) in model.bricks() {
                 match b.uniform() {
                     Some(m) => used[m as usize] = true,
-                    None => b.mask.ones().for_each(|bit| used[b.material(bit) as usize] = true),
+                    None => b
+                        .mask
+                        .ones()
+                        .for_each(|bit| used[b.material(bit) as usize] = true),
                 }
             }
         }
@@ -566,13 +573,20 @@ fn remove_unused_materials(scene: &Scene) -> Result<Applied> {
         for (id, model) in objects.models() {
             let bricks: Vec<BrickUndo> = model
                 .bricks()
-                .filter(|(_, b)| b.mask.ones().any(|bit| remap[b.material(bit) as usize] != b.material(bit)))
+                .filter(|(_, b)| {
+                    b.mask
+                        .ones()
+                        .any(|bit| remap[b.material(bit) as usize] != b.material(bit))
+                })
                 .map(|(brick, b)| BrickUndo {
                     brick,
                     prior_mask: b.mask,
                     touched: b.mask,
                     prior: PriorMaterials::packed(
-                        b.mask.ones().map(|bit| remap[b.material(bit) as usize]).collect(),
+                        b.mask
+                            .ones()
+                            .map(|bit| remap[b.material(bit) as usize])
+                            .collect(),
                     ),
                 })
                 .collect();

@@ -54,6 +54,12 @@ impl From<brickmap::objects::ObjectError> for EditError {
     }
 }
 
+impl From<brickmap::objects::TreeError> for EditError {
+    fn from(e: brickmap::objects::TreeError) -> Self {
+        Self::Objects(e.into())
+    }
+}
+
 impl EditError {
     /// Whether the edit had nothing to act on (an undo with nothing to undo, a copy without
     /// a selection): a no-op, not a failure.

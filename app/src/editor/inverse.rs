@@ -33,6 +33,8 @@ pub enum Inverse {
     Settings(RenderSettings),
     /// The previous selection.
     Selection(Option<Selection>),
+    /// The previous active object.
+    Active(Option<brickmap::objects::NodeId>),
     /// Several, undone last first (a move: its voxels, then its selection).
     Compound(Vec<Inverse>),
 }
@@ -86,6 +88,11 @@ impl Inverse {
                 Inverse::Settings(std::mem::replace(&mut scene.params.settings, v))
             }
             Inverse::Selection(v) => Inverse::Selection(std::mem::replace(&mut scene.selection, v)),
+            Inverse::Active(v) => {
+                let now = scene.active();
+                scene.set_active(v);
+                Inverse::Active(now)
+            }
             Inverse::Compound(list) => {
                 // On a failure the parts already applied are put back (all or nothing).
                 let mut back: Vec<Inverse> = Vec::with_capacity(list.len());

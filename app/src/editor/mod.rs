@@ -8,6 +8,7 @@ mod fill;
 pub mod history;
 mod inverse;
 pub mod live;
+pub mod objects;
 pub mod progress;
 pub mod script;
 

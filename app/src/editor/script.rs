@@ -138,6 +138,24 @@ pub enum Step {
     },
     /// The number of solid voxels.
     ExpectSolidCount(u64),
+    /// A node of the object tree: exists, and (each where given) has this name, world
+    /// placement, visibility, and (an object) this many solid voxels in its model.
+    ExpectObject {
+        /// The node.
+        node: brickmap::objects::NodeId,
+        /// Its name.
+        #[serde(default)]
+        name: Option<String>,
+        /// Its placement in the world (its parents' composed in).
+        #[serde(default)]
+        placement: Option<brickmap::objects::Placement>,
+        /// Shown.
+        #[serde(default)]
+        visible: Option<bool>,
+        /// Solid voxels of its model.
+        #[serde(default)]
+        voxels: Option<u64>,
+    },
     /// Steps that can be undone and redone.
     ExpectHistory {
         /// Undoable steps.
@@ -403,6 +421,45 @@ fn run_step(
             let got = doc.scene.world.read().solid_count();
             ensure!(got == *want, "{got} solid voxels, expected {want}");
             format!("{want} solid voxels")
+        }
+        Step::ExpectObject {
+            node,
+            name,
+            placement,
+            visible,
+            voxels,
+        } => {
+            let objects = doc.scene.objects();
+            let tree = objects.tree();
+            let n = tree
+                .node(*node)
+                .with_context(|| format!("object #{}", node.0))?;
+            let at = tree.world_placement(*node)?;
+            let count = match n.kind {
+                brickmap::objects::NodeKind::Object { model, .. } => {
+                    objects.model(model).map(|m| m.solid_count())
+                }
+                brickmap::objects::NodeKind::Group { .. } => None,
+            };
+            let checks = [
+                (
+                    name.as_ref().is_none_or(|w| *w == n.name),
+                    format!("named {:?}", n.name),
+                ),
+                (placement.is_none_or(|w| w == at), format!("placed {at:?}")),
+                (
+                    visible.is_none_or(|w| w == n.visible),
+                    format!("visible {}", n.visible),
+                ),
+                (
+                    voxels.is_none_or(|w| Some(w) == count),
+                    format!("{count:?} voxels"),
+                ),
+            ];
+            for (ok, got) in &checks {
+                ensure!(*ok, "object #{} is {got}, not as expected", node.0);
+            }
+            format!("object #{} as expected", node.0)
         }
         Step::ExpectHistory { undo, redo } => {
             let got = (doc.history.undo_len(), doc.history.redo_len());

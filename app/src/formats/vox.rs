@@ -136,7 +136,8 @@ pub fn import_bytes(
     let dims = GridDims::from_voxels((top + 1).max(IVec3::ONE).as_uvec3())
         .map_err(|_| invalid(VoxError::TooLarge(top + 1)))?;
     let world_error = |e| FormatError::world(path, e);
-    let world = World::new(dims, brickmap::WorldConfig::with_workers(workers)).map_err(world_error)?;
+    let world =
+        World::new(dims, brickmap::WorldConfig::with_workers(workers)).map_err(world_error)?;
     let mut params = render::SceneParams::framing(dims.voxels().as_dvec3());
     if let Some((lo, hi)) = bounds(&placed) {
         // Framed whole (the default camera's direction), as the editor's "frame the scene".

@@ -11,8 +11,9 @@
 //! - **merge**: one new object (identity, a model the size of the objects' joint box) holding
 //!   what the objects show, where they overlap the later one's voxel (the drawing order);
 //!   the objects go;
-//! - **split**: the voxels of an object inside a world voxel set move to a new object with
-//!   the same placement and a model of the same size.
+//! - **delete**: the node and its subtree go, with the models only they placed;
+//! - **split**: the voxels of an object inside a world voxel set move to a new object whose
+//!   model is their box, placed so that they stay where they are.
 
 use super::model::Model;
 use super::orient::{Orientation, Placement};
@@ -67,6 +68,26 @@ fn add_after(
         },
         new: NewNode::Object { model, layer },
     })
+}
+
+/// Removes a node and its subtree, and the models only they placed (a file saved after it
+/// holds no model nothing places).
+pub fn delete(o: &Objects, node: NodeId) -> Result<ObjectOp, ObjectError> {
+    let tree = o.tree();
+    let gone = tree.subtree(node)?;
+    let mut models = std::collections::BTreeSet::new();
+    for n in &gone {
+        if let NodeKind::Object { model, .. } = tree.node(*n)?.kind {
+            models.insert(model);
+        }
+    }
+    let mut ops = vec![ObjectOp::Remove { node }];
+    for model in models {
+        if tree.instances(model).iter().all(|i| gone.contains(i)) {
+            ops.push(ObjectOp::RemoveModel { model });
+        }
+    }
+    Ok(ObjectOp::Batch(ops))
 }
 
 /// Another object placing the same model, after it, moved by `offset`.
@@ -224,8 +245,8 @@ pub fn merge(
     Ok(ObjectOp::Batch(ops))
 }
 
-/// The voxels of the object inside `selection` (world voxels) move to a new object with
-/// the same placement, after it.
+/// The voxels of the object inside `selection` (world voxels) move to a new object after
+/// it, whose model is their box, placed so that they stay where they are.
 pub fn split(
     o: &Objects,
     node: NodeId,
@@ -236,21 +257,27 @@ pub fn split(
     let m = o.model(model).ok_or(ObjectError::NoModel(model))?;
     let p = o.tree().world_placement(node)?;
     let inside = p.set_to_model(selection, m.size());
-    // The new model: the original's voxels inside the selection.
-    let mut part = Model::new(m.size())?;
-    let mut list = Vec::new();
-    for v in inside.voxels() {
-        if let Some(mat) = m.voxel(v) {
-            list.push(crate::edit::VoxelEdit {
-                pos: v,
-                op: crate::edit::VoxelOp::Set(mat),
-            });
-        }
+    // The new model: the original's voxels inside the selection, in their box.
+    let held: Vec<(IVec3, u8)> = inside
+        .voxels()
+        .filter_map(|v| m.voxel(v).map(|mat| (v, mat)))
+        .collect();
+    let lo = held.iter().fold(IVec3::MAX, |a, (v, _)| a.min(*v));
+    let hi = held.iter().fold(IVec3::MIN, |a, (v, _)| a.max(*v));
+    if held.is_empty() {
+        return Err(ObjectError::NothingSelected(node));
     }
-    part.apply(&EditOp::Voxels(list), table)?;
+    let size = hi - lo + 1;
+    let part = Model::from_voxels(size, held.iter().map(|(v, mat)| (*v - lo, *mat)), table)?;
     let id = o.free_model_id();
     let (parent, index) = slot(o.tree(), node)?;
     let n = o.tree().node(node)?;
+    // Placed so each voxel stays where it was: R(v − lo + ½ − ⌊s′/2⌋) + t′ = R(v + ½ −
+    // ⌊s/2⌋) + t.
+    let placement = Placement {
+        rot: n.placement.rot,
+        t: n.placement.t + n.placement.rot.apply(lo - m.size() / 2 + size / 2),
+    };
     Ok(ObjectOp::Batch(vec![
         ObjectOp::AddModel {
             model: id,
@@ -260,7 +287,7 @@ pub fn split(
             parent,
             index: Some(index + 1),
             name: format!("{} part", n.name),
-            placement: n.placement,
+            placement,
             new: NewNode::Object { model: id, layer },
         },
         ObjectOp::Edit {
@@ -419,5 +446,37 @@ mod tests {
             "both halves hold voxels: {taken} + {left}"
         );
         assert_eq!(taken + left, solid);
+        // A turned part splits in place too: its new part is its selected voxels' box,
+        // every voxel where it was.
+        let at = o.tree().node(part).unwrap().placement;
+        let turned = Placement {
+            rot: Orientation::quarter_turn(Axis::Y, 2).after(&at.rot),
+            ..at
+        };
+        round(
+            &mut o,
+            &w,
+            ObjectOp::Place {
+                node: part,
+                placement: turned,
+            },
+        );
+        let hash = w.read().content_hash();
+        let mut corner = VoxelSet::new();
+        for x in 0..24 {
+            for y in 0..32 {
+                for z in 0..24 {
+                    corner.insert(IVec3::new(x, y, z));
+                }
+            }
+        }
+        let op = split(&o, part, &corner, &t).unwrap();
+        round(&mut o, &w, op);
+        assert_eq!(w.read().content_hash(), hash, "the same voxels show");
+        let empty = VoxelSet::new();
+        assert!(matches!(
+            split(&o, part, &empty, &t),
+            Err(ObjectError::NothingSelected(_))
+        ));
     }
 }

@@ -197,6 +197,9 @@ pub enum ObjectError {
     /// The id is taken by another model.
     #[error("model {} exists already", .0.0)]
     ModelTaken(ModelId),
+    /// A split whose selection holds none of the object's voxels.
+    #[error("the selection holds no voxel of object #{}", .0.0)]
+    NothingSelected(NodeId),
     /// An edit with no object to act on (the editor's active object is none).
     #[error("no object is active to edit: choose one in the Objects window")]
     NoActiveObject,

@@ -21,7 +21,6 @@
 
 mod objects;
 
-
 use super::{FormatError, payload};
 use crate::scene::Scene;
 use base64::Engine;

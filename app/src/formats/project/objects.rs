@@ -258,4 +258,3 @@ fn read_model(r: &ModelRecord, table: &MaterialTable, path: &Path) -> Result<Mod
     }
     Ok(model)
 }
-

@@ -77,7 +77,8 @@ pub fn import_objects(
     let top = hi + shift;
     let dims = GridDims::from_voxels(top.max(IVec3::ONE).as_uvec3())
         .map_err(|_| invalid(VoxError::TooLarge(top)))?;
-    let world = World::new(dims, brickmap::WorldConfig::with_workers(workers)).map_err(world_error)?;
+    let world =
+        World::new(dims, brickmap::WorldConfig::with_workers(workers)).map_err(world_error)?;
     for (i, c) in palette_of(&data).iter().enumerate() {
         world.set_colour(i as u8, [c.r, c.g, c.b]);
     }

@@ -1,0 +1,257 @@
+//! The object commands (arrange mode, the Objects window): which object edits act on, show,
+//! lock, rename, move, turn and flip an object, duplicate, instance, make unique, delete,
+//! group, ungroup, merge, split the selection into a new object, show a layer. Each is an
+//! [`ObjectOp`] (a batch for the compound ones, built by `brickmap::objects::arrange`) with
+//! its exact inverse; a command that removes the active object makes the first remaining
+//! one active, and its undo makes it active again.
+
+use super::error::{EditError, Result, invalid};
+use super::inverse::{Applied, Inverse};
+use crate::scene::Scene;
+use brickmap::objects::{
+    Axis, LayerId, NodeId, NodeKind, ObjectOp, Orientation, Placement, arrange,
+};
+use glam::IVec3;
+use serde::{Deserialize, Serialize};
+
+/// One object command (node ids are the tree's: stable through undo and redo, so a script's
+/// ids stay valid).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum ObjectCommand {
+    /// Voxel edits act on this object (none: on nothing).
+    Activate(Option<NodeId>),
+    /// Shows or hides a node and its subtree.
+    Show {
+        /// The node.
+        node: NodeId,
+        /// Visible.
+        visible: bool,
+    },
+    /// Locks or unlocks a node (a locked one refuses edits and moves).
+    Lock {
+        /// The node.
+        node: NodeId,
+        /// Locked.
+        locked: bool,
+    },
+    /// Renames a node.
+    Rename {
+        /// The node.
+        node: NodeId,
+        /// Its new name.
+        name: String,
+    },
+    /// Moves a node by whole voxels (in its parent's frame).
+    Translate {
+        /// The node.
+        node: NodeId,
+        /// The move.
+        by: IVec3,
+    },
+    /// Turns a node by quarter turns about an axis through its pivot.
+    Turn {
+        /// The node.
+        node: NodeId,
+        /// The axis.
+        axis: Axis,
+        /// Quarter turns (counter-clockwise looking down the axis).
+        quarters: i32,
+    },
+    /// Mirrors a node along an axis through its pivot.
+    Flip {
+        /// The node.
+        node: NodeId,
+        /// The axis.
+        axis: Axis,
+    },
+    /// Another object placing a copy of the node's model, moved by `offset`.
+    Duplicate {
+        /// The object.
+        node: NodeId,
+        /// Where the copy goes, relative to it.
+        offset: IVec3,
+    },
+    /// Another object placing the same model (edits of one show in both).
+    Instance {
+        /// The object.
+        node: NodeId,
+        /// Where the instance goes, relative to it.
+        offset: IVec3,
+    },
+    /// The object gets its own copy of its shared model.
+    MakeUnique(NodeId),
+    /// Removes a node, its subtree and the models only they placed.
+    Delete(NodeId),
+    /// A new group holding the nodes, where the first one was.
+    Group {
+        /// The nodes.
+        nodes: Vec<NodeId>,
+        /// The group's name.
+        name: String,
+    },
+    /// The group's children take its place; the group goes.
+    Ungroup(NodeId),
+    /// One new object holding what the objects show (later ones win where they overlap).
+    Merge {
+        /// The objects.
+        nodes: Vec<NodeId>,
+        /// The new object's name.
+        name: String,
+    },
+    /// The active object's selected voxels move to a new object.
+    SplitSelection,
+    /// Shows or hides a layer.
+    ShowLayer {
+        /// The layer.
+        layer: LayerId,
+        /// Visible.
+        visible: bool,
+    },
+}
+
+impl ObjectCommand {
+    /// A label for the history list.
+    pub fn label(&self) -> String {
+        match self {
+            Self::Activate(Some(n)) => format!("Edit object #{}", n.0),
+            Self::Activate(None) => "Edit no object".into(),
+            Self::Show { node, visible } => {
+                format!("{} #{}", if *visible { "Show" } else { "Hide" }, node.0)
+            }
+            Self::Lock { node, locked } => {
+                format!("{} #{}", if *locked { "Lock" } else { "Unlock" }, node.0)
+            }
+            Self::Rename { node, name } => format!("Rename #{} to {name:?}", node.0),
+            Self::Translate { node, by } => format!("Move #{} by {by}", node.0),
+            Self::Turn {
+                node,
+                axis,
+                quarters,
+            } => format!("Turn #{} {}° about {axis:?}", node.0, quarters * 90),
+            Self::Flip { node, axis } => format!("Flip #{} along {axis:?}", node.0),
+            Self::Duplicate { node, .. } => format!("Duplicate #{}", node.0),
+            Self::Instance { node, .. } => format!("Instance #{}", node.0),
+            Self::MakeUnique(n) => format!("Make #{} unique", n.0),
+            Self::Delete(n) => format!("Delete #{}", n.0),
+            Self::Group { nodes, .. } => format!("Group {} nodes", nodes.len()),
+            Self::Ungroup(n) => format!("Ungroup #{}", n.0),
+            Self::Merge { nodes, .. } => format!("Merge {} objects", nodes.len()),
+            Self::SplitSelection => "Split the selection into an object".into(),
+            Self::ShowLayer { layer, visible } => format!(
+                "{} layer {}",
+                if *visible { "Show" } else { "Hide" },
+                layer.0
+            ),
+        }
+    }
+
+    /// Executes the command. On error the scene is as it was.
+    pub fn apply(&self, scene: &mut Scene) -> Result<Applied> {
+        let before = scene.active();
+        if let Self::Activate(node) = self {
+            if let Some(n) = node {
+                let objects = scene.objects();
+                if !matches!(objects.tree().node(*n)?.kind, NodeKind::Object { .. }) {
+                    return Err(brickmap::objects::ObjectError::NotAnObject(*n).into());
+                }
+            }
+            scene.set_active(*node);
+            return Ok(Applied {
+                inverse: Inverse::Active(before),
+                changed_voxels: 0,
+            });
+        }
+        let op = self.op(scene)?;
+        let (inverse, changed_voxels) = scene.apply(op)?;
+        // The active object gone (deleted, merged, ungrouped away): the first one left.
+        let gone = before.is_some_and(|n| {
+            !scene
+                .objects()
+                .tree()
+                .node(n)
+                .is_ok_and(|n| matches!(n.kind, NodeKind::Object { .. }))
+        });
+        let inverse = if gone {
+            let first = Scene::first_object(&scene.objects());
+            scene.set_active(first);
+            Inverse::Compound(vec![
+                Inverse::Voxels(vec![inverse], None),
+                Inverse::Active(before),
+            ])
+        } else {
+            Inverse::Voxels(vec![inverse], None)
+        };
+        Ok(Applied {
+            inverse,
+            changed_voxels,
+        })
+    }
+
+    /// The op that does it, built from the scene as it is.
+    fn op(&self, scene: &Scene) -> Result<ObjectOp> {
+        let table = scene.world.materials().clone();
+        let objects = scene.objects();
+        let placed = |node: NodeId, f: &dyn Fn(Placement) -> Placement| -> Result<ObjectOp> {
+            let p = objects.tree().node(node)?.placement;
+            Ok(ObjectOp::Place {
+                node,
+                placement: f(p),
+            })
+        };
+        let op = match self {
+            Self::Activate(_) => unreachable!("handled before"),
+            Self::Show { node, visible } => ObjectOp::Show {
+                node: *node,
+                visible: *visible,
+            },
+            Self::Lock { node, locked } => ObjectOp::Lock {
+                node: *node,
+                locked: *locked,
+            },
+            Self::Rename { node, name } => {
+                if name.trim().is_empty() {
+                    return Err(invalid("a name needs at least one visible character"));
+                }
+                ObjectOp::Rename {
+                    node: *node,
+                    name: name.clone(),
+                }
+            }
+            Self::Translate { node, by } => placed(*node, &|p| Placement { t: p.t + *by, ..p })?,
+            Self::Turn {
+                node,
+                axis,
+                quarters,
+            } => placed(*node, &|p| Placement {
+                rot: Orientation::quarter_turn(*axis, *quarters).after(&p.rot),
+                ..p
+            })?,
+            Self::Flip { node, axis } => placed(*node, &|p| Placement {
+                rot: Orientation::flip(*axis).after(&p.rot),
+                ..p
+            })?,
+            Self::Duplicate { node, offset } => arrange::duplicate(&objects, *node, *offset)?,
+            Self::Instance { node, offset } => arrange::instance(&objects, *node, *offset)?,
+            Self::MakeUnique(node) => arrange::make_unique(&objects, *node)?,
+            Self::Delete(node) => arrange::delete(&objects, *node)?,
+            Self::Group { nodes, name } => arrange::group(&objects, nodes, name)?,
+            Self::Ungroup(node) => arrange::ungroup(&objects, *node)?,
+            Self::Merge { nodes, name } => arrange::merge(&objects, nodes, name, &table)?,
+            Self::SplitSelection => {
+                let node = scene
+                    .active()
+                    .ok_or(brickmap::objects::ObjectError::NoActiveObject)?;
+                let selection = scene
+                    .selection
+                    .as_ref()
+                    .ok_or(EditError::NothingToDo("nothing is selected"))?;
+                arrange::split(&objects, node, &selection.voxels, &table)?
+            }
+            Self::ShowLayer { layer, visible } => ObjectOp::ShowLayer {
+                layer: *layer,
+                visible: *visible,
+            },
+        };
+        Ok(op)
+    }
+}
