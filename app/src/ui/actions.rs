@@ -106,6 +106,7 @@ impl Editor {
                 self.execute(Command::SetParam { kind, index, value })
             }
             UiEvent::Generate(spec) => self.execute(Command::GenerateTerrain(spec)),
+            UiEvent::Objects(c) => self.execute(Command::Object(c)),
             UiEvent::Jump { undo, redo } => {
                 for _ in 0..undo {
                     self.edits.submit(&self.doc, Edit::Undo);

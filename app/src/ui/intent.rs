@@ -152,6 +152,8 @@ pub enum UiEvent {
         /// The value.
         value: f32,
     },
+    /// An object command (the Objects window).
+    Objects(crate::editor::objects::ObjectCommand),
     /// Replace the scene's voxels by generated terrain (undoable).
     Generate(crate::editor::command::TerrainSpec),
     /// Go back (undo) or forward (redo) this many steps in the history.

@@ -35,6 +35,7 @@ mod intent;
 pub mod jobs;
 pub mod keymap;
 mod motion;
+mod outliner;
 pub mod panels;
 mod pending;
 mod pointer;

@@ -94,6 +94,8 @@ pub struct PanelState {
     pub busy: Vec<String>,
     /// The editing windows (tools, palette, history).
     pub editing: super::editing::EditingState,
+    /// The Objects window.
+    pub outliner: super::outliner::OutlinerState,
     /// The key map's bindings (chord, action) for the shortcut list.
     pub keys: Vec<(String, String)>,
     /// The viewport's rectangle: what the menu bar, the status line and the docked panels
@@ -221,6 +223,7 @@ pub fn draw(
                 ui.checkbox(&mut palette, "Palette and materials");
                 state.editing.palette_hidden = !palette;
                 ui.checkbox(&mut state.editing.history_open, "History");
+                ui.checkbox(&mut state.outliner.open, "Objects");
                 if ui.button("Terrain and water…").clicked() {
                     let d = doc.scene.world.dims().voxels();
                     state.editing.terrain = Some(crate::editor::command::TerrainSpec::for_size((
@@ -259,6 +262,7 @@ pub fn draw(
     let area = root.available_rect_before_wrap();
     state.viewport = Some(area);
     super::editing::draw(ctx, area, &mut state.editing, doc, &mut out);
+    super::outliner::draw(ctx, area, &mut state.outliner, doc, &mut out);
     if let Some((browser, places)) = &mut state.browser {
         match browser.draw(ctx, between_bars, places) {
             super::browser::Answer::Open => {}
