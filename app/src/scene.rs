@@ -10,6 +10,7 @@
 use crate::selection::{Clip, Selection};
 use brickmap::objects::{NodeId, NodeKind, ObjectError, ObjectOp, ObjectTree, Objects};
 use brickmap::{EditOp, GridDims, World, WorldConfig};
+use glam::IVec3;
 use render::SceneParams;
 use std::sync::{Arc, Mutex, MutexGuard};
 
@@ -24,6 +25,12 @@ pub struct Scene {
     objects: Mutex<Objects>,
     /// The object voxel edits act on (edit mode), if any.
     active: Option<NodeId>,
+    /// Counts the worlds this scene has had (a regrid makes a new one): a viewport holding
+    /// an older one uploads the new one whole.
+    epoch: u64,
+    /// How far every voxel has moved since the scene was made (the sum of the regrids'
+    /// shifts): a view camera kept outside the scene follows by the difference.
+    shifted: IVec3,
     /// Camera, sun, sky, render settings.
     pub params: SceneParams,
     /// The editing session's selection (never saved).
@@ -63,6 +70,8 @@ impl Scene {
             world,
             objects: Mutex::new(objects),
             active,
+            epoch: 0,
+            shifted: IVec3::ZERO,
             params,
             selection: None,
             clipboard: None,
@@ -97,6 +106,41 @@ impl Scene {
     /// Makes `node` the object voxel edits act on (`None`: none).
     pub fn set_active(&mut self, node: Option<NodeId>) {
         self.active = node;
+    }
+
+    /// Counts the worlds this scene has had (see the field).
+    pub fn epoch(&self) -> u64 {
+        self.epoch
+    }
+
+    /// How far every voxel has moved since the scene was made.
+    pub fn shifted(&self) -> IVec3 {
+        self.shifted
+    }
+
+    /// Moves the scene into a new world of `dims`, every voxel moved by `shift` (a whole
+    /// number of bricks keeps a flat scene's object brick-aligned), and the camera, the
+    /// sun and the selection with them. Returns the grid and shift that undo it. On an error
+    /// (the objects do not fit the new grid) nothing changed.
+    pub fn regrid(
+        &mut self,
+        dims: GridDims,
+        shift: IVec3,
+    ) -> Result<(GridDims, IVec3), ObjectError> {
+        let world = World::new(dims, WorldConfig::with_workers(self.world.workers()))?;
+        world.replace_materials(self.world.materials().clone())?;
+        self.objects_mut().regrid(&world, shift)?;
+        world.take_dirty();
+        let old = std::mem::replace(&mut self.world, world).dims();
+        let d = shift.as_dvec3();
+        self.params.camera.position += d;
+        self.params.sun.position += d;
+        if let Some(sel) = &self.selection {
+            self.selection = Some(Selection::new(sel.region.translated(shift), dims.voxels()));
+        }
+        self.epoch += 1;
+        self.shifted += shift;
+        Ok((old, -shift))
     }
 
     /// A voxel edit, in world voxels, of the active object (carried into its frame; its

@@ -312,19 +312,54 @@ fn a_selection_splits_into_a_new_object_that_edits_apart() {
     assert!(solid(&doc, split) > before);
     assert_eq!(solid(&doc, terrain), ground);
     assert_composite(&doc, "split and painted");
-    // Its model is the selected voxels' box: it moves within the grid; past it the move is
-    // refused, naming the grid.
-    doc.execute(Command::Object(ObjectCommand::Translate {
-        node: split,
-        by: IVec3::new(40, 0, 40),
-    }))
-    .unwrap();
+    // Its model is the selected voxels' box: it moves within the grid.
+    let translate = |node, by: IVec3| Command::Object(ObjectCommand::Translate { node, by });
+    doc.execute(translate(split, IVec3::new(40, 0, 40)))
+        .unwrap();
     assert_composite(&doc, "moved");
-    let far = doc.execute(Command::Object(ObjectCommand::Translate {
-        node: split,
-        by: IVec3::new(200, 0, 0),
-    }));
-    assert!(far.unwrap_err().to_string().contains("voxel grid"));
+    // Past the grid's far side and past the origin, the grid grows (by whole bricks, the
+    // scene moved with the camera where it passed the origin); undo shrinks it back.
+    let (grid, hash, camera) = (
+        doc.scene.world.dims(),
+        doc.scene.world.read().content_hash(),
+        doc.scene.params.camera.position,
+    );
+    doc.execute(translate(split, IVec3::new(200, 0, 0)))
+        .unwrap();
+    assert_eq!(
+        doc.scene.world.dims().voxels().x,
+        272,
+        "40 + 200 + 32 voxels, in bricks"
+    );
+    assert_composite(&doc, "past the far side");
+    doc.execute(translate(split, IVec3::new(-260, 0, 0)))
+        .unwrap();
+    assert_eq!(
+        doc.scene.shifted(),
+        IVec3::new(24, 0, 0),
+        "−20 rounded to whole bricks"
+    );
+    assert_eq!(
+        doc.scene.params.camera.position,
+        camera + DVec3::new(24.0, 0.0, 0.0)
+    );
+    assert_composite(&doc, "past the origin");
+    doc.undo().unwrap();
+    doc.undo().unwrap();
+    assert_eq!(doc.scene.world.dims(), grid);
+    assert_eq!(doc.scene.world.read().content_hash(), hash);
+    assert_eq!(doc.scene.params.camera.position, camera);
+    doc.redo().unwrap();
+    doc.redo().unwrap();
+    assert_composite(&doc, "redone");
+    doc.undo().unwrap();
+    doc.undo().unwrap();
+    // Past the largest grid: refused, naming it; nothing changed.
+    let far = doc.execute(translate(split, IVec3::new(5000, 0, 0)));
+    let e = far.unwrap_err().to_string();
+    assert!(e.contains("largest, 4096×1024×4096"), "{e}");
+    assert_eq!(doc.scene.world.dims(), grid);
+    assert_eq!(doc.scene.world.read().content_hash(), hash);
     // Hiding the terrain leaves the split voxels alone in the world.
     doc.execute(Command::Object(ObjectCommand::Show {
         node: terrain,

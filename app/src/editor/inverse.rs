@@ -35,6 +35,8 @@ pub enum Inverse {
     Selection(Option<Selection>),
     /// The previous active object.
     Active(Option<brickmap::objects::NodeId>),
+    /// The previous grid: its size, and the shift that moves every voxel back into it.
+    Regrid(brickmap::GridDims, glam::IVec3),
     /// Several, undone last first (a move: its voxels, then its selection).
     Compound(Vec<Inverse>),
 }
@@ -88,6 +90,10 @@ impl Inverse {
                 Inverse::Settings(std::mem::replace(&mut scene.params.settings, v))
             }
             Inverse::Selection(v) => Inverse::Selection(std::mem::replace(&mut scene.selection, v)),
+            Inverse::Regrid(dims, shift) => {
+                let (back, undo) = scene.regrid(dims, shift)?;
+                Inverse::Regrid(back, undo)
+            }
             Inverse::Active(v) => {
                 let now = scene.active();
                 scene.set_active(v);

@@ -3,13 +3,17 @@
 //! group, ungroup, merge, split the selection into a new object, show a layer. Each is an
 //! [`ObjectOp`] (a batch for the compound ones, built by `brickmap::objects::arrange`) with
 //! its exact inverse; a command that removes the active object makes the first remaining
-//! one active, and its undo makes it active again.
+//! one active, and its undo makes it active again. An object moved, turned, copied or
+//! shown past the grid grows it (and moves everything by whole bricks where it passed
+//! the origin), up to the largest grid; the undo shrinks it back exactly.
 
 use super::error::{EditError, Result, invalid};
 use super::inverse::{Applied, Inverse};
 use crate::scene::Scene;
+use brickmap::GridDims;
 use brickmap::objects::{
-    Axis, LayerId, NodeId, NodeKind, ObjectOp, Orientation, Placement, arrange,
+    Axis, CompositeError, LayerId, NodeId, NodeKind, ObjectError, ObjectOp, Orientation, Placement,
+    arrange,
 };
 use glam::IVec3;
 use serde::{Deserialize, Serialize};
@@ -161,8 +165,46 @@ impl ObjectCommand {
                 changed_voxels: 0,
             });
         }
-        let op = self.op(scene)?;
-        let (inverse, changed_voxels) = scene.apply(op)?;
+        // An object placed past the grid grows it (a regrid, undone with the op).
+        let mut regrids = Vec::new();
+        let (inverse, changed_voxels) = loop {
+            let done = self.op(scene).and_then(|op| Ok(scene.apply(op)?));
+            let grown =
+                match &done {
+                    Err(EditError::Objects(ObjectError::Composite(
+                        CompositeError::OutsideGrid { lo, hi, grid, .. },
+                    ))) if regrids.len() < MAX_REGRIDS => larger(*lo, *hi, *grid),
+                    _ => None,
+                };
+            match (done, grown) {
+                (Ok(done), _) => break done,
+                (Err(_), Some((dims, shift))) => regrids.push(scene.regrid(dims, shift)?),
+                (Err(e), None) => {
+                    for (dims, shift) in regrids.into_iter().rev() {
+                        scene.regrid(dims, shift)?;
+                    }
+                    return Err(match e {
+                        EditError::Objects(ObjectError::Composite(
+                            CompositeError::OutsideGrid { node, lo, hi, grid },
+                        )) => invalid(format!(
+                            "object #{} would cover {lo}..{hi}: that needs a grid past the \
+                             largest, {}×{}×{} voxels (the grid is {}×{}×{})",
+                            node.0, MAX_GRID.x, MAX_GRID.y, MAX_GRID.z, grid.x, grid.y, grid.z
+                        )),
+                        e => e,
+                    });
+                }
+            }
+        };
+        let mut inverse = Inverse::Voxels(vec![inverse], None);
+        if !regrids.is_empty() {
+            let mut parts: Vec<Inverse> = regrids
+                .into_iter()
+                .map(|(dims, shift)| Inverse::Regrid(dims, shift))
+                .collect();
+            parts.push(inverse);
+            inverse = Inverse::Compound(parts);
+        }
         // The active object gone (deleted, merged, ungrouped away): the first one left.
         let gone = before.is_some_and(|n| {
             !scene
@@ -174,12 +216,9 @@ impl ObjectCommand {
         let inverse = if gone {
             let first = Scene::first_object(&scene.objects());
             scene.set_active(first);
-            Inverse::Compound(vec![
-                Inverse::Voxels(vec![inverse], None),
-                Inverse::Active(before),
-            ])
+            Inverse::Compound(vec![inverse, Inverse::Active(before)])
         } else {
-            Inverse::Voxels(vec![inverse], None)
+            inverse
         };
         Ok(Applied {
             inverse,
@@ -187,7 +226,8 @@ impl ObjectCommand {
         })
     }
 
-    /// The op that does it, built from the scene as it is.
+    /// The op that does it, built from the scene as it is (again after a regrid: what it
+    /// reads of the world moved).
     fn op(&self, scene: &Scene) -> Result<ObjectOp> {
         let table = scene.world.materials().clone();
         let objects = scene.objects();
@@ -254,4 +294,24 @@ impl ObjectCommand {
         };
         Ok(op)
     }
+}
+
+/// The largest grid, in voxels.
+const MAX_GRID: IVec3 = IVec3::new(
+    brickmap::grid::MAX_BRICKS_X as i32 * 8,
+    brickmap::grid::MAX_BRICKS_Y as i32 * 8,
+    brickmap::grid::MAX_BRICKS_Z as i32 * 8,
+);
+
+/// Regrids one command may make before it is refused (each takes in at least the object the
+/// composite refused; a group's move may need one per object).
+const MAX_REGRIDS: usize = 16;
+
+/// The grid that holds the box `lo..hi` as well as the grid `grid`, and the shift (whole
+/// bricks) that brings `lo` to the origin; `None` past the largest grid.
+fn larger(lo: IVec3, hi: IVec3, grid: IVec3) -> Option<(GridDims, IVec3)> {
+    let shift = ((-lo).max(IVec3::ZERO) + 7) / 8 * 8;
+    let need = hi.max(grid) + shift;
+    let dims = GridDims::from_voxels(need.as_uvec3()).ok()?;
+    Some((dims, shift))
 }

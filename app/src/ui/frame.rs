@@ -118,16 +118,18 @@ impl Editor {
     ) -> Result<()> {
         self.viewing.set_window(size);
         self.viewing.set_area((0, 0, size.0, size.1));
-        let viewport = {
+        let (viewport, epoch) = {
             let doc = self.read();
             let view = doc.scene.world.read();
-            Viewport::new(ctx, &view)?
+            let epoch = (doc.scene.epoch(), doc.scene.shifted());
+            (Viewport::new(ctx, &view)?, epoch)
         };
         self.gfx = Some(Gfx {
             presenter,
             viewport,
             host,
             generation: self.generation,
+            epoch,
             title: String::new(),
         });
         self.refresh_stats();
@@ -188,8 +190,17 @@ impl Editor {
             }
             .into());
         }
-        if gfx.generation != self.generation {
-            // A new document: a new GPU world on the same device (the old one goes first).
+        let epoch = {
+            let doc = self.read();
+            (doc.scene.epoch(), doc.scene.shifted())
+        };
+        if gfx.generation != self.generation || gfx.epoch.0 != epoch.0 {
+            // A new document, or the scene moved into a larger grid: a new GPU world on the
+            // same device (the old one goes first). Within a document the view follows the
+            // scene's shift.
+            if gfx.generation == self.generation {
+                self.viewing.shift((epoch.1 - gfx.epoch.1).as_dvec3());
+            }
             let ctx = gfx.viewport.ctx().clone();
             let next = {
                 let doc = self.read();
@@ -198,6 +209,8 @@ impl Editor {
             };
             gfx.viewport = next;
             gfx.generation = self.generation;
+            gfx.epoch = epoch;
+            self.refresh_stats();
         }
         let capture_now = self
             .script

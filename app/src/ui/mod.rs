@@ -129,6 +129,9 @@ struct Gfx {
     host: Host,
     /// The document generation whose world the viewport holds.
     generation: u64,
+    /// The scene's world (its epoch) the viewport holds, and how far the scene had moved
+    /// then (a regrid makes a new world and moves the scene).
+    epoch: (u64, glam::IVec3),
     /// The window title last set.
     title: String,
 }

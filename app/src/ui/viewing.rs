@@ -35,6 +35,14 @@ impl Viewing {
         }
     }
 
+    /// Moves the view and every stored view by `d` (the scene moved into a larger grid:
+    /// what was in view stays in view).
+    pub fn shift(&mut self, d: DVec3) {
+        for c in std::iter::once(&mut self.camera).chain(self.slots.iter_mut().flatten()) {
+            c.camera.position += d;
+        }
+    }
+
     /// The view stored in slot `n` (1–9), if any.
     pub fn stored(&self, n: u8) -> Option<ViewCamera> {
         self.slots

@@ -52,17 +52,17 @@ pub enum CompositeError {
         /// The model it names.
         model: ModelId,
     },
-    /// An object's placed box leaves the world's grid.
+    /// Objects' placed boxes leave the world's grid.
     #[error(
-        "object #{} covers {lo}..{hi}, outside the {grid} voxel grid (the composite's limit)",
+        "object #{} (with any other outside) covers {lo}..{hi}, outside the {grid} voxel grid",
         .node.0
     )]
     OutsideGrid {
-        /// The object.
+        /// The first object outside.
         node: NodeId,
-        /// Its lowest cell.
+        /// The lowest cell of the objects outside.
         lo: IVec3,
-        /// One past its highest.
+        /// One past their highest.
         hi: IVec3,
         /// The grid in voxels.
         grid: IVec3,
@@ -104,6 +104,7 @@ impl Composite {
         grid: IVec3,
     ) -> Result<Self, CompositeError> {
         let mut entries = Vec::new();
+        let mut outside: Option<(NodeId, IVec3, IVec3)> = None;
         for drawn in tree.drawn() {
             let model = models.model(drawn.model).ok_or(CompositeError::NoModel {
                 node: drawn.node,
@@ -112,12 +113,12 @@ impl Composite {
             let size = model.size();
             let (lo, hi) = drawn.placement.bounds(size);
             if lo.cmplt(IVec3::ZERO).any() || hi.cmpgt(grid).any() {
-                return Err(CompositeError::OutsideGrid {
-                    node: drawn.node,
-                    lo,
-                    hi,
-                    grid,
+                // Every object outside, in one box (a grid that holds it holds them all).
+                outside = Some(match outside {
+                    None => (drawn.node, lo, hi),
+                    Some((node, a, b)) => (node, a.min(lo), b.max(hi)),
                 });
+                continue;
             }
             entries.push(Entry {
                 drawn,
@@ -125,6 +126,9 @@ impl Composite {
                 lo,
                 hi,
             });
+        }
+        if let Some((node, lo, hi)) = outside {
+            return Err(CompositeError::OutsideGrid { node, lo, hi, grid });
         }
         let mut index: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
         for (i, e) in entries.iter().enumerate() {
