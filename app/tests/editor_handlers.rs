@@ -698,6 +698,41 @@ fn selection_operations_land_and_a_selection_gets_a_material_of_its_own(s: &mut 
     assert_eq!(s.ed.notice(), Some("Select none: nothing selected"));
 }
 
+/// Arrange mode: Tab, then a click picks the object under the cursor and an arrow moves it
+/// (the scene's one grid-sized object: past the grid's side, so the grid grows and the
+/// viewport takes the new world, validated); Ctrl + Z puts it back and the grid with it;
+/// Tab again is the brush.
+fn arrange_mode_picks_and_moves_an_object(s: &mut Session) {
+    s.quiet();
+    let grid = |s: &Session| s.ed.document().read().unwrap().scene.world.dims();
+    let (before, dims) = (s.state(), grid(s));
+    s.key(KeyCode::Tab, true);
+    s.key(KeyCode::Tab, false);
+    let at = s.on_the_terrain();
+    s.to(at);
+    s.frame();
+    s.left(true);
+    s.left(false);
+    s.quiet();
+    assert_eq!(s.state(), before, "a pick changes nothing");
+    s.key(KeyCode::ArrowRight, true);
+    s.key(KeyCode::ArrowRight, false);
+    s.quiet();
+    let moved = s.state();
+    assert_eq!(moved.1, before.1 + 1, "one step");
+    assert_ne!(grid(s), dims, "the object left the grid: it grew");
+    for _ in 0..3 {
+        s.frame();
+    }
+    s.ctrl(KeyCode::KeyZ);
+    s.quiet();
+    assert_eq!(s.state().0, before.0);
+    assert_eq!(grid(s), dims);
+    s.key(KeyCode::Tab, true);
+    s.key(KeyCode::Tab, false);
+    s.quiet();
+}
+
 #[test]
 fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     let dir = window::scratch("editor-handlers");
@@ -712,6 +747,7 @@ fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     a_paste_being_placed_shows_its_voxels(&mut s);
     a_dielectric_asks_for_the_bounces_it_needs(&mut s);
     selection_operations_land_and_a_selection_gets_a_material_of_its_own(&mut s);
+    arrange_mode_picks_and_moves_an_object(&mut s);
     the_docks_leave_the_viewport_framing_fits_it_and_the_palette_paints(&mut s);
     without_a_dialog_save_as_and_open_ask_in_the_browser(&mut s, &dir);
     the_first_click_on_an_empty_scene_attaches_on_the_floor(&mut s, &dir);

@@ -171,7 +171,7 @@ fn object_commands_and_edits_keep_the_composite_and_undo_and_redo_exactly() {
     run(
         &mut doc,
         Command::Object(ObjectCommand::Translate {
-            node: b,
+            nodes: vec![b],
             by: IVec3::new(3, 1, -2),
         }),
     );
@@ -217,7 +217,7 @@ fn object_commands_and_edits_keep_the_composite_and_undo_and_redo_exactly() {
     run(
         &mut doc,
         Command::Object(ObjectCommand::Translate {
-            node: group,
+            nodes: vec![group],
             by: IVec3::new(1, 0, 1),
         }),
     );
@@ -230,7 +230,7 @@ fn object_commands_and_edits_keep_the_composite_and_undo_and_redo_exactly() {
         }),
     );
     // The active object deleted: the first one left becomes active; undo brings it back.
-    run(&mut doc, Command::Object(ObjectCommand::Delete(a)));
+    run(&mut doc, Command::Object(ObjectCommand::Delete(vec![a])));
     assert_ne!(doc.scene.active(), Some(a));
     let active = doc.scene.active().unwrap();
     let at = centre(&doc, active);
@@ -245,7 +245,7 @@ fn object_commands_and_edits_keep_the_composite_and_undo_and_redo_exactly() {
     );
     let before = (outline(&doc), doc.scene.world.read().content_hash());
     let refused = doc.execute(Command::Object(ObjectCommand::Translate {
-        node: active,
+        nodes: vec![active],
         by: IVec3::X,
     }));
     assert!(refused.is_err());
@@ -313,7 +313,12 @@ fn a_selection_splits_into_a_new_object_that_edits_apart() {
     assert_eq!(solid(&doc, terrain), ground);
     assert_composite(&doc, "split and painted");
     // Its model is the selected voxels' box: it moves within the grid.
-    let translate = |node, by: IVec3| Command::Object(ObjectCommand::Translate { node, by });
+    let translate = |node, by: IVec3| {
+        Command::Object(ObjectCommand::Translate {
+            nodes: vec![node],
+            by,
+        })
+    };
     doc.execute(translate(split, IVec3::new(40, 0, 40)))
         .unwrap();
     assert_composite(&doc, "moved");

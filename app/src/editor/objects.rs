@@ -45,10 +45,10 @@ pub enum ObjectCommand {
         /// Its new name.
         name: String,
     },
-    /// Moves a node by whole voxels (in its parent's frame).
+    /// Moves nodes by whole voxels (each in its parent's frame).
     Translate {
-        /// The node.
-        node: NodeId,
+        /// The nodes.
+        nodes: Vec<NodeId>,
         /// The move.
         by: IVec3,
     },
@@ -84,8 +84,8 @@ pub enum ObjectCommand {
     },
     /// The object gets its own copy of its shared model.
     MakeUnique(NodeId),
-    /// Removes a node, its subtree and the models only they placed.
-    Delete(NodeId),
+    /// Removes nodes, their subtrees and the models only they placed.
+    Delete(Vec<NodeId>),
     /// A new group holding the nodes, where the first one was.
     Group {
         /// The nodes.
@@ -126,7 +126,7 @@ impl ObjectCommand {
                 format!("{} #{}", if *locked { "Lock" } else { "Unlock" }, node.0)
             }
             Self::Rename { node, name } => format!("Rename #{} to {name:?}", node.0),
-            Self::Translate { node, by } => format!("Move #{} by {by}", node.0),
+            Self::Translate { nodes, by } => format!("Move {} by {by}", names(nodes)),
             Self::Turn {
                 node,
                 axis,
@@ -136,7 +136,7 @@ impl ObjectCommand {
             Self::Duplicate { node, .. } => format!("Duplicate #{}", node.0),
             Self::Instance { node, .. } => format!("Instance #{}", node.0),
             Self::MakeUnique(n) => format!("Make #{} unique", n.0),
-            Self::Delete(n) => format!("Delete #{}", n.0),
+            Self::Delete(nodes) => format!("Delete {}", names(nodes)),
             Self::Group { nodes, .. } => format!("Group {} nodes", nodes.len()),
             Self::Ungroup(n) => format!("Ungroup #{}", n.0),
             Self::Merge { nodes, .. } => format!("Merge {} objects", nodes.len()),
@@ -257,7 +257,12 @@ impl ObjectCommand {
                     name: name.clone(),
                 }
             }
-            Self::Translate { node, by } => placed(*node, &|p| Placement { t: p.t + *by, ..p })?,
+            Self::Translate { nodes, by } => ObjectOp::Batch(
+                nodes
+                    .iter()
+                    .map(|n| placed(*n, &|p| Placement { t: p.t + *by, ..p }))
+                    .collect::<Result<_>>()?,
+            ),
             Self::Turn {
                 node,
                 axis,
@@ -273,7 +278,7 @@ impl ObjectCommand {
             Self::Duplicate { node, offset } => arrange::duplicate(&objects, *node, *offset)?,
             Self::Instance { node, offset } => arrange::instance(&objects, *node, *offset)?,
             Self::MakeUnique(node) => arrange::make_unique(&objects, *node)?,
-            Self::Delete(node) => arrange::delete(&objects, *node)?,
+            Self::Delete(nodes) => arrange::delete(&objects, nodes)?,
             Self::Group { nodes, name } => arrange::group(&objects, nodes, name)?,
             Self::Ungroup(node) => arrange::ungroup(&objects, *node)?,
             Self::Merge { nodes, name } => arrange::merge(&objects, nodes, name, &table)?,
@@ -314,4 +319,12 @@ fn larger(lo: IVec3, hi: IVec3, grid: IVec3) -> Option<(GridDims, IVec3)> {
     let need = hi.max(grid) + shift;
     let dims = GridDims::from_voxels(need.as_uvec3()).ok()?;
     Some((dims, shift))
+}
+
+/// Node ids for a label: "#3" or "3 nodes".
+fn names(nodes: &[NodeId]) -> String {
+    match nodes {
+        [n] => format!("#{}", n.0),
+        _ => format!("{} nodes", nodes.len()),
+    }
 }

@@ -56,9 +56,19 @@ impl Editor {
                 self.settings.brush.tool = Tool::Brush;
             }
             Action::SelectTool => self.settings.brush.tool = Tool::Select,
+            Action::ArrangeTool => {
+                self.settings.brush.tool = if self.settings.brush.tool == Tool::Arrange {
+                    Tool::Brush
+                } else {
+                    Tool::Arrange
+                }
+            }
             Action::RemoveUnusedMaterials => self.execute(Command::RemoveUnusedMaterials),
             Action::SelectAll => self.select(SelectOp::All),
             Action::SelectNone => self.select(SelectOp::None),
+            Action::DeleteSelection if self.settings.brush.tool == Tool::Arrange => {
+                self.arrange_delete()
+            }
             Action::DeleteSelection => self.execute(Command::DeleteSelection),
             Action::FillSelection => {
                 self.execute(Command::FillSelection(self.settings.brush.material))
@@ -71,6 +81,7 @@ impl Editor {
             // The copy is on the document once queued edits (a copy just asked for) ran;
             // until then the placement shows nothing and a click pastes nothing.
             Action::Paste => self.pointer.pasting = true,
+            Action::Nudge(n) if self.settings.brush.tool == Tool::Arrange => self.arrange_nudge(n),
             Action::Nudge(n) => self.nudge(n),
             Action::Help => self.panels.help_open = !self.panels.help_open,
             Action::Quit => self.guard_unsaved(Pending::Quit),

@@ -215,6 +215,7 @@ fn tools(
             }
         }
         ui.selectable_value(&mut brush.tool, Tool::Select, "Select  M");
+        ui.selectable_value(&mut brush.tool, Tool::Arrange, "Arrange  Tab");
     });
     ui.horizontal_wrapped(|ui| {
         for (s, name) in [

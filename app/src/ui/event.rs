@@ -168,6 +168,19 @@ impl Input {
     /// Whether egui keeps the event to itself (egui-winit's rule: pointer events while egui
     /// wants the pointer — a move only while it is using it —, keys while it wants the
     /// keyboard).
+    /// Whether egui is kept from seeing this input: Tab is arrange mode's key, which egui
+    /// would take for moving its focus (and keep the arrows after), unless a text field has
+    /// the focus.
+    pub fn kept_from(&self, egui: &egui::Context) -> bool {
+        matches!(
+            self,
+            Self::Key {
+                code: winit::keyboard::KeyCode::Tab,
+                ..
+            }
+        ) && !egui.egui_wants_keyboard_input()
+    }
+
     pub fn consumed_by(&self, egui: &egui::Context) -> bool {
         match self {
             Self::Moved { .. } => egui.egui_is_using_pointer(),

@@ -287,6 +287,8 @@ impl Editor {
                 .map(|d| (d.first, d.last));
             let empty = doc.scene.world.read().solid_count() == 0;
             let dragged = self.dragged_box();
+            let picked =
+                super::arranging::picked_boxes(&doc.scene.objects(), &self.panels.outliner.picked);
             egui_ctx.run_ui(raw, |ui| {
                 // Under every panel and window, over the viewport image.
                 let painter = ui.ctx().layer_painter(egui::LayerId::background());
@@ -309,6 +311,7 @@ impl Editor {
                     dragged,
                     paste,
                 );
+                super::arranging::paint(&painter, &self.viewing.camera, rect, &picked);
                 if empty {
                     preview::paint_floor(&painter, &self.viewing.camera, rect, dims);
                 }

@@ -226,6 +226,10 @@ impl Editor {
             self.select_press();
             return;
         }
+        if self.settings.brush.tool == Tool::Arrange && !self.pointer.mods.alt {
+            self.arrange_press();
+            return;
+        }
         let (origin, dir) = self.cursor_ray();
         let doc = self.doc.clone();
         let doc = doc.read().unwrap_or_else(|p| p.into_inner());
@@ -303,7 +307,7 @@ impl Editor {
     ) -> Option<crate::editor::command::Stroke> {
         let brush = &self.settings.brush;
         let dims = view.dims().voxels();
-        if brush.tool == Tool::Select || self.pointer.pasting {
+        if brush.tool != Tool::Brush || self.pointer.pasting {
             return None;
         }
         match &self.pointer.drawing {

@@ -53,14 +53,16 @@ impl Editor {
             Input::Modifiers(m) => *m,
             _ => self.pointer.mods,
         };
+        let kept = input.kept_from(&self.egui);
         if let Some(Gfx {
             host: Host::Headless(h),
             ..
         }) = &mut self.gfx
+            && !kept
         {
             h.push(&input, mods);
         }
-        let consumed = input.consumed_by(&self.egui);
+        let consumed = !kept && input.consumed_by(&self.egui);
         self.input_with(input, consumed);
     }
 

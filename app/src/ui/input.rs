@@ -58,6 +58,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "M",
         "selection tool (drag a box on a face; Shift adds, Ctrl subtracts)",
     ),
+    (
+        "Tab",
+        "arrange mode (again: the brush): click picks an object, Shift adds, Ctrl takes away; arrows move the picked ones, Delete deletes them",
+    ),
     ("Ctrl+A / Ctrl+D", "select all / nothing"),
     (
         "Delete, Ctrl+F, Ctrl+P",

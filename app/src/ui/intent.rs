@@ -59,6 +59,8 @@ pub enum Action {
     RemoveUnusedMaterials,
     /// The selection tool.
     SelectTool,
+    /// Arrange mode (pick and move objects), or back to the brush.
+    ArrangeTool,
     /// Select the whole grid.
     SelectAll,
     /// Select nothing.

@@ -154,6 +154,7 @@ pub fn default_bindings() -> Vec<Binding> {
         ("L", Action::Shape(BrushShape::Line)),
         ("R", Action::Shape(BrushShape::Box)),
         ("M", Action::SelectTool),
+        ("Tab", Action::ArrangeTool),
         ("Ctrl+A", Action::SelectAll),
         ("Ctrl+D", Action::SelectNone),
         ("Delete", Action::DeleteSelection),

@@ -17,6 +17,7 @@
 //! native dialog (tested with `VOXBRICK_TEST_GPU_FAILURE_AT_FRAME`).
 
 mod actions;
+mod arranging;
 mod browser;
 mod budget;
 pub mod camera;
@@ -424,7 +425,9 @@ impl ApplicationHandler<Wake> for Editor {
             WindowEvent::ScaleFactorChanged { .. } => self.request_redraw(),
             _ => {
                 let input = Input::from_window_event(&event);
+                let tab = input.as_ref().is_some_and(|i| i.kept_from(&self.egui));
                 let consumed = match &mut self.gfx {
+                    _ if tab => false,
                     Some(Gfx {
                         host:
                             Host::Window {

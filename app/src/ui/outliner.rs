@@ -158,10 +158,8 @@ fn commands(
             );
             state.picked.clear();
         }
-        if let Some(n) = first
-            && ui.button("Delete").clicked()
-        {
-            send(out, ObjectCommand::Delete(n));
+        if first.is_some() && ui.button("Delete").clicked() {
+            send(out, ObjectCommand::Delete(state.picked.clone()));
             state.picked.clear();
         }
         if let Some(node) = first {
@@ -196,7 +194,7 @@ fn commands(
                     send(
                         out,
                         ObjectCommand::Translate {
-                            node,
+                            nodes: state.picked.clone(),
                             by: by * step,
                         },
                     );

@@ -46,6 +46,8 @@ pub enum Tool {
     Brush,
     /// Drag selection boxes.
     Select,
+    /// Pick and move objects (arrange mode).
+    Arrange,
 }
 
 impl Default for Brush {

@@ -70,18 +70,30 @@ fn add_after(
     })
 }
 
-/// Removes a node and its subtree, and the models only they placed (a file saved after it
-/// holds no model nothing places).
-pub fn delete(o: &Objects, node: NodeId) -> Result<ObjectOp, ObjectError> {
+/// Removes nodes with their subtrees (a node inside another one removed goes with it), and
+/// the models only they placed (a file saved after it holds no model nothing places).
+pub fn delete(o: &Objects, nodes: &[NodeId]) -> Result<ObjectOp, ObjectError> {
     let tree = o.tree();
-    let gone = tree.subtree(node)?;
+    let mut tops: Vec<NodeId> = Vec::new();
+    let mut gone: Vec<NodeId> = Vec::new();
+    for n in nodes {
+        if !gone.contains(n) {
+            for g in tree.subtree(*n)? {
+                if let Some(i) = tops.iter().position(|t| *t == g) {
+                    tops.remove(i);
+                }
+                gone.push(g);
+            }
+            tops.push(*n);
+        }
+    }
     let mut models = std::collections::BTreeSet::new();
     for n in &gone {
         if let NodeKind::Object { model, .. } = tree.node(*n)?.kind {
             models.insert(model);
         }
     }
-    let mut ops = vec![ObjectOp::Remove { node }];
+    let mut ops: Vec<ObjectOp> = tops.iter().map(|n| ObjectOp::Remove { node: *n }).collect();
     for model in models {
         if tree.instances(model).iter().all(|i| gone.contains(i)) {
             ops.push(ObjectOp::RemoveModel { model });

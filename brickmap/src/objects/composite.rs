@@ -148,6 +148,22 @@ impl Composite {
         })
     }
 
+    /// The drawn object whose voxel shows at world cell `v` (the last in drawing order
+    /// holding one there), if any.
+    pub fn object_at(&self, v: IVec3, models: &impl ModelSource) -> Option<NodeId> {
+        if v.cmplt(IVec3::ZERO).any() {
+            return None;
+        }
+        let cell = (v / (8 * CELL_BRICKS)).to_array();
+        self.index.get(&cell)?.iter().rev().find_map(|&i| {
+            let e = &self.entries[i as usize];
+            let inside = v.cmpge(e.lo).all() && v.cmplt(e.hi).all();
+            let model = models.model(e.drawn.model)?;
+            (inside && model.voxel(e.drawn.placement.unplace(v, e.size)).is_some())
+                .then_some(e.drawn.node)
+        })
+    }
+
     /// The drawn objects, in drawing order.
     pub fn drawn(&self) -> impl Iterator<Item = Drawn> + '_ {
         self.entries.iter().map(|e| e.drawn)

@@ -617,6 +617,11 @@ impl Objects {
         }
     }
 
+    /// The object whose voxel shows at world cell `v`, if any (what a click picks).
+    pub fn object_at(&self, v: IVec3) -> Option<NodeId> {
+        self.composite.object_at(v, &self.models)
+    }
+
     /// The grid the composite fills, in voxels.
     pub fn grid(&self) -> IVec3 {
         self.grid

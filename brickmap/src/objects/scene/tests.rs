@@ -343,3 +343,42 @@ fn a_grid_adopted_as_one_object_edits_as_the_grid() {
         worlds[1].read().solid_count()
     );
 }
+
+/// A click's object: at every solid world cell, the object the reference says drew it.
+#[test]
+fn the_object_at_a_cell_is_the_one_whose_voxel_shows_there() {
+    let (o, w) = start(2);
+    let view = w.read();
+    let mut seen = 0;
+    for d in o.tree().drawn() {
+        let m = o.model(d.model).unwrap();
+        for (b, brick) in m.bricks() {
+            for bit in brick.mask.ones() {
+                let v = b.as_ivec3() * 8
+                    + IVec3::new(bit as i32 & 7, (bit as i32 >> 3) & 7, bit as i32 >> 6);
+                let cell = d.placement.place(v, m.size());
+                // The last drawn object with a voxel at the cell is the one shown.
+                let shown = o
+                    .tree()
+                    .drawn()
+                    .into_iter()
+                    .rev()
+                    .find(|e| {
+                        let em = o.model(e.model).unwrap();
+                        em.voxel(e.placement.unplace(cell, em.size())).is_some()
+                    })
+                    .unwrap();
+                assert_eq!(o.object_at(cell), Some(shown.node), "{cell}");
+                assert!(view.voxel(cell).unwrap().is_some());
+                seen += 1;
+            }
+        }
+    }
+    assert!(seen > 100);
+    assert_eq!(o.object_at(IVec3::new(-1, 0, 0)), None);
+    let empty = (0..64)
+        .map(|x| IVec3::new(x, 31, 47))
+        .find(|v| view.voxel(*v).unwrap().is_none())
+        .unwrap();
+    assert_eq!(o.object_at(empty), None);
+}
