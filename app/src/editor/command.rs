@@ -454,17 +454,15 @@ impl Command {
                     (params.height_range, params.water_level) = (t.height_range, t.water_level);
                     (params.rock_line, params.snow_line, params.soil_depth) =
                         (t.bands.rock_line, t.bands.snow_line, t.bands.soil_depth);
+                    let b = world.dims().bricks();
                     let edit = match NoiseTerrain::new(params, world.dims())?.edit() {
-                        EditOp::Generate(g) => EditOp::Generate(brickmap::edit::Generator(
-                            std::sync::Arc::new(super::progress::Counted {
-                                inner: g.0,
-                                progress: progress.clone(),
-                            }),
-                        )),
+                        EditOp::Generate(g) => {
+                            EditOp::Generate(brickmap::edit::Generator(std::sync::Arc::new(
+                                super::progress::Counted::new(g.0, progress.clone(), (b.x, b.z)),
+                            )))
+                        }
                         other => other,
                     };
-                    let b = world.dims().bricks();
-                    progress.start(b.x as u64 * b.z as u64);
                     let out = scene.edit(edit);
                     progress.finish();
                     Ok::<_, EditError>(out?)

@@ -47,12 +47,36 @@ impl Progress {
     }
 }
 
-/// A column source that counts the columns it produced.
+/// A column source that counts the columns it produced, each once (a flat scene's model and
+/// world are generated at the same time, from the same source).
 pub(super) struct Counted {
     /// What produces the columns.
-    pub inner: std::sync::Arc<dyn brickmap::edit::ColumnSource>,
+    inner: std::sync::Arc<dyn brickmap::edit::ColumnSource>,
     /// Where the count goes.
-    pub progress: std::sync::Arc<Progress>,
+    progress: std::sync::Arc<Progress>,
+    /// Columns produced so far, x fastest.
+    seen: Vec<std::sync::atomic::AtomicBool>,
+    /// Columns along x.
+    width: u32,
+}
+
+impl Counted {
+    /// Counts `inner`'s columns of a grid of `columns` (x, z) brick columns into `progress`,
+    /// which starts now.
+    pub fn new(
+        inner: std::sync::Arc<dyn brickmap::edit::ColumnSource>,
+        progress: std::sync::Arc<Progress>,
+        columns: (u32, u32),
+    ) -> Self {
+        let n = columns.0 as usize * columns.1 as usize;
+        progress.start(n as u64);
+        Self {
+            inner,
+            progress,
+            seen: (0..n).map(|_| Default::default()).collect(),
+            width: columns.0,
+        }
+    }
 }
 
 impl brickmap::edit::ColumnSource for Counted {
@@ -63,7 +87,14 @@ impl brickmap::edit::ColumnSource for Counted {
         emit: &mut dyn FnMut(u32, brickmap::Mask, brickmap::PriorMaterials),
     ) {
         self.inner.column(bx, bz, emit);
-        self.progress.step();
+        let at = bz as usize * self.width as usize + bx as usize;
+        if self
+            .seen
+            .get(at)
+            .is_some_and(|s| !s.swap(true, Ordering::Relaxed))
+        {
+            self.progress.step();
+        }
     }
     fn materials(&self) -> Vec<u8> {
         self.inner.materials()

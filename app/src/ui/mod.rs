@@ -36,7 +36,7 @@ mod intent;
 pub mod jobs;
 pub mod keymap;
 mod motion;
-mod outliner;
+pub mod outliner;
 pub mod panels;
 mod pending;
 mod pointer;

@@ -148,6 +148,21 @@ impl Composite {
         })
     }
 
+    /// The model of the only drawn object when it places it unrotated at the origin and
+    /// it fills the grid (a flat scene): the world is then the model, voxel for voxel, and
+    /// an edit of the model is the same edit of the world.
+    pub fn flat(&self) -> Option<ModelId> {
+        match self.entries.as_slice() {
+            [e] if e.lo == IVec3::ZERO
+                && e.size == self.grid
+                && e.drawn.placement.rot == super::orient::Orientation::IDENTITY =>
+            {
+                Some(e.drawn.model)
+            }
+            _ => None,
+        }
+    }
+
     /// The drawn object whose voxel shows at world cell `v` (the last in drawing order
     /// holding one there), if any.
     pub fn object_at(&self, v: IVec3, models: &impl ModelSource) -> Option<NodeId> {

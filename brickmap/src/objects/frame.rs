@@ -59,11 +59,21 @@ impl Placement {
                 points: points.iter().map(point).collect(),
                 radius: *radius,
             },
-            Shape::Set(set) => Shape::Set(Arc::new(self.set_to_model(set, size))),
+            Shape::Set(set) => Shape::Set(self.set_arc_to_model(set, size)),
             Shape::Within { shape, set } => Shape::Within {
                 shape: Box::new(self.shape_to_model(shape, size)),
-                set: Arc::new(self.set_to_model(set, size)),
+                set: self.set_arc_to_model(set, size),
             },
+        }
+    }
+
+    /// [`Placement::set_to_model`], shared as it is where the model's frame is the world's
+    /// (the model clips a set to itself as it clips any shape).
+    fn set_arc_to_model(&self, set: &Arc<VoxelSet>, size: IVec3) -> Arc<VoxelSet> {
+        if self.brick_shift(size) == Some(IVec3::ZERO) {
+            set.clone()
+        } else {
+            Arc::new(self.set_to_model(set, size))
         }
     }
 

@@ -582,6 +582,32 @@ impl Objects {
             .models
             .get_mut(&model)
             .ok_or(ObjectError::NoModel(model))?;
+        if self.composite.flat() == Some(model) {
+            // A flat scene: the world is the model, so it takes the same edit, on its
+            // workers while the model is edited here (no composite to recompute).
+            let ticket = world.submit(edit.clone())?;
+            let out = m.apply(edit, table);
+            let written = ticket.wait();
+            return match (out, written) {
+                (Ok(out), Ok(_)) => {
+                    *changed += out.changed_voxels;
+                    Ok(ObjectOp::RestoreModel {
+                        model,
+                        inverse: out.inverse,
+                    })
+                }
+                (Ok(out), Err(e)) => {
+                    m.apply(&EditOp::Restore(out.inverse), table)
+                        .expect("a model takes its own inverse");
+                    Err(e.into())
+                }
+                (Err(e), Ok(w)) => {
+                    world.apply(EditOp::Restore(w.inverse))?;
+                    Err(e.into())
+                }
+                (Err(e), Err(_)) => Err(e.into()),
+            };
+        }
         let out = m.apply(edit, table)?;
         if let Err(e) = self
             .composite
