@@ -262,9 +262,24 @@ impl Model {
                     Mode::Remove => None,
                 };
                 let paint = matches!(mode, Mode::Paint(_));
+                let constant = match mode {
+                    Mode::Add(m) => Some(Some(*m)),
+                    Mode::Remove => Some(None),
+                    Mode::Paint(_) => None,
+                };
                 let one = |b: &UVec3| {
-                    let touched = shape.mask(b.as_ivec3() * 8).and(&self.inside(*b));
-                    self.rewrite(*b, &touched, value, paint)
+                    // As the world does: whole bricks inside or outside the shape need no
+                    // voxel-by-voxel mask.
+                    let region = match shape.coverage(b.as_ivec3() * 8) {
+                        crate::shape::Coverage::Outside => return None,
+                        crate::shape::Coverage::Inside => Mask::FULL,
+                        crate::shape::Coverage::Partial => shape.mask(b.as_ivec3() * 8),
+                    };
+                    let touched = region.and(&self.inside(*b));
+                    match constant {
+                        Some(v) => self.rewrite_to(*b, &touched, v),
+                        None => self.rewrite(*b, &touched, value, paint),
+                    }
                 };
                 let rewrites = self.on_cores(&list, |b| one(b).into_iter().collect());
                 rewrites
@@ -281,6 +296,10 @@ impl Model {
                 }
                 let mut changed = 0;
                 for u in &inv.bricks {
+                    if let Some(r) = self.restore_uniform(u) {
+                        changed += r.map_or(0, |r| self.commit(r, &mut undo));
+                        continue;
+                    }
                     let prior = u.prior_mask.and(&u.touched);
                     changed += self.write(
                         u.brick,
@@ -479,6 +498,106 @@ impl Model {
             brick: (!mask.is_empty()).then(|| ModelBrick::packed(mask, mats)),
             changed,
         })
+    }
+
+    /// [`Model::rewrite`] of every touched voxel to one value (`None`: empty), a mask at a
+    /// time where the brick holds one material (most bricks a shape covers); else voxel by
+    /// voxel.
+    fn rewrite_to(&self, b: UVec3, touched: &Mask, v: Option<u8>) -> Option<Rewrite> {
+        let old = self.bricks.get(&key(b));
+        let (old_mask, u) = match old {
+            None => (Mask::EMPTY, 0),
+            Some(o) => match o.uniform() {
+                Some(u) => (o.mask, u),
+                None => return self.rewrite(b, touched, |_, _| v, false),
+            },
+        };
+        if touched.is_empty() {
+            return None;
+        }
+        let held = old_mask.and(touched);
+        let (mask, materials, changed) = match v {
+            Some(m) => {
+                let mask = old_mask.or(touched);
+                let recoloured = if u == m { 0 } else { held.count() };
+                let changed = touched.and_not(&old_mask).count() + recoloured;
+                let kept = old_mask.and_not(touched);
+                let materials = if u == m || kept.is_empty() {
+                    BrickMaterials::Uniform(m)
+                } else {
+                    let mut per = Box::new([0u8; 512]);
+                    kept.ones().for_each(|bit| per[bit] = u);
+                    touched.ones().for_each(|bit| per[bit] = m);
+                    BrickMaterials::PerVoxel(per)
+                };
+                (mask, materials, changed)
+            }
+            None => (
+                old_mask.and_not(touched),
+                BrickMaterials::Uniform(u),
+                held.count(),
+            ),
+        };
+        if changed == 0 {
+            return None;
+        }
+        Some(Rewrite {
+            undo: BrickUndo {
+                brick: b,
+                prior_mask: old_mask,
+                touched: *touched,
+                prior: PriorMaterials::Uniform(u),
+            },
+            brick: (!mask.is_empty()).then_some(ModelBrick { mask, materials }),
+            changed: changed as u64,
+        })
+    }
+
+    /// A brick restore a mask at a time, where the brick and the restored voxels each hold
+    /// one material (what pastes, moves and imports mostly write); `None` where it does not
+    /// apply (then voxel by voxel), `Some(None)` where nothing changes.
+    fn restore_uniform(&self, u: &BrickUndo) -> Option<Option<Rewrite>> {
+        let PriorMaterials::Uniform(p) = u.prior else {
+            return None;
+        };
+        let (old_mask, c) = match self.bricks.get(&key(u.brick)) {
+            None => (Mask::EMPTY, 0),
+            Some(o) => (o.mask, o.uniform()?),
+        };
+        let touched = u.touched;
+        let set = u.prior_mask.and(&touched);
+        let kept = old_mask.and_not(&touched);
+        let mask = kept.or(&set);
+        let flipped = Mask(std::array::from_fn(|i| old_mask.0[i] ^ set.0[i])).and(&touched);
+        let recoloured = if c == p {
+            0
+        } else {
+            old_mask.and(&set).count()
+        };
+        let changed = flipped.count() + recoloured;
+        if changed == 0 {
+            return Some(None);
+        }
+        let materials = if set.is_empty() || c == p {
+            BrickMaterials::Uniform(if set.is_empty() { c } else { p })
+        } else if kept.is_empty() {
+            BrickMaterials::Uniform(p)
+        } else {
+            let mut per = Box::new([0u8; 512]);
+            kept.ones().for_each(|bit| per[bit] = c);
+            set.ones().for_each(|bit| per[bit] = p);
+            BrickMaterials::PerVoxel(per)
+        };
+        Some(Some(Rewrite {
+            undo: BrickUndo {
+                brick: u.brick,
+                prior_mask: old_mask,
+                touched,
+                prior: PriorMaterials::Uniform(c),
+            },
+            brick: (!mask.is_empty()).then_some(ModelBrick { mask, materials }),
+            changed: changed as u64,
+        }))
     }
 
     /// Stores a computed rewrite and records its undo; returns the voxels changed.
