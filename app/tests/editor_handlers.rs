@@ -700,8 +700,8 @@ fn selection_operations_land_and_a_selection_gets_a_material_of_its_own(s: &mut 
 
 /// Arrange mode: Tab, then a click picks the object under the cursor and an arrow moves it
 /// (the scene's one grid-sized object: past the grid's side, so the grid grows and the
-/// viewport takes the new world, validated); Ctrl + Z puts it back and the grid with it;
-/// Tab again is the brush.
+/// viewport takes the new world, validated); Ctrl + Z puts it back and the grid with it; a
+/// drag from it moves it by one step at the release; Tab again is the brush.
 fn arrange_mode_picks_and_moves_an_object(s: &mut Session) {
     s.quiet();
     let grid = |s: &Session| s.ed.document().read().unwrap().scene.world.dims();
@@ -728,6 +728,22 @@ fn arrange_mode_picks_and_moves_an_object(s: &mut Session) {
     s.quiet();
     assert_eq!(s.state().0, before.0);
     assert_eq!(grid(s), dims);
+    // A drag that starts on the picked object moves it once, at the release.
+    s.to(at);
+    s.frame();
+    s.left(true);
+    for k in 1..=8 {
+        s.to((at.0 + 8.0 * f64::from(k), at.1 + 3.0 * f64::from(k)));
+        s.frame();
+    }
+    assert_eq!(s.state(), before, "nothing moves before the release");
+    s.left(false);
+    s.quiet();
+    assert_eq!(s.state().1, before.1 + 1, "the drag is one step");
+    assert_ne!(s.state().0, before.0);
+    s.ctrl(KeyCode::KeyZ);
+    s.quiet();
+    assert_eq!(s.state(), before);
     s.key(KeyCode::Tab, true);
     s.key(KeyCode::Tab, false);
     s.quiet();

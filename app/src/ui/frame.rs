@@ -287,8 +287,13 @@ impl Editor {
                 .map(|d| (d.first, d.last));
             let empty = doc.scene.world.read().solid_count() == 0;
             let dragged = self.dragged_box();
-            let picked =
-                super::arranging::picked_boxes(&doc.scene.objects(), &self.panels.outliner.picked);
+            // The picked objects' boxes, where a drag of them would put them.
+            let by = self.dragged_by();
+            let picked: Vec<_> =
+                super::arranging::picked_boxes(&doc.scene.objects(), &self.panels.outliner.picked)
+                    .into_iter()
+                    .map(|(lo, hi)| (lo + by, hi + by))
+                    .collect();
             egui_ctx.run_ui(raw, |ui| {
                 // Under every panel and window, over the viewport image.
                 let painter = ui.ctx().layer_painter(egui::LayerId::background());

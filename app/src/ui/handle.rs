@@ -182,6 +182,7 @@ impl Editor {
                 self.motion.settling();
             }
             (false, MouseButton::Left) if self.pointer.selecting.is_some() => self.select_release(),
+            (false, MouseButton::Left) if self.pointer.moving.is_some() => self.arrange_release(),
             (true, _) if free => {
                 self.pointer.drag = input::drag_for_button(button, self.pointer.mods)
                     .map(|d| (d, self.pointer.cursor));
@@ -213,6 +214,7 @@ impl Editor {
         }
         self.stroke_to_cursor();
         self.select_to_cursor();
+        self.arrange_to_cursor();
     }
 
     /// Left button down: a paste being placed goes down, the eyedropper (Alt), the selection

@@ -1,5 +1,6 @@
 //! The pointer and the gesture it is making: the modifier keys held, the cursor, a camera
-//! drag, a stroke being drawn, a selection box being dragged, a paste following the cursor.
+//! drag, a stroke being drawn, a selection box being dragged, a paste following the cursor,
+//! picked objects being dragged (arrange mode).
 //! `handle.rs` and `selecting.rs` change it; the frame reads it (the paste preview, whether a
 //! stroke is drawn); replacing the document ends every gesture.
 
@@ -12,6 +13,15 @@ pub(super) struct Drawing {
     pub(super) layer: tools::Layer,
     pub(super) first: glam::IVec3,
     pub(super) last: glam::IVec3,
+}
+
+/// Picked objects being dragged (arrange mode) over the horizontal plane at height `y`
+/// through the voxel the press hit: where the drag started on it, and the whole voxels moved
+/// so far (applied as one move at the release).
+pub(super) struct MoveDrag {
+    pub(super) y: f64,
+    pub(super) start: glam::DVec3,
+    pub(super) by: glam::IVec3,
 }
 
 /// What the pointer is doing.
@@ -29,14 +39,17 @@ pub(super) struct Pointer {
     pub(super) selecting: Option<SelectDrag>,
     /// A paste follows the cursor until a click.
     pub(super) pasting: bool,
+    /// Picked objects being dragged.
+    pub(super) moving: Option<MoveDrag>,
 }
 
 impl Pointer {
     /// Ends a paste and a selection drag (Escape, or a new document); whether one was on.
     pub(super) fn cancel_placing(&mut self) -> bool {
-        let was = self.pasting || self.selecting.is_some();
+        let was = self.pasting || self.selecting.is_some() || self.moving.is_some();
         self.pasting = false;
         self.selecting = None;
+        self.moving = None;
         was
     }
 
