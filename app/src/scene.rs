@@ -8,7 +8,10 @@
 //! is written directly (a generator building one, then [`Scene::new`] adopting it).
 
 use crate::selection::{Clip, Selection};
-use brickmap::objects::{NodeId, NodeKind, ObjectError, ObjectOp, ObjectTree, Objects};
+use brickmap::objects::{
+    Composite, LayerId, Model, ModelId, ModelSource, NewNode, NodeId, NodeKind, ObjectError,
+    ObjectOp, ObjectTree, Objects,
+};
 use brickmap::{EditOp, GridDims, World, WorldConfig};
 use glam::IVec3;
 use render::SceneParams;
@@ -143,6 +146,47 @@ impl Scene {
         Ok((old, -shift))
     }
 
+    /// The world as the active object alone draws it (shown or hidden), for the reads that
+    /// must see only the object edits act on: copy, move, the flood fill. `None` where the
+    /// scene's own world is that (a flat scene, or no other object drawn). It costs a world
+    /// of the grid's size holding the object's box.
+    pub fn active_world(&self) -> Result<Option<World>, ObjectError> {
+        let Some(node) = self.active else {
+            return Ok(None);
+        };
+        let objects = self.objects();
+        let tree = objects.tree();
+        let drawn = tree.drawn();
+        if drawn.len() == 1 && drawn[0].node == node {
+            return Ok(None);
+        }
+        let NodeKind::Object { model, .. } = tree.node(node)?.kind else {
+            return Err(ObjectError::NotAnObject(node));
+        };
+        let m = objects.model(model).ok_or(ObjectError::NoModel(model))?;
+        let mut alone = ObjectTree::new();
+        let placement = tree.world_placement(node)?;
+        alone.add(
+            ObjectTree::ROOT,
+            None,
+            "alone",
+            placement,
+            NewNode::Object {
+                model,
+                layer: LayerId(0),
+            },
+        )?;
+        let world = World::new(
+            self.world.dims(),
+            WorldConfig::with_workers(self.world.workers()),
+        )?;
+        world.replace_materials(self.world.materials().clone())?;
+        let source = One(model, m);
+        let composite = Composite::new(&alone, &source, self.world.dims().voxels())?;
+        composite.write(&world, &composite.all_bricks(), &source)?;
+        Ok(Some(world))
+    }
+
     /// A voxel edit, in world voxels, of the active object (carried into its frame; its
     /// instances follow). Returns the inverse and the voxels changed.
     pub fn edit(&self, edit: EditOp) -> Result<(ObjectOp, u64), ObjectError> {
@@ -155,5 +199,14 @@ impl Scene {
     pub fn apply(&self, op: ObjectOp) -> Result<(ObjectOp, u64), ObjectError> {
         let table = self.world.materials().clone();
         self.objects().apply_counted(&self.world, op, &table)
+    }
+}
+
+/// One model, as the composite reads models.
+struct One<'a>(ModelId, &'a Model);
+
+impl ModelSource for One<'_> {
+    fn model(&self, id: ModelId) -> Option<&Model> {
+        (id == self.0).then_some(self.1)
     }
 }

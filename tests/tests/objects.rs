@@ -380,3 +380,38 @@ fn a_selection_splits_into_a_new_object_that_edits_apart() {
         .is_err()
     );
 }
+
+/// In a scene of several objects, the selection's reads see the active object alone: a move
+/// of a box where only another object shows moves nothing; made active, that object moves.
+#[test]
+fn selection_moves_read_the_active_object_alone() {
+    let scene = app::builtin::default_scene(app::builtin::SceneSize::Small, 2).unwrap();
+    let mut doc = Document::new(scene, History::default());
+    let terrain = doc.scene.active().unwrap();
+    let corner = app::selection::SelectOp::Replace {
+        min: IVec3::new(0, 0, 0),
+        max: IVec3::new(31, 63, 31),
+    };
+    doc.execute(Command::Select(corner.clone())).unwrap();
+    doc.execute(Command::Object(ObjectCommand::SplitSelection))
+        .unwrap();
+    let part = *objects_in_order(&doc)
+        .iter()
+        .find(|n| **n != terrain)
+        .unwrap();
+    doc.execute(Command::Select(corner)).unwrap();
+    let hash = doc.scene.world.read().content_hash();
+    // The terrain is active: it holds nothing in the box, so nothing moves (the part's
+    // voxels, which show there, are not copied into the terrain).
+    doc.execute(Command::MoveSelection(IVec3::new(40, 0, 40)))
+        .unwrap();
+    assert_eq!(doc.scene.world.read().content_hash(), hash);
+    assert_composite(&doc, "an empty move");
+    doc.undo().unwrap();
+    doc.execute(Command::Object(ObjectCommand::Activate(Some(part))))
+        .unwrap();
+    doc.execute(Command::MoveSelection(IVec3::new(40, 0, 40)))
+        .unwrap();
+    assert_ne!(doc.scene.world.read().content_hash(), hash);
+    assert_composite(&doc, "the part's voxels moved within it");
+}

@@ -341,19 +341,25 @@ impl Command {
             }
             Command::MoveSelection(offset) => {
                 let selection = selected(scene)?.clone();
-                let edit = selection::move_edit(&world.read(), &selection, *offset);
+                let alone = scene.active_world()?;
+                let source = alone.as_ref().unwrap_or(world);
+                let edit = selection::move_edit(&source.read(), &selection, *offset);
                 let moved =
                     Selection::new(selection.region.translated(*offset), world.dims().voxels());
                 with_selection(scene, edit, Some(moved))?
             }
             Command::Copy => {
-                let clip = Clip::copy(&world.read(), selected(scene)?)
+                let alone = scene.active_world()?;
+                let source = alone.as_ref().unwrap_or(world);
+                let clip = Clip::copy(&source.read(), selected(scene)?)
                     .ok_or(super::error::EditError::NothingToDo("nothing is selected"))?;
                 scene.clipboard = Some(std::sync::Arc::new(clip));
                 unchanged(Inverse::Compound(Vec::new()))
             }
             Command::Cut => {
-                let clip = Clip::copy(&world.read(), selected(scene)?)
+                let alone = scene.active_world()?;
+                let source = alone.as_ref().unwrap_or(world);
+                let clip = Clip::copy(&source.read(), selected(scene)?)
                     .ok_or(super::error::EditError::NothingToDo("nothing is selected"))?;
                 let applied = selection_edit(scene, Mode::Remove)?;
                 scene.clipboard = Some(std::sync::Arc::new(clip));

@@ -31,14 +31,17 @@ const NEIGHBOURS: [IVec3; 26] = {
     n
 };
 
-/// Paint edits for the connected surface of voxels sharing `start`'s material, seen from the
-/// camera or not; a voxel is on the surface when a face neighbour is empty or outside the
+/// Paint edits for the connected surface of the active object's voxels sharing `start`'s
+/// material, seen from the camera or not; a voxel is on the surface when a face neighbour is empty or outside the
 /// grid. Surface voxels connect through faces, edges and corners (26 neighbours): a curved
 /// surface's voxels often touch only along an edge (a sphere's, a hill's), and face
 /// neighbours alone stopped a fill at the first such step.
 pub(super) fn flood_fill(scene: &Scene, start: IVec3, material: u8) -> Result<Vec<VoxelEdit>> {
     const LIMIT: usize = 1 << 24;
-    let view = scene.world.read();
+    // The active object's voxels alone (in a scene of several objects, another's voxels
+    // neither join nor bound the surface).
+    let alone = scene.active_world()?;
+    let view = alone.as_ref().unwrap_or(&scene.world).read();
     let dims = view.dims();
     let target = view
         .voxel(start)?
