@@ -392,7 +392,7 @@ fn selection_moves_read_the_active_object_alone() {
         min: IVec3::new(0, 0, 0),
         max: IVec3::new(31, 63, 31),
     };
-    doc.execute(Command::Select(corner.clone())).unwrap();
+    doc.execute(Command::Select(corner)).unwrap();
     doc.execute(Command::Object(ObjectCommand::SplitSelection))
         .unwrap();
     let part = *objects_in_order(&doc)
