@@ -415,3 +415,53 @@ fn selection_moves_read_the_active_object_alone() {
     assert_ne!(doc.scene.world.read().content_hash(), hash);
     assert_composite(&doc, "the part's voxels moved within it");
 }
+
+/// Importing a `.vox` file into a scene adds its objects (a group named after the file,
+/// its groups, names, hidden parts and shared models) beside what is there; the grid grows
+/// to take them; undo takes them and the grid back exactly.
+#[test]
+fn an_imported_vox_file_joins_the_scene_as_its_objects() {
+    let scene = app::builtin::default_scene(app::builtin::SceneSize::Small, 2).unwrap();
+    let mut doc = Document::new(scene, History::default());
+    let (hash, grid, before) = (
+        doc.scene.world.read().content_hash(),
+        doc.scene.world.dims(),
+        objects_in_order(&doc).len(),
+    );
+    let park = asset("ogt_test_multiple_model_scene.vox");
+    let file = app::formats::load(&park, 1).unwrap();
+    doc.execute(Command::ImportVox {
+        path: park.to_string_lossy().into_owned(),
+        offset: IVec3::new(100, 0, 100),
+    })
+    .unwrap();
+    assert_composite(&doc, "imported");
+    let added = objects_in_order(&doc).len() - before;
+    assert_eq!(
+        added,
+        objects_in_order(&Document::new(file, History::default())).len()
+    );
+    assert_ne!(
+        doc.scene.world.dims(),
+        grid,
+        "the park does not fit beside the terrain"
+    );
+    {
+        let o = doc.scene.objects();
+        let group = *o
+            .tree()
+            .node(ObjectTree::ROOT)
+            .unwrap()
+            .children()
+            .last()
+            .unwrap();
+        assert_eq!(
+            o.tree().node(group).unwrap().name,
+            "ogt_test_multiple_model_scene"
+        );
+    }
+    doc.undo().unwrap();
+    assert_eq!(doc.scene.world.read().content_hash(), hash);
+    assert_eq!(doc.scene.world.dims(), grid);
+    assert_eq!(objects_in_order(&doc).len(), before);
+}

@@ -485,24 +485,30 @@ impl Command {
                 }
             }
             Command::ImportVox { path, offset } => {
+                // The file's objects (its groups, names, hidden parts, shared models) join
+                // the scene as a group named after the file, drawn last.
                 let file = folder.join(path);
                 let bytes =
                     std::fs::read(&file).map_err(|e| crate::formats::FormatError::io(&file, e))?;
                 let before = world.materials().clone();
-                let options = crate::formats::vox::ImportOptions {
-                    offset: *offset,
-                    ..Default::default()
-                };
-                let imported = crate::formats::vox::import_into(world, &bytes, &options, None)
-                    .map_err(|e| EditError::from(crate::formats::FormatError::vox(&file, e)))
-                    .and_then(|(report, edit)| Ok((report, scene.edit(edit)?)));
+                let name = file
+                    .file_stem()
+                    .map_or_else(|| "import".into(), |s| s.to_string_lossy().into_owned());
+                let imported = (|| {
+                    let into = crate::formats::vox::objects_into(&scene.world, &bytes, *offset)
+                        .map_err(|e| crate::formats::FormatError::vox(&file, e))?;
+                    let voxels = into.report.voxels;
+                    let op = super::objects::import_ops(scene, into, &name)?;
+                    let (inverse, _) = super::objects::apply_growing(scene, |_| Ok(op.clone()))?;
+                    Ok::<_, EditError>((inverse, voxels))
+                })();
                 match imported {
-                    Ok((report, (inverse, _))) => Applied {
-                        inverse: Inverse::Voxels(vec![inverse], Some(Box::new(before))),
-                        changed_voxels: report.voxels,
+                    Ok((inverse, voxels)) => Applied {
+                        inverse: Inverse::Compound(vec![Inverse::Table(Box::new(before)), inverse]),
+                        changed_voxels: voxels,
                     },
                     Err(e) => {
-                        world.replace_materials(before)?;
+                        scene.world.replace_materials(before)?;
                         return Err(e);
                     }
                 }

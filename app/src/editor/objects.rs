@@ -165,46 +165,7 @@ impl ObjectCommand {
                 changed_voxels: 0,
             });
         }
-        // An object placed past the grid grows it (a regrid, undone with the op).
-        let mut regrids = Vec::new();
-        let (inverse, changed_voxels) = loop {
-            let done = self.op(scene).and_then(|op| Ok(scene.apply(op)?));
-            let grown =
-                match &done {
-                    Err(EditError::Objects(ObjectError::Composite(
-                        CompositeError::OutsideGrid { lo, hi, grid, .. },
-                    ))) if regrids.len() < MAX_REGRIDS => larger(*lo, *hi, *grid),
-                    _ => None,
-                };
-            match (done, grown) {
-                (Ok(done), _) => break done,
-                (Err(_), Some((dims, shift))) => regrids.push(scene.regrid(dims, shift)?),
-                (Err(e), None) => {
-                    for (dims, shift) in regrids.into_iter().rev() {
-                        scene.regrid(dims, shift)?;
-                    }
-                    return Err(match e {
-                        EditError::Objects(ObjectError::Composite(
-                            CompositeError::OutsideGrid { node, lo, hi, grid },
-                        )) => invalid(format!(
-                            "object #{} would cover {lo}..{hi}: that needs a grid past the \
-                             largest, {}×{}×{} voxels (the grid is {}×{}×{})",
-                            node.0, MAX_GRID.x, MAX_GRID.y, MAX_GRID.z, grid.x, grid.y, grid.z
-                        )),
-                        e => e,
-                    });
-                }
-            }
-        };
-        let mut inverse = Inverse::Voxels(vec![inverse], None);
-        if !regrids.is_empty() {
-            let mut parts: Vec<Inverse> = regrids
-                .into_iter()
-                .map(|(dims, shift)| Inverse::Regrid(dims, shift))
-                .collect();
-            parts.push(inverse);
-            inverse = Inverse::Compound(parts);
-        }
+        let (inverse, changed_voxels) = apply_growing(scene, |scene| self.op(scene))?;
         // The active object gone (deleted, merged, ungrouped away): the first one left.
         let gone = before.is_some_and(|n| {
             !scene
@@ -299,6 +260,136 @@ impl ObjectCommand {
         };
         Ok(op)
     }
+}
+
+/// Applies the op `build` makes of the scene; where it would place an object past the grid,
+/// the grid grows first (a regrid, after which the op is built again: what it reads of the
+/// world moved) and the inverse shrinks it back after undoing the op. Past the largest grid
+/// the refusal names it; on any error the scene is as it was.
+pub(super) fn apply_growing(
+    scene: &mut Scene,
+    build: impl Fn(&Scene) -> Result<ObjectOp>,
+) -> Result<(Inverse, u64)> {
+    let mut regrids = Vec::new();
+    let (inverse, changed_voxels) =
+        loop {
+            let done = build(scene).and_then(|op| Ok(scene.apply(op)?));
+            let grown =
+                match &done {
+                    Err(EditError::Objects(ObjectError::Composite(
+                        CompositeError::OutsideGrid { lo, hi, grid, .. },
+                    ))) if regrids.len() < MAX_REGRIDS => larger(*lo, *hi, *grid),
+                    _ => None,
+                };
+            match (done, grown) {
+                (Ok(done), _) => break done,
+                (Err(_), Some((dims, shift))) => regrids.push(scene.regrid(dims, shift)?),
+                (Err(e), None) => {
+                    for (dims, shift) in regrids.into_iter().rev() {
+                        scene.regrid(dims, shift)?;
+                    }
+                    return Err(match e {
+                        EditError::Objects(ObjectError::Composite(
+                            CompositeError::OutsideGrid { node, lo, hi, grid },
+                        )) => invalid(format!(
+                            "object #{} would cover {lo}..{hi}: that needs a grid past the \
+                         largest, {}×{}×{} voxels (the grid is {}×{}×{})",
+                            node.0, MAX_GRID.x, MAX_GRID.y, MAX_GRID.z, grid.x, grid.y, grid.z
+                        )),
+                        e => e,
+                    });
+                }
+            }
+        };
+    let mut inverse = Inverse::Voxels(vec![inverse], None);
+    if !regrids.is_empty() {
+        let mut parts: Vec<Inverse> = regrids
+            .into_iter()
+            .map(|(dims, shift)| Inverse::Regrid(dims, shift))
+            .collect();
+        parts.push(inverse);
+        inverse = Inverse::Compound(parts);
+    }
+    Ok((inverse, changed_voxels))
+}
+
+/// The ops that add a `.vox` file's objects (from `formats::vox::objects_into`) to the
+/// scene: its models under unused ids, a group named `name` at the end of the drawing
+/// order holding the file's tree (the root's placement its own), hidden and locked nodes as
+/// the file has them. Node ids are predicted as the tree will give them (the lowest free,
+/// in order).
+pub(super) fn import_ops(
+    scene: &Scene,
+    into: crate::formats::vox::ObjectsInto,
+    name: &str,
+) -> Result<ObjectOp> {
+    use brickmap::objects::{ModelId, NewNode, ObjectTree};
+    let objects = scene.objects();
+    let tree = objects.tree();
+    let mut free_nodes = (0u32..).map(NodeId).filter(|n| tree.node(*n).is_err());
+    let mut free_models = (0u32..)
+        .map(ModelId)
+        .filter(|m| objects.model(*m).is_none());
+    let mut ops = Vec::new();
+    let mut model_ids = std::collections::BTreeMap::new();
+    for (id, model) in into.models {
+        let new = free_models.next().expect("fewer than 2^32 models");
+        model_ids.insert(id, new);
+        ops.push(ObjectOp::AddModel {
+            model: new,
+            voxels: Box::new(model),
+        });
+    }
+    let file = &into.tree;
+    let layer = scene
+        .active()
+        .and_then(|n| match tree.node(n).ok()?.kind {
+            NodeKind::Object { layer, .. } => Some(layer),
+            NodeKind::Group { .. } => None,
+        })
+        .unwrap_or(LayerId(0));
+    let mut node_ids = std::collections::BTreeMap::new();
+    let mut flags = Vec::new();
+    for id in file.subtree(ObjectTree::ROOT)? {
+        let n = file.node(id)?;
+        let parent = n.parent().map_or(ObjectTree::ROOT, |p| node_ids[&p]);
+        let (name, new, on_hidden_layer) = match &n.kind {
+            _ if id == ObjectTree::ROOT => (name.to_string(), NewNode::Group, false),
+            NodeKind::Group { .. } => (n.name.clone(), NewNode::Group, false),
+            NodeKind::Object { model, layer: on } => (
+                n.name.clone(),
+                NewNode::Object {
+                    model: model_ids[model],
+                    layer,
+                },
+                // Objects on a hidden layer of the file come in hidden.
+                file.layers().get(on.0 as usize).is_some_and(|l| !l.visible),
+            ),
+        };
+        let new_id = free_nodes.next().expect("fewer than 2^32 nodes");
+        node_ids.insert(id, new_id);
+        ops.push(ObjectOp::Add {
+            parent,
+            index: None,
+            name,
+            placement: n.placement,
+            new,
+        });
+        if !n.visible || on_hidden_layer {
+            flags.push(ObjectOp::Show {
+                node: new_id,
+                visible: false,
+            });
+        }
+        if n.locked {
+            flags.push(ObjectOp::Lock {
+                node: new_id,
+                locked: true,
+            });
+        }
+    }
+    ops.extend(flags);
+    Ok(ObjectOp::Batch(ops))
 }
 
 /// The largest grid, in voxels.

@@ -41,7 +41,9 @@ pub use error::VoxError;
 pub use export::*;
 use graph::*;
 use materials::*;
-pub use objects::{ObjectImport, export_objects, export_objects_data, import_objects};
+pub use objects::{
+    ObjectImport, ObjectsInto, export_objects, export_objects_data, import_objects, objects_into,
+};
 
 /// How to import.
 #[derive(Clone, Debug, Default)]

@@ -111,6 +111,87 @@ pub fn import_objects(
     })
 }
 
+/// A `.vox` file's objects for an existing scene: its tree (the root's placement moved so
+/// the file's lowest voxel lands at `offset`, as a flattening import puts it) and its
+/// placed models, their materials merged into `world`'s table (an identical colour or
+/// material reused, as [`import_into`] merges them).
+pub struct ObjectsInto {
+    /// The file's tree (hidden nodes kept hidden).
+    pub tree: ObjectTree,
+    /// Its placed models, by the file's model index.
+    pub models: BTreeMap<ModelId, VoxelModel>,
+    /// What was imported and what was left out.
+    pub report: ImportReport,
+}
+
+/// Reads `.vox` bytes as objects to add to the scene of `world` (see [`ObjectsInto`]).
+pub fn objects_into(world: &World, bytes: &[u8], offset: IVec3) -> Result<ObjectsInto, VoxError> {
+    let data = parse(bytes)?;
+    let mut report = ImportReport {
+        models: data.models.len(),
+        ..Default::default()
+    };
+    let mut tree = read_tree(&data, Hidden::Keep, &mut report)?;
+    let mut used = [false; 256];
+    let mut placed = BTreeSet::new();
+    let mut lo = IVec3::MAX;
+    for id in tree
+        .subtree(ObjectTree::ROOT)
+        .map_err(|e| VoxError::Malformed(e.to_string()))?
+    {
+        let Ok(node) = tree.node(id) else { continue };
+        let NodeKind::Object { model, .. } = node.kind else {
+            continue;
+        };
+        let m = &data.models[model.0 as usize];
+        let p = tree.world_placement(id).expect("a node of the tree");
+        // The lowest placed voxel (not the model's box): the content's corner goes to
+        // `offset`, as in a flattening import.
+        let size = model_size(m);
+        for v in &m.voxels {
+            lo = lo.min(p.place(model_voxel(v, m), size));
+        }
+        placed.insert(model);
+        for v in &m.voxels {
+            used[v.i as usize] = true;
+        }
+    }
+    if placed.is_empty() || lo == IVec3::MAX {
+        return Err(VoxError::NothingPlaced {
+            models: data.models.len(),
+            voxels: data.models.iter().map(|m| m.voxels.len() as u64).sum(),
+            why: "no model is placed by the scene graph".into(),
+        });
+    }
+    let root = tree.node_mut(ObjectTree::ROOT).expect("the root");
+    root.placement.t += (-lo).max(IVec3::ZERO) + offset;
+    let indices: Vec<(IVec3, u8)> = (0..=255u8)
+        .filter(|i| used[*i as usize])
+        .map(|i| (IVec3::ZERO, i))
+        .collect();
+    let palette = palette_of(&data);
+    let mut taken = std::collections::HashSet::new();
+    let map = install_materials(world, &data, &indices, &mut report, |i| {
+        colour_slot(world, palette[i as usize], &mut taken)
+    })?;
+    let table = world.materials().clone();
+    let mut models = BTreeMap::new();
+    for id in placed {
+        let m = &data.models[id.0 as usize];
+        models.insert(id, model_of(m, &map, &table)?);
+    }
+    report.instances = tree.drawn().len();
+    report.voxels = models
+        .iter()
+        .map(|(id, m)| m.solid_count() * tree.instances(*id).len() as u64)
+        .sum();
+    Ok(ObjectsInto {
+        tree,
+        models,
+        report,
+    })
+}
+
 /// A `.vox` model in voxbrick's axes, its palette indices mapped to materials, built a brick
 /// at a time.
 fn model_of(
