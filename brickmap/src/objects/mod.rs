@@ -11,6 +11,7 @@ pub mod arrange;
 pub mod composite;
 pub mod frame;
 pub mod model;
+pub mod op;
 pub mod orient;
 pub mod scene;
 #[cfg(test)]
