@@ -172,7 +172,7 @@ impl Model {
         let mut bricks = Vec::new();
         view.for_each_brick(|b, mask, mats| {
             let held = (0..mask.count() as usize).map(|k| mats.at(k)).collect();
-            bricks.push((b, *mask, PriorMaterials::PerVoxel(held)));
+            bricks.push((b, *mask, PriorMaterials::packed(held)));
         });
         Self::from_bricks(view.dims().voxels(), bricks, view.materials())
     }
@@ -558,7 +558,7 @@ impl Model {
     /// apply (then voxel by voxel), `Some(None)` where nothing changes.
     fn restore_uniform(&self, u: &BrickUndo) -> Option<Option<Rewrite>> {
         let PriorMaterials::Uniform(p) = u.prior else {
-            return None;
+            return self.restore_into_empty(u);
         };
         let (old_mask, c) = match self.bricks.get(&key(u.brick)) {
             None => (Mask::EMPTY, 0),
@@ -597,6 +597,32 @@ impl Model {
             },
             brick: (!mask.is_empty()).then_some(ModelBrick { mask, materials }),
             changed: changed as u64,
+        }))
+    }
+
+    /// A brick restore with per-voxel materials into an empty brick (a model being built):
+    /// the restored voxels are the brick. `None` where the brick holds voxels.
+    fn restore_into_empty(&self, u: &BrickUndo) -> Option<Option<Rewrite>> {
+        if self.bricks.contains_key(&key(u.brick)) {
+            return None;
+        }
+        let set = u.prior_mask.and(&u.touched);
+        if set.is_empty() {
+            return Some(None);
+        }
+        let mut per = Box::new([0u8; 512]);
+        for (k, bit) in set.ones().enumerate() {
+            per[bit] = u.prior_material(k);
+        }
+        Some(Some(Rewrite {
+            undo: BrickUndo {
+                brick: u.brick,
+                prior_mask: Mask::EMPTY,
+                touched: u.touched,
+                prior: PriorMaterials::Uniform(0),
+            },
+            brick: Some(ModelBrick::packed(set, per)),
+            changed: set.count() as u64,
         }))
     }
 
