@@ -226,8 +226,25 @@ impl Editor {
         let shown = (self.viewing.area().2, self.viewing.area().3);
         let internal = gfx.viewport.fit_internal(self.internal_size(shown));
         let paths = internal.0 as f64 * internal.1 as f64 * self.frames.last_added as f64;
+        // Which object brushes edit, or arrange mode and how many nodes are picked.
+        let mode = if self.settings.brush.tool == super::tools::Tool::Arrange {
+            format!(
+                "arrange ({} picked; Tab: edit)",
+                self.panels.outliner.picked.len()
+            )
+        } else {
+            let doc = self.read();
+            let objects = doc.scene.objects();
+            doc.scene
+                .active()
+                .and_then(|n| objects.tree().node(n).ok())
+                .map_or_else(
+                    || "no object to edit (Tab: arrange)".to_string(),
+                    |n| format!("editing {} (Tab: arrange)", n.name),
+                )
+        };
         self.panels.status = format!(
-            "{samples}/{} spp · GPU {gpu_ms:.2} ms/frame · {:.1} Mpaths/s · internal {}x{}{} · {}{}",
+            "{mode} · {samples}/{} spp · GPU {gpu_ms:.2} ms/frame · {:.1} Mpaths/s · internal {}x{}{} · {}{}",
             self.settings.target_spp,
             if gpu_ms > 0.0 {
                 paths / gpu_ms / 1e3
