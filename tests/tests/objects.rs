@@ -277,15 +277,20 @@ fn object_commands_and_edits_keep_the_composite_and_undo_and_redo_exactly() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-#[test]
-fn a_selection_splits_into_a_new_object_that_edits_apart() {
+/// The small default scene (one terrain object) and a selection of its corner column.
+fn small_default() -> (Document, app::selection::SelectOp) {
     let scene = app::builtin::default_scene(app::builtin::SceneSize::Small, 2).unwrap();
-    let mut doc = Document::new(scene, History::default());
-    let terrain = doc.scene.active().unwrap();
     let corner = app::selection::SelectOp::Replace {
         min: IVec3::new(0, 0, 0),
         max: IVec3::new(31, 63, 31),
     };
+    (Document::new(scene, History::default()), corner)
+}
+
+#[test]
+fn a_selection_splits_into_a_new_object_that_edits_apart() {
+    let (mut doc, corner) = small_default();
+    let terrain = doc.scene.active().unwrap();
     doc.execute(Command::Select(corner)).unwrap();
     let hash = doc.scene.world.read().content_hash();
     doc.execute(Command::Object(ObjectCommand::SplitSelection))
@@ -385,13 +390,8 @@ fn a_selection_splits_into_a_new_object_that_edits_apart() {
 /// of a box where only another object shows moves nothing; made active, that object moves.
 #[test]
 fn selection_moves_read_the_active_object_alone() {
-    let scene = app::builtin::default_scene(app::builtin::SceneSize::Small, 2).unwrap();
-    let mut doc = Document::new(scene, History::default());
+    let (mut doc, corner) = small_default();
     let terrain = doc.scene.active().unwrap();
-    let corner = app::selection::SelectOp::Replace {
-        min: IVec3::new(0, 0, 0),
-        max: IVec3::new(31, 63, 31),
-    };
     doc.execute(Command::Select(corner)).unwrap();
     doc.execute(Command::Object(ObjectCommand::SplitSelection))
         .unwrap();
