@@ -28,7 +28,20 @@ impl Editor {
                     .pick(Purpose::Export, self.folder(), Some("scene.vox".into()))
             }
             Action::Frame => {
-                let (min, max) = content_bounds(&self.read().scene);
+                // In arrange mode with nodes picked: their boxes; else the scene's content.
+                let picked = (self.settings.brush.tool == Tool::Arrange)
+                    .then(|| {
+                        let doc = self.read();
+                        let objects = doc.scene.objects();
+                        super::arranging::picked_boxes(&objects, &self.panels.outliner.picked)
+                            .into_iter()
+                            .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+                    })
+                    .flatten();
+                let (min, max) = match picked {
+                    Some((lo, hi)) => (lo.as_dvec3(), hi.as_dvec3()),
+                    None => content_bounds(&self.read().scene),
+                };
                 let aspect = self.aspect();
                 self.viewing.camera.frame(min, max, aspect);
                 self.moved();

@@ -60,7 +60,7 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ),
     (
         "Tab",
-        "arrange mode (again: the brush): click picks an object, Shift adds, Ctrl takes away; arrows move the picked ones, Delete deletes them",
+        "arrange mode (again: the brush): click picks an object, Shift adds, Ctrl takes away; drag or arrows move the picked ones, Delete deletes them, F frames them",
     ),
     ("Ctrl+A / Ctrl+D", "select all / nothing"),
     (
