@@ -96,7 +96,7 @@ impl Scene {
         self.objects.lock().unwrap_or_else(|p| p.into_inner())
     }
 
-    /// The objects, taken out of the scene (for a scene being dropped or saved whole).
+    /// The objects, without the lock (the scene is held exclusively: a regrid).
     pub fn objects_mut(&mut self) -> &mut Objects {
         self.objects.get_mut().unwrap_or_else(|p| p.into_inner())
     }
