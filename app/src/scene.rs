@@ -97,7 +97,7 @@ impl Scene {
     }
 
     /// The objects, without the lock (the scene is held exclusively: a regrid).
-    pub fn objects_mut(&mut self) -> &mut Objects {
+    fn objects_mut(&mut self) -> &mut Objects {
         self.objects.get_mut().unwrap_or_else(|p| p.into_inner())
     }
 
