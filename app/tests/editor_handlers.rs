@@ -193,6 +193,19 @@ impl Session {
         matches!(hit, Ok(Some(_)))
     }
 
+    /// A point of the viewport, free of every panel, with nothing of the scene behind it.
+    fn on_the_sky(&self) -> (f64, f64) {
+        let (x0, y0, w, h) = self.ed.view_area();
+        let (x0, y0, w, h) = (f64::from(x0), f64::from(y0), f64::from(w), f64::from(h));
+        for (fx, fy) in (1..16).flat_map(|j| (1..16).map(move |i| (i, j))) {
+            let p = (x0 + w * f64::from(fx) / 16.0, y0 + h * f64::from(fy) / 16.0);
+            if !self.ed.on_ui_at(p.0, p.1) && !self.terrain_behind(p) {
+                return p;
+            }
+        }
+        panic!("the scene fills the viewport")
+    }
+
     /// Where the terrain's surface shows in the viewport, free of every panel.
     fn on_the_terrain(&self) -> (f64, f64) {
         let doc = self.ed.document();
@@ -701,7 +714,9 @@ fn selection_operations_land_and_a_selection_gets_a_material_of_its_own(s: &mut 
 /// Arrange mode: Tab, then a click picks the object under the cursor and an arrow moves it
 /// (the scene's one grid-sized object: past the grid's side, so the grid grows and the
 /// viewport takes the new world, validated); Ctrl + Z puts it back and the grid with it; a
-/// drag from it moves it by one step at the release; Tab again is the brush.
+/// drag from it moves it by one step at the release; a click on the sky un-picks it, a box
+/// dragged from the sky over it picks it again, and the turn keys turn it; Tab again is the
+/// brush.
 fn arrange_mode_picks_and_moves_an_object(s: &mut Session) {
     s.quiet();
     let grid = |s: &Session| s.ed.document().read().unwrap().scene.world.dims();
@@ -741,6 +756,55 @@ fn arrange_mode_picks_and_moves_an_object(s: &mut Session) {
     s.quiet();
     assert_eq!(s.state().1, before.1 + 1, "the drag is one step");
     assert_ne!(s.state().0, before.0);
+    s.ctrl(KeyCode::KeyZ);
+    s.quiet();
+    assert_eq!(s.state(), before);
+    // A click on nothing clears the picked objects: the turn key then turns nothing.
+    let sky = s.on_the_sky();
+    s.to(sky);
+    s.frame();
+    s.left(true);
+    s.left(false);
+    s.quiet();
+    let alt = |s: &mut Session, shift: bool| {
+        let mods = app::ui::input::Mods {
+            alt: true,
+            shift,
+            ..Default::default()
+        };
+        s.ed.input(Input::Modifiers(mods));
+        s.key(KeyCode::KeyY, true);
+        s.key(KeyCode::KeyY, false);
+        s.ed.input(Input::Modifiers(Default::default()));
+        s.quiet();
+    };
+    alt(s, false);
+    assert_eq!(s.state(), before, "nothing picked, nothing turned");
+    // A box dragged from the sky over the object picks it; Alt + Y turns it a quarter,
+    // Alt + Shift + Y turns it back (two steps), undo and undo again are where it began.
+    s.to(sky);
+    s.frame();
+    s.left(true);
+    for k in 1..=6 {
+        let f = f64::from(k) / 6.0;
+        s.to((sky.0 + (at.0 - sky.0) * f, sky.1 + (at.1 - sky.1) * f));
+        s.frame();
+    }
+    s.left(false);
+    s.quiet();
+    alt(s, false);
+    let turned = s.state();
+    assert_eq!(
+        turned.1,
+        before.1 + 1,
+        "the box picked the object: one turn"
+    );
+    assert_ne!(turned.0, before.0);
+    alt(s, true);
+    assert_eq!(s.state(), (before.0, before.1 + 2), "turned back");
+    s.ctrl(KeyCode::KeyZ);
+    s.quiet();
+    assert_eq!(s.state().0, turned.0);
     s.ctrl(KeyCode::KeyZ);
     s.quiet();
     assert_eq!(s.state(), before);

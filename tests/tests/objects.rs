@@ -156,7 +156,7 @@ fn object_commands_and_edits_keep_the_composite_and_undo_and_redo_exactly() {
     run(
         &mut doc,
         Command::Object(ObjectCommand::Turn {
-            node: a,
+            nodes: vec![a],
             axis: Axis::Y,
             quarters: 1,
         }),
@@ -164,7 +164,7 @@ fn object_commands_and_edits_keep_the_composite_and_undo_and_redo_exactly() {
     run(
         &mut doc,
         Command::Object(ObjectCommand::Flip {
-            node: a,
+            nodes: vec![a],
             axis: Axis::X,
         }),
     );

@@ -52,19 +52,21 @@ pub enum ObjectCommand {
         /// The move.
         by: IVec3,
     },
-    /// Turns a node by quarter turns about an axis through its pivot.
+    /// Turns nodes by quarter turns, each about an axis through its own pivot.
     Turn {
-        /// The node.
-        node: NodeId,
+        /// The nodes (a script may name one as `node: N`).
+        #[serde(alias = "node", deserialize_with = "one_or_many")]
+        nodes: Vec<NodeId>,
         /// The axis.
         axis: Axis,
         /// Quarter turns (counter-clockwise looking down the axis).
         quarters: i32,
     },
-    /// Mirrors a node along an axis through its pivot.
+    /// Mirrors nodes, each along an axis through its own pivot.
     Flip {
-        /// The node.
-        node: NodeId,
+        /// The nodes (a script may name one as `node: N`).
+        #[serde(alias = "node", deserialize_with = "one_or_many")]
+        nodes: Vec<NodeId>,
         /// The axis.
         axis: Axis,
     },
@@ -128,11 +130,11 @@ impl ObjectCommand {
             Self::Rename { node, name } => format!("Rename #{} to {name:?}", node.0),
             Self::Translate { nodes, by } => format!("Move {} by {by}", names(nodes)),
             Self::Turn {
-                node,
+                nodes,
                 axis,
                 quarters,
-            } => format!("Turn #{} {}° about {axis:?}", node.0, quarters * 90),
-            Self::Flip { node, axis } => format!("Flip #{} along {axis:?}", node.0),
+            } => format!("Turn {} {}° about {axis:?}", names(nodes), quarters * 90),
+            Self::Flip { nodes, axis } => format!("Flip {} along {axis:?}", names(nodes)),
             Self::Duplicate { node, .. } => format!("Duplicate #{}", node.0),
             Self::Instance { node, .. } => format!("Instance #{}", node.0),
             Self::MakeUnique(n) => format!("Make #{} unique", n.0),
@@ -192,12 +194,16 @@ impl ObjectCommand {
     fn op(&self, scene: &Scene) -> Result<ObjectOp> {
         let table = scene.world.materials().clone();
         let objects = scene.objects();
-        let placed = |node: NodeId, f: &dyn Fn(Placement) -> Placement| -> Result<ObjectOp> {
-            let p = objects.tree().node(node)?.placement;
-            Ok(ObjectOp::Place {
-                node,
-                placement: f(p),
-            })
+        // Each node placed anew by `f` of its placement, in one batch.
+        let each = |nodes: &[NodeId], f: &dyn Fn(Placement) -> Placement| -> Result<ObjectOp> {
+            let places = nodes.iter().map(|&node| {
+                let p = objects.tree().node(node)?.placement;
+                Ok(ObjectOp::Place {
+                    node,
+                    placement: f(p),
+                })
+            });
+            Ok(ObjectOp::Batch(places.collect::<Result<_>>()?))
         };
         let op = match self {
             Self::Activate(_) => unreachable!("handled before"),
@@ -218,21 +224,16 @@ impl ObjectCommand {
                     name: name.clone(),
                 }
             }
-            Self::Translate { nodes, by } => ObjectOp::Batch(
-                nodes
-                    .iter()
-                    .map(|n| placed(*n, &|p| Placement { t: p.t + *by, ..p }))
-                    .collect::<Result<_>>()?,
-            ),
+            Self::Translate { nodes, by } => each(nodes, &|p| Placement { t: p.t + *by, ..p })?,
             Self::Turn {
-                node,
+                nodes,
                 axis,
                 quarters,
-            } => placed(*node, &|p| Placement {
+            } => each(nodes, &|p| Placement {
                 rot: Orientation::quarter_turn(*axis, *quarters).after(&p.rot),
                 ..p
             })?,
-            Self::Flip { node, axis } => placed(*node, &|p| Placement {
+            Self::Flip { nodes, axis } => each(nodes, &|p| Placement {
                 rot: Orientation::flip(*axis).after(&p.rot),
                 ..p
             })?,
@@ -412,10 +413,98 @@ fn larger(lo: IVec3, hi: IVec3, grid: IVec3) -> Option<(GridDims, IVec3)> {
     Some((dims, shift))
 }
 
+/// A list of nodes, or one node alone (the form scripts wrote before a turn or a flip took
+/// several): `(2)`, `[(2), (5)]` or `[2, 5]` (RON writes a node id as a one-field tuple).
+fn one_or_many<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> std::result::Result<Vec<NodeId>, D::Error> {
+    use serde::de::{SeqAccess, Visitor};
+    use std::fmt;
+    /// Node ids: a bare number, or a sequence of bare or wrapped ones.
+    struct Ids;
+    impl<'de> Visitor<'de> for Ids {
+        type Value = Vec<NodeId>;
+        fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+            f.write_str("a node id or a list of node ids")
+        }
+        fn visit_u64<E: serde::de::Error>(self, v: u64) -> std::result::Result<Self::Value, E> {
+            let id = u32::try_from(v).map_err(|_| E::custom(format!("node id {v} too large")))?;
+            Ok(vec![NodeId(id)])
+        }
+        fn visit_newtype_struct<D: serde::Deserializer<'de>>(
+            self,
+            d: D,
+        ) -> std::result::Result<Self::Value, D::Error> {
+            d.deserialize_any(Ids)
+        }
+        fn visit_seq<A: SeqAccess<'de>>(
+            self,
+            mut seq: A,
+        ) -> std::result::Result<Self::Value, A::Error> {
+            let mut out = Vec::new();
+            while let Some(ids) = seq.next_element_seed(IdsSeed)? {
+                out.extend(ids);
+            }
+            Ok(out)
+        }
+    }
+    struct IdsSeed;
+    impl<'de> serde::de::DeserializeSeed<'de> for IdsSeed {
+        type Value = Vec<NodeId>;
+        fn deserialize<D: serde::Deserializer<'de>>(
+            self,
+            d: D,
+        ) -> std::result::Result<Self::Value, D::Error> {
+            d.deserialize_any(Ids)
+        }
+    }
+    d.deserialize_any(Ids)
+}
+
 /// Node ids for a label: "#3" or "3 nodes".
 fn names(nodes: &[NodeId]) -> String {
     match nodes {
         [n] => format!("#{}", n.0),
         _ => format!("{} nodes", nodes.len()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_turn_or_a_flip_reads_one_node_or_several() {
+        let one: ObjectCommand = ron::from_str("Turn(node: (2), axis: Y, quarters: 1)").unwrap();
+        let many: ObjectCommand =
+            ron::from_str("Turn(nodes: [(2), (5)], axis: Y, quarters: 1)").unwrap();
+        let flip: ObjectCommand = ron::from_str("Flip(node: (7), axis: Z)").unwrap();
+        assert_eq!(
+            one,
+            ObjectCommand::Turn {
+                nodes: vec![NodeId(2)],
+                axis: Axis::Y,
+                quarters: 1
+            }
+        );
+        assert_eq!(
+            many,
+            ObjectCommand::Turn {
+                nodes: vec![NodeId(2), NodeId(5)],
+                axis: Axis::Y,
+                quarters: 1
+            }
+        );
+        assert_eq!(
+            flip,
+            ObjectCommand::Flip {
+                nodes: vec![NodeId(7)],
+                axis: Axis::Z
+            }
+        );
+        // What is written reads back.
+        let text = ron::to_string(&many).unwrap();
+        assert_eq!(ron::from_str::<ObjectCommand>(&text).unwrap(), many);
+        assert!(ron::from_str::<ObjectCommand>("Turn(node: \"x\", axis: Y, quarters: 1)").is_err());
     }
 }

@@ -10,7 +10,9 @@ use super::purpose::Purpose;
 use super::tools::Tool;
 use super::{Editor, content_bounds};
 use crate::editor::command::Command;
+use crate::editor::objects::ObjectCommand;
 use crate::selection::SelectOp;
+use brickmap::objects::NodeId;
 use glam::DVec3;
 
 impl Editor {
@@ -96,8 +98,31 @@ impl Editor {
             Action::Paste => self.pointer.pasting = true,
             Action::Nudge(n) if self.settings.brush.tool == Tool::Arrange => self.arrange_nudge(n),
             Action::Nudge(n) => self.nudge(n),
+            Action::Turn(axis) => self.turn_or_flip(|nodes| ObjectCommand::Turn {
+                nodes,
+                axis,
+                quarters: 1,
+            }),
+            Action::TurnBack(axis) => self.turn_or_flip(|nodes| ObjectCommand::Turn {
+                nodes,
+                axis,
+                quarters: -1,
+            }),
+            Action::Flip(axis) => self.turn_or_flip(|nodes| ObjectCommand::Flip { nodes, axis }),
             Action::Help => self.panels.help_open = !self.panels.help_open,
             Action::Quit => self.guard_unsaved(Pending::Quit),
+        }
+    }
+
+    /// A turn or a flip of the picked nodes in arrange mode, else of the object brushes edit.
+    fn turn_or_flip(&mut self, command: impl FnOnce(Vec<NodeId>) -> ObjectCommand) {
+        let nodes = if self.settings.brush.tool == Tool::Arrange {
+            self.panels.outliner.picked.clone()
+        } else {
+            self.read().scene.active().into_iter().collect()
+        };
+        if !nodes.is_empty() {
+            self.execute(Command::Object(command(nodes)));
         }
     }
 

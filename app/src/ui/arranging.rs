@@ -2,9 +2,10 @@
 //! under the cursor (Shift adds it to the picked nodes, Ctrl takes it away; a click on
 //! nothing clears them) and makes a single picked object the one brushes edit; a drag that
 //! starts on a picked object moves the picked ones over the horizontal plane it started on
-//! (their outlines follow; one move at the release, Esc cancels); the nudge keys move the
-//! picked nodes (Shift: a brick), Delete deletes them. The picked nodes are the Objects
-//! window's.
+//! (their outlines follow; one move at the release, Esc cancels); a drag that starts on
+//! nothing is a box select (the visible objects whose box it meets; Shift adds, Ctrl takes
+//! away); the nudge keys move the picked nodes (Shift: a brick), the turn and flip keys
+//! turn and mirror them, Delete deletes them. The picked nodes are the Objects window's.
 
 use super::Editor;
 use super::camera::ViewCamera;
@@ -39,6 +40,10 @@ impl Editor {
             Some(n) => *picked = vec![n],
             None if mods.shift || mods.ctrl => {}
             None => picked.clear(),
+        }
+        // A press on nothing starts a box select (a click without moving only clears).
+        if node.is_none() {
+            self.pointer.boxing = Some(self.pointer.cursor);
         }
         // A press on a picked object (no modifier) starts dragging the picked ones.
         if let (Some(v), Some(n)) = (hit, node)
@@ -77,8 +82,32 @@ impl Editor {
         }
     }
 
-    /// The release of a drag of picked objects: one move by what the drag showed.
+    /// The release of a drag of picked objects: one move by what the drag showed; of a box
+    /// select: the objects in the box picked (Shift: added, Ctrl: taken away).
     pub(super) fn arrange_release(&mut self) {
+        if let Some(from) = self.pointer.boxing.take() {
+            let band = band(from, self.pointer.cursor);
+            if band.1.0 - band.0.0 < MIN_BAND && band.1.1 - band.0.1 < MIN_BAND {
+                return;
+            }
+            let inside = {
+                let doc = self.read();
+                let objects = doc.scene.objects();
+                in_band(&objects, band, |p| self.viewing.window_point(p))
+            };
+            let mods = self.pointer.mods;
+            let picked = &mut self.panels.outliner.picked;
+            if mods.ctrl {
+                picked.retain(|p| !inside.contains(p));
+            } else {
+                for n in inside {
+                    if !picked.contains(&n) {
+                        picked.push(n);
+                    }
+                }
+            }
+            return;
+        }
         let Some(m) = self.pointer.moving.take() else {
             return;
         };
@@ -120,6 +149,64 @@ impl Editor {
     }
 }
 
+/// A box select moved less than this (window pixels) on both axes is a click.
+const MIN_BAND: f64 = 4.0;
+
+/// The rectangle between two window points: (lowest x and y, highest x and y).
+pub fn band(a: (f64, f64), b: (f64, f64)) -> ((f64, f64), (f64, f64)) {
+    ((a.0.min(b.0), a.1.min(b.1)), (a.0.max(b.0), a.1.max(b.1)))
+}
+
+/// The box select being dragged, in window pixels.
+pub(super) fn boxing_band(editor: &Editor) -> Option<((f64, f64), (f64, f64))> {
+    editor
+        .pointer
+        .boxing
+        .map(|from| band(from, editor.pointer.cursor))
+        .filter(|(lo, hi)| hi.0 - lo.0 >= MIN_BAND || hi.1 - lo.1 >= MIN_BAND)
+}
+
+/// The visible objects whose box, as `project` shows it in the window, meets the rectangle
+/// `band`, in drawing order. A box wholly behind the eye is not in it; one partly behind
+/// counts by its corners in front.
+pub fn in_band(
+    objects: &Objects,
+    (lo, hi): ((f64, f64), (f64, f64)),
+    project: impl Fn(DVec3) -> Option<(f64, f64)>,
+) -> Vec<NodeId> {
+    let mut out = Vec::new();
+    for d in objects.tree().drawn() {
+        let Some(m) = objects.model(d.model) else {
+            continue;
+        };
+        let (a, b) = d.placement.bounds(m.size());
+        let (a, b) = (a.as_dvec3(), b.as_dvec3());
+        let mut seen: Option<((f64, f64), (f64, f64))> = None;
+        for i in 0..8 {
+            let corner = DVec3::new(
+                if i & 1 == 0 { a.x } else { b.x },
+                if i & 2 == 0 { a.y } else { b.y },
+                if i & 4 == 0 { a.z } else { b.z },
+            );
+            if let Some(p) = project(corner) {
+                seen = Some(match seen {
+                    None => (p, p),
+                    Some((l, h)) => ((l.0.min(p.0), l.1.min(p.1)), (h.0.max(p.0), h.1.max(p.1))),
+                });
+            }
+        }
+        if let Some((l, h)) = seen
+            && l.0 <= hi.0
+            && h.0 >= lo.0
+            && l.1 <= hi.1
+            && h.1 >= lo.1
+        {
+            out.push(d.node);
+        }
+    }
+    out
+}
+
 /// Where a ray meets the horizontal plane at height `y` (ahead of it, within a long way:
 /// a ray nearly along the plane has no useful point on it).
 fn on_plane(origin: DVec3, dir: DVec3, y: f64) -> Option<DVec3> {
@@ -147,15 +234,27 @@ pub fn picked_boxes(objects: &Objects, picked: &[NodeId]) -> Vec<(IVec3, IVec3)>
     out
 }
 
-/// Outlines the picked objects' boxes.
+/// Outlines the picked objects' boxes, and the box select being dragged (`band`, in
+/// points).
 pub fn paint(
     painter: &egui::Painter,
     view: &ViewCamera,
     rect: egui::Rect,
     boxes: &[(IVec3, IVec3)],
+    band: Option<egui::Rect>,
 ) {
-    let stroke = egui::Stroke::new(2.0, egui::Color32::from_rgb(120, 200, 255));
+    let colour = egui::Color32::from_rgb(120, 200, 255);
+    let stroke = egui::Stroke::new(2.0, colour);
     for (lo, hi) in boxes {
         super::preview::paint_box(painter, view, rect, lo.as_dvec3(), hi.as_dvec3(), stroke);
+    }
+    if let Some(band) = band {
+        painter.rect_filled(band, 0.0, colour.gamma_multiply(0.15));
+        painter.rect_stroke(
+            band,
+            0.0,
+            egui::Stroke::new(1.0, colour),
+            egui::StrokeKind::Inside,
+        );
     }
 }

@@ -311,6 +311,7 @@ impl Editor {
                     .into_iter()
                     .map(|(lo, hi)| (lo + by, hi + by))
                     .collect();
+            let band = super::arranging::boxing_band(self);
             egui_ctx.run_ui(raw, |ui| {
                 // Under every panel and window, over the viewport image.
                 let painter = ui.ctx().layer_painter(egui::LayerId::background());
@@ -333,7 +334,13 @@ impl Editor {
                     dragged,
                     paste,
                 );
-                super::arranging::paint(&painter, &self.viewing.camera, rect, &picked);
+                let band = band.map(|((x0, y0), (x1, y1))| {
+                    egui::Rect::from_min_max(
+                        egui::pos2(x0 as f32 / ppp, y0 as f32 / ppp),
+                        egui::pos2(x1 as f32 / ppp, y1 as f32 / ppp),
+                    )
+                });
+                super::arranging::paint(&painter, &self.viewing.camera, rect, &picked, band);
                 if empty {
                     preview::paint_floor(&painter, &self.viewing.camera, rect, dims);
                 }

@@ -182,7 +182,11 @@ impl Editor {
                 self.motion.settling();
             }
             (false, MouseButton::Left) if self.pointer.selecting.is_some() => self.select_release(),
-            (false, MouseButton::Left) if self.pointer.moving.is_some() => self.arrange_release(),
+            (false, MouseButton::Left)
+                if self.pointer.moving.is_some() || self.pointer.boxing.is_some() =>
+            {
+                self.arrange_release()
+            }
             (true, _) if free => {
                 self.pointer.drag = input::drag_for_button(button, self.pointer.mods)
                     .map(|d| (d, self.pointer.cursor));

@@ -60,7 +60,11 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ),
     (
         "Tab",
-        "arrange mode (again: the brush): click picks an object, Shift adds, Ctrl takes away; drag or arrows move the picked ones, Delete deletes them, F frames them",
+        "arrange mode (again: the brush): click picks an object, Shift adds, Ctrl takes away, a drag from nothing picks those in its box; drag or arrows move the picked ones, Delete deletes them, F frames them",
+    ),
+    (
+        "Alt + X / Y / Z (Shift: back), Ctrl + Alt + X / Y / Z",
+        "turn a quarter about / flip along an axis: the picked objects (arrange mode) or the edited one",
     ),
     ("Ctrl+A / Ctrl+D", "select all / nothing"),
     (

@@ -5,6 +5,7 @@
 
 use super::purpose::Purpose;
 use crate::editor::command::{BrushMode, BrushShape};
+use brickmap::objects::Axis;
 use render::{RenderSettings, Sky, Sun};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -79,6 +80,13 @@ pub enum Action {
     Paste,
     /// Move the selection a voxel (Shift: a brick).
     Nudge(Nudge),
+    /// Turn the picked objects (arrange mode) or the object brushes edit a quarter turn
+    /// about an axis (counter-clockwise looking down it).
+    Turn(Axis),
+    /// The same, clockwise.
+    TurnBack(Axis),
+    /// Mirror them along an axis.
+    Flip(Axis),
     /// Show or hide the shortcut list.
     Help,
     /// Quit (asks about unsaved changes).

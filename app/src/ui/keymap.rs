@@ -9,6 +9,7 @@
 
 use super::intent::{Action, Mods, Nudge};
 use crate::editor::command::{BrushMode, BrushShape};
+use brickmap::objects::Axis;
 use serde::{Deserialize, Serialize};
 use winit::keyboard::KeyCode;
 
@@ -178,6 +179,11 @@ pub fn default_bindings() -> Vec<Binding> {
     ] {
         b.push((key.to_string(), Action::Nudge(n)));
         b.push((format!("Shift+{key}"), Action::Nudge(n)));
+    }
+    for (key, axis) in [("X", Axis::X), ("Y", Axis::Y), ("Z", Axis::Z)] {
+        b.push((format!("Alt+{key}"), Action::Turn(axis)));
+        b.push((format!("Alt+Shift+{key}"), Action::TurnBack(axis)));
+        b.push((format!("Ctrl+Alt+{key}"), Action::Flip(axis)));
     }
     for n in 1..=9u8 {
         b.push((format!("Ctrl+{n}"), Action::StoreView(n)));

@@ -162,14 +162,14 @@ fn commands(
             send(out, ObjectCommand::Delete(state.picked.clone()));
             state.picked.clear();
         }
-        if let Some(node) = first {
+        if first.is_some() {
             ui.end_row();
             for (axis, name) in [(Axis::X, "X"), (Axis::Y, "Y"), (Axis::Z, "Z")] {
                 if ui.button(format!("Turn {name}")).clicked() {
                     send(
                         out,
                         ObjectCommand::Turn {
-                            node,
+                            nodes: state.picked.clone(),
                             axis,
                             quarters: 1,
                         },
@@ -178,7 +178,13 @@ fn commands(
             }
             for (axis, name) in [(Axis::X, "X"), (Axis::Y, "Y"), (Axis::Z, "Z")] {
                 if ui.button(format!("Flip {name}")).clicked() {
-                    send(out, ObjectCommand::Flip { node, axis });
+                    send(
+                        out,
+                        ObjectCommand::Flip {
+                            nodes: state.picked.clone(),
+                            axis,
+                        },
+                    );
                 }
             }
             ui.end_row();

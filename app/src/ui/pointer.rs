@@ -1,6 +1,6 @@
 //! The pointer and the gesture it is making: the modifier keys held, the cursor, a camera
 //! drag, a stroke being drawn, a selection box being dragged, a paste following the cursor,
-//! picked objects being dragged (arrange mode).
+//! picked objects being dragged or a box select of objects (arrange mode).
 //! `handle.rs` and `selecting.rs` change it; the frame reads it (the paste preview, whether a
 //! stroke is drawn); replacing the document ends every gesture.
 
@@ -41,15 +41,21 @@ pub(super) struct Pointer {
     pub(super) pasting: bool,
     /// Picked objects being dragged.
     pub(super) moving: Option<MoveDrag>,
+    /// A box select of objects (arrange mode): where it started, in window pixels.
+    pub(super) boxing: Option<(f64, f64)>,
 }
 
 impl Pointer {
     /// Ends a paste and a selection drag (Escape, or a new document); whether one was on.
     pub(super) fn cancel_placing(&mut self) -> bool {
-        let was = self.pasting || self.selecting.is_some() || self.moving.is_some();
+        let was = self.pasting
+            || self.selecting.is_some()
+            || self.moving.is_some()
+            || self.boxing.is_some();
         self.pasting = false;
         self.selecting = None;
         self.moving = None;
+        self.boxing = None;
         was
     }
 
