@@ -10,7 +10,7 @@ use app::editor::Document;
 use app::editor::command::{Axis as BrushAxis, BrushMode, BrushShape, Command, Mirror, Stroke};
 use app::editor::history::History;
 use app::editor::objects::ObjectCommand;
-use brickmap::objects::{Axis, NodeId, NodeKind, ObjectTree, Objects};
+use brickmap::objects::{Axis, LayerId, NodeId, NodeKind, ObjectTree, Objects};
 use glam::{DVec3, IVec3};
 use std::collections::HashMap;
 use std::path::PathBuf;
@@ -219,6 +219,54 @@ fn object_commands_and_edits_keep_the_composite_and_undo_and_redo_exactly() {
         Command::Object(ObjectCommand::Translate {
             nodes: vec![group],
             by: IVec3::new(1, 0, 1),
+        }),
+    );
+    // Another object dragged into the group (before b): it stays where it was; the group's
+    // objects on a new layer, hidden with it and shown again.
+    let e = ids[4];
+    let e_at = centre(&doc, e);
+    run(
+        &mut doc,
+        Command::Object(ObjectCommand::Reparent {
+            nodes: vec![e],
+            parent: group,
+            before: Some(b),
+        }),
+    );
+    assert_eq!(centre(&doc, e), e_at, "a node moved into a group stays put");
+    assert_eq!(
+        doc.scene.objects().tree().node(group).unwrap().children(),
+        &[e, b, c]
+    );
+    run(
+        &mut doc,
+        Command::Object(ObjectCommand::AddLayer("extra".into())),
+    );
+    let layer = LayerId(doc.scene.objects().tree().layers().len() as u8 - 1);
+    run(
+        &mut doc,
+        Command::Object(ObjectCommand::SetLayer {
+            nodes: vec![group],
+            layer,
+        }),
+    );
+    let shown = doc.scene.world.read().solid_count();
+    run(
+        &mut doc,
+        Command::Object(ObjectCommand::ShowLayer {
+            layer,
+            visible: false,
+        }),
+    );
+    assert!(
+        doc.scene.world.read().solid_count() < shown,
+        "the layer hides"
+    );
+    run(
+        &mut doc,
+        Command::Object(ObjectCommand::ShowLayer {
+            layer,
+            visible: true,
         }),
     );
     run(&mut doc, Command::Object(ObjectCommand::Ungroup(group)));

@@ -1,6 +1,7 @@
 //! The object commands (arrange mode, the Objects window): which object edits act on, show,
 //! lock, rename, move, turn and flip an object, duplicate, instance, make unique, delete,
-//! group, ungroup, merge, split the selection into a new object, show a layer. Each is an
+//! group, ungroup, merge, split the selection into a new object, move nodes into a group,
+//! put objects on a layer, add a layer, show a layer. Each is an
 //! [`ObjectOp`] (a batch for the compound ones, built by `brickmap::objects::arrange`) with
 //! its exact inverse; a command that removes the active object makes the first remaining
 //! one active, and its undo makes it active again. An object moved, turned, copied or
@@ -106,6 +107,25 @@ pub enum ObjectCommand {
     },
     /// The active object's selected voxels move to a new object.
     SplitSelection,
+    /// Moves nodes under a group, before one of its children (at its end when `None`), each
+    /// staying where it is in the world.
+    Reparent {
+        /// The nodes, in the order they take.
+        nodes: Vec<NodeId>,
+        /// The group.
+        parent: NodeId,
+        /// The child they go before.
+        before: Option<NodeId>,
+    },
+    /// Puts the objects among the nodes and in their subtrees on a layer.
+    SetLayer {
+        /// The nodes.
+        nodes: Vec<NodeId>,
+        /// The layer.
+        layer: LayerId,
+    },
+    /// A new layer at the end of the list, shown.
+    AddLayer(String),
     /// Shows or hides a layer.
     ShowLayer {
         /// The layer.
@@ -143,6 +163,11 @@ impl ObjectCommand {
             Self::Ungroup(n) => format!("Ungroup #{}", n.0),
             Self::Merge { nodes, .. } => format!("Merge {} objects", nodes.len()),
             Self::SplitSelection => "Split the selection into an object".into(),
+            Self::Reparent { nodes, parent, .. } => {
+                format!("Move {} into #{}", names(nodes), parent.0)
+            }
+            Self::SetLayer { nodes, layer } => format!("Put {} on layer {}", names(nodes), layer.0),
+            Self::AddLayer(name) => format!("Add layer {name:?}"),
             Self::ShowLayer { layer, visible } => format!(
                 "{} layer {}",
                 if *visible { "Show" } else { "Hide" },
@@ -253,6 +278,38 @@ impl ObjectCommand {
                     .as_ref()
                     .ok_or(EditError::NothingToDo("nothing is selected"))?;
                 arrange::split(&objects, node, &selection.voxels, &table)?
+            }
+            Self::Reparent {
+                nodes,
+                parent,
+                before,
+            } => arrange::reparent(&objects, nodes, *parent, *before)?,
+            Self::SetLayer { nodes, layer } => {
+                let tree = objects.tree();
+                let mut seen = std::collections::BTreeSet::new();
+                let mut ops = Vec::new();
+                for n in nodes {
+                    for node in tree.subtree(*n)? {
+                        if matches!(tree.node(node)?.kind, NodeKind::Object { .. })
+                            && seen.insert(node)
+                        {
+                            ops.push(ObjectOp::SetLayer {
+                                node,
+                                layer: *layer,
+                            });
+                        }
+                    }
+                }
+                ObjectOp::Batch(ops)
+            }
+            Self::AddLayer(name) => {
+                if name.trim().is_empty() {
+                    return Err(invalid("a name needs at least one visible character"));
+                }
+                ObjectOp::AddLayer(brickmap::objects::Layer {
+                    name: name.clone(),
+                    visible: true,
+                })
             }
             Self::ShowLayer { layer, visible } => ObjectOp::ShowLayer {
                 layer: *layer,

@@ -155,6 +155,12 @@ pub enum Step {
         /// Solid voxels of its model.
         #[serde(default)]
         voxels: Option<u64>,
+        /// Its parent group.
+        #[serde(default)]
+        parent: Option<brickmap::objects::NodeId>,
+        /// Its layer (an object's).
+        #[serde(default)]
+        layer: Option<brickmap::objects::LayerId>,
     },
     /// Steps that can be undone and redone.
     ExpectHistory {
@@ -428,6 +434,8 @@ fn run_step(
             placement,
             visible,
             voxels,
+            parent,
+            layer,
         } => {
             let objects = doc.scene.objects();
             let tree = objects.tree();
@@ -435,11 +443,11 @@ fn run_step(
                 .node(*node)
                 .with_context(|| format!("object #{}", node.0))?;
             let at = tree.world_placement(*node)?;
-            let count = match n.kind {
-                brickmap::objects::NodeKind::Object { model, .. } => {
-                    objects.model(model).map(|m| m.solid_count())
+            let (count, on) = match n.kind {
+                brickmap::objects::NodeKind::Object { model, layer } => {
+                    (objects.model(model).map(|m| m.solid_count()), Some(layer))
                 }
-                brickmap::objects::NodeKind::Group { .. } => None,
+                brickmap::objects::NodeKind::Group { .. } => (None, None),
             };
             let checks = [
                 (
@@ -454,6 +462,14 @@ fn run_step(
                 (
                     voxels.is_none_or(|w| Some(w) == count),
                     format!("{count:?} voxels"),
+                ),
+                (
+                    parent.is_none_or(|w| Some(w) == n.parent()),
+                    format!("under {:?}", n.parent()),
+                ),
+                (
+                    layer.is_none_or(|w| Some(w) == on),
+                    format!("on layer {on:?}"),
                 ),
             ];
             for (ok, got) in &checks {

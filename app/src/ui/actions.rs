@@ -156,6 +156,14 @@ impl Editor {
             }
             UiEvent::Generate(spec) => self.execute(Command::GenerateTerrain(spec)),
             UiEvent::Objects(c) => self.execute(Command::Object(c)),
+            UiEvent::EditObject(n) => {
+                if self.read().scene.active() != Some(n) {
+                    self.execute(Command::Object(ObjectCommand::Activate(Some(n))));
+                }
+                if self.settings.brush.tool == Tool::Arrange {
+                    self.settings.brush.tool = Tool::Brush;
+                }
+            }
             UiEvent::Jump { undo, redo } => {
                 for _ in 0..undo {
                     self.edits.submit(&self.doc, Edit::Undo);

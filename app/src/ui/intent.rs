@@ -164,6 +164,8 @@ pub enum UiEvent {
     },
     /// An object command (the Objects window).
     Objects(crate::editor::objects::ObjectCommand),
+    /// Edit this object's voxels: it becomes the one brushes edit, arrange mode ends.
+    EditObject(brickmap::objects::NodeId),
     /// Replace the scene's voxels by generated terrain (undoable).
     Generate(crate::editor::command::TerrainSpec),
     /// Go back (undo) or forward (redo) this many steps in the history.

@@ -1,8 +1,11 @@
 //! The Objects window (the outliner): the tree in drawing order with each node's visibility
-//! and lock toggles, its name (click: pick it, and edit it if an object; Ctrl + click: add
-//! to or take from the picked nodes; double-click: rename), and for an object its model's
-//! size, voxel count and how many objects share the model; the layers with their
-//! visibility; and the arrange commands on the picked nodes. Only the rows in view are laid
+//! and lock toggles, its name (click: pick it, and make it the one brushes edit if an
+//! object; Ctrl + click: add to or take from the picked nodes; double-click: edit an
+//! object's voxels, rename a group; drag: move the picked nodes before, after or into the
+//! row let go on, each staying where it is in the world; right-click: rename, edit, put on a
+//! layer), and for an object its model's size, voxel count and how many objects share the
+//! model; the layers with their visibility (and a new one); and the arrange commands on the
+//! picked nodes. Only the rows in view are laid
 //! out, so a tree of 10,000 objects scrolls as one of ten. Every change is an
 //! [`ObjectCommand`]: undoable, in the History, recorded.
 
@@ -230,6 +233,10 @@ fn layers(ui: &mut egui::Ui, objects: &Objects, out: &mut Vec<UiEvent>) {
                 );
             }
         }
+        let count = objects.tree().layers().len();
+        if count < 256 && ui.button("+").on_hover_text("a new layer").clicked() {
+            send(out, ObjectCommand::AddLayer(format!("layer {count}")));
+        }
     });
 }
 
@@ -250,7 +257,7 @@ fn tree(
         .show_rows(ui, height, rows.len(), |ui, range| {
             for &(id, depth) in &rows[range] {
                 let Ok(n) = tree.node(id) else { continue };
-                ui.horizontal(|ui| {
+                let row = ui.horizontal(|ui| {
                     ui.add_space(depth as f32 * 14.0);
                     let mut visible = n.visible;
                     if ui
@@ -303,9 +310,21 @@ fn tree(
                         text = text.italics();
                     }
                     let picked = state.picked.contains(&id);
-                    let label = ui.selectable_label(picked, text);
+                    let label = ui
+                        .selectable_label(picked, text)
+                        .interact(egui::Sense::drag());
+                    // A drag takes the picked nodes when it starts on one of them.
+                    label.dnd_set_drag_payload(if picked {
+                        state.picked.clone()
+                    } else {
+                        vec![id]
+                    });
                     if label.double_clicked() {
-                        state.renaming = Some((id, n.name.clone()));
+                        if object {
+                            out.push(UiEvent::EditObject(id));
+                        } else {
+                            state.renaming = Some((id, n.name.clone()));
+                        }
                     } else if label.clicked() {
                         if ui.input(|i| i.modifiers.command) {
                             if picked {
@@ -320,6 +339,35 @@ fn tree(
                             }
                         }
                     }
+                    label.context_menu(|ui| {
+                        if ui.button("Rename").clicked() {
+                            state.renaming = Some((id, n.name.clone()));
+                            ui.close();
+                        }
+                        if object && ui.button("Edit its voxels").clicked() {
+                            out.push(UiEvent::EditObject(id));
+                            ui.close();
+                        }
+                        ui.menu_button("Put on layer", |ui| {
+                            let nodes = if picked {
+                                state.picked.clone()
+                            } else {
+                                vec![id]
+                            };
+                            for (i, l) in tree.layers().iter().enumerate() {
+                                if ui.button(&l.name).clicked() {
+                                    send(
+                                        out,
+                                        ObjectCommand::SetLayer {
+                                            nodes: nodes.clone(),
+                                            layer: LayerId(i as u8),
+                                        },
+                                    );
+                                    ui.close();
+                                }
+                            }
+                        });
+                    });
                     if let NodeKind::Object { model, .. } = n.kind
                         && let Some(m) = objects.model(model)
                     {
@@ -339,9 +387,95 @@ fn tree(
                         ));
                     }
                 });
+                drop_on(ui, &row.response, tree, id, out);
             }
         });
-    ui.weak("Bold: the object brushes edit. Double-click a name to rename it.");
+    ui.weak(
+        "Bold: the object brushes edit. Double-click an object to edit it, a group to rename \
+         it; drag names to reorder or regroup; right-click for more.",
+    );
+}
+
+/// Where nodes dropped on a row go: before it (its upper part), after it (its lower part),
+/// or into it (the middle of a group's row).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Drop {
+    Before,
+    After,
+    Into,
+}
+
+/// Which part of a row of height `h` a pointer `y` below its top is over.
+fn drop_at(y: f32, h: f32, group: bool) -> Drop {
+    let f = y / h.max(1.0);
+    match (group, f) {
+        (true, f) if (0.25..0.75).contains(&f) => Drop::Into,
+        (_, f) if f < 0.5 => Drop::Before,
+        _ => Drop::After,
+    }
+}
+
+/// The reparent a drop on `id`'s row asks for: the group and the child to go before.
+fn drop_target(tree: &ObjectTree, id: NodeId, drop: Drop) -> Option<(NodeId, Option<NodeId>)> {
+    let n = tree.node(id).ok()?;
+    if drop == Drop::Into {
+        return Some((id, n.children().first().copied()));
+    }
+    let parent = n.parent()?;
+    let siblings = tree.node(parent).ok()?.children();
+    let at = siblings.iter().position(|c| *c == id)?;
+    Some(match drop {
+        Drop::Before => (parent, Some(id)),
+        _ => (parent, siblings.get(at + 1).copied()),
+    })
+}
+
+/// A row as a drop target of dragged nodes: a line where they would go (a frame round a
+/// group they would go into), and the move when they are let go.
+fn drop_on(
+    ui: &egui::Ui,
+    row: &egui::Response,
+    tree: &ObjectTree,
+    id: NodeId,
+    out: &mut Vec<UiEvent>,
+) {
+    let Some(dragged) = row.dnd_hover_payload::<Vec<NodeId>>() else {
+        return;
+    };
+    let Some(pointer) = ui.input(|i| i.pointer.interact_pos()) else {
+        return;
+    };
+    let group = tree
+        .node(id)
+        .is_ok_and(|n| matches!(n.kind, NodeKind::Group { .. }));
+    let rect = row.rect;
+    let drop = drop_at(pointer.y - rect.top(), rect.height(), group);
+    let stroke = ui.visuals().selection.stroke;
+    match drop {
+        Drop::Before => {
+            ui.painter().hline(rect.x_range(), rect.top(), stroke);
+        }
+        Drop::After => {
+            ui.painter().hline(rect.x_range(), rect.bottom(), stroke);
+        }
+        Drop::Into => {
+            ui.painter()
+                .rect_stroke(rect, 2.0, stroke, egui::StrokeKind::Inside);
+        }
+    }
+    if row.dnd_release_payload::<Vec<NodeId>>().is_some()
+        && !dragged.contains(&id)
+        && let Some((parent, before)) = drop_target(tree, id, drop)
+    {
+        send(
+            out,
+            ObjectCommand::Reparent {
+                nodes: dragged.to_vec(),
+                parent,
+                before,
+            },
+        );
+    }
 }
 
 #[cfg(test)]
@@ -373,5 +507,18 @@ mod tests {
         assert_eq!(rows(&t), vec![(g, 0), (a, 1), (c, 1), (b, 0)]);
         let order: Vec<NodeId> = t.subtree(ObjectTree::ROOT).unwrap()[1..].to_vec();
         assert_eq!(rows(&t).iter().map(|r| r.0).collect::<Vec<_>>(), order);
+        // Drops: on a's upper half before it, its lower half after it (before c), on the
+        // middle of g into g (before its first child); on b's lower half: the root's end.
+        assert_eq!(drop_at(2.0, 20.0, false), Drop::Before);
+        assert_eq!(drop_at(12.0, 20.0, false), Drop::After);
+        assert_eq!(drop_at(10.0, 20.0, true), Drop::Into);
+        assert_eq!(drop_at(18.0, 20.0, true), Drop::After);
+        assert_eq!(drop_target(&t, a, Drop::Before), Some((g, Some(a))));
+        assert_eq!(drop_target(&t, a, Drop::After), Some((g, Some(c))));
+        assert_eq!(drop_target(&t, g, Drop::Into), Some((g, Some(a))));
+        assert_eq!(
+            drop_target(&t, b, Drop::After),
+            Some((ObjectTree::ROOT, None))
+        );
     }
 }

@@ -11,6 +11,8 @@
 //! - **merge**: one new object (identity, a model the size of the objects' joint box) holding
 //!   what the objects show, where they overlap the later one's voxel (the drawing order);
 //!   the objects go;
+//! - **reparent**: nodes move under a group, before one of its children or at its end, each
+//!   where it was in the world (its placement composed anew under the group);
 //! - **delete**: the node and its subtree go, with the models only they placed;
 //! - **split**: the voxels of an object inside a world voxel set move to a new object whose
 //!   model is their box, placed so that they stay where they are.
@@ -187,6 +189,81 @@ pub fn ungroup(o: &Objects, group: NodeId) -> Result<ObjectOp, ObjectError> {
         });
     }
     ops.push(ObjectOp::Remove { node: group });
+    Ok(ObjectOp::Batch(ops))
+}
+
+/// Moves nodes under the group `parent`, before its child `before` (at its end when `None`),
+/// in their order, each staying where it is in the world (its placement composed anew under
+/// the parent). A node inside another one moved goes with it. Refused: the root, a parent
+/// that is not a group or lies inside a moved node, `before` not a child of the parent.
+pub fn reparent(
+    o: &Objects,
+    nodes: &[NodeId],
+    parent: NodeId,
+    before: Option<NodeId>,
+) -> Result<ObjectOp, ObjectError> {
+    let tree = o.tree();
+    let NodeKind::Group { children } = &tree.node(parent)?.kind else {
+        return Err(TreeError::NotAGroup(parent).into());
+    };
+    let mut moved: Vec<NodeId> = Vec::new();
+    for &n in nodes {
+        let mut up = tree.node(n)?.parent().ok_or(TreeError::Root)?;
+        let inside = loop {
+            if nodes.contains(&up) {
+                break true;
+            }
+            match tree.node(up)?.parent() {
+                Some(p) => up = p,
+                None => break false,
+            }
+        };
+        if !inside && !moved.contains(&n) {
+            moved.push(n);
+        }
+    }
+    let mut up = Some(parent);
+    while let Some(u) = up {
+        if let Some(&node) = moved.iter().find(|m| **m == u) {
+            return Err(TreeError::IntoItself { node, parent }.into());
+        }
+        up = tree.node(u)?.parent();
+    }
+    // What the moved nodes go before: `before`, or the first child after it not moved.
+    let anchor = match before {
+        None => None,
+        Some(b) => {
+            let at = children
+                .iter()
+                .position(|c| *c == b)
+                .ok_or(TreeError::NotAChild {
+                    node: b,
+                    group: parent,
+                })?;
+            children[at..].iter().copied().find(|c| !moved.contains(c))
+        }
+    };
+    let into = inverse(&tree.world_placement(parent)?);
+    // The parent's children as each move leaves them (an index counts after the node left).
+    let mut list = children.clone();
+    let mut ops = Vec::new();
+    let mut previous: Option<NodeId> = None;
+    for n in moved {
+        list.retain(|c| *c != n);
+        let at = |x: NodeId, list: &[NodeId]| list.iter().position(|c| *c == x);
+        let index = match previous {
+            Some(p) => at(p, &list).map_or(list.len(), |i| i + 1),
+            None => anchor.and_then(|a| at(a, &list)).unwrap_or(list.len()),
+        };
+        list.insert(index, n);
+        ops.push(ObjectOp::Reparent {
+            node: n,
+            parent,
+            index: Some(index),
+            placement: into.then(&tree.world_placement(n)?),
+        });
+        previous = Some(n);
+    }
     Ok(ObjectOp::Batch(ops))
 }
 
@@ -404,6 +481,66 @@ mod tests {
         assert_eq!(w.read().content_hash(), turned_hash, "nothing moved");
         let pair = o.tree().node(ObjectTree::ROOT).unwrap().children()[0];
         assert_eq!(o.tree().node(pair).unwrap().children(), &root[..2]);
+    }
+
+    #[test]
+    fn reparent_keeps_world_placements_and_orders_as_asked() {
+        let (mut o, w) = start(2);
+        let t = table();
+        let (g, a, b, c) = (NodeId(1), NodeId(2), NodeId(3), NodeId(4));
+        let p = o.tree().node(g).unwrap().placement;
+        let turned = Placement {
+            rot: Orientation::quarter_turn(Axis::Y, 1).after(&Orientation::flip(Axis::X)),
+            t: p.t,
+        };
+        let place = ObjectOp::Place {
+            node: g,
+            placement: turned,
+        };
+        o.apply(&w, place, &t).unwrap();
+        let world = |o: &Objects| {
+            [a, b, c].map(|n| {
+                let m = object(o, n).unwrap().0;
+                let at = o.tree().world_placement(n).unwrap();
+                (at.bounds(o.model(m).unwrap().size()), at.rot)
+            })
+        };
+        let children = |o: &Objects, n: NodeId| o.tree().node(n).unwrap().children().to_vec();
+        let before = world(&o);
+        // c into the turned, mirrored group, before b: nothing moves in the world.
+        let op = reparent(&o, &[c], g, Some(b)).unwrap();
+        round(&mut o, &w, op);
+        assert_eq!(world(&o), before);
+        assert_eq!(children(&o, g), vec![a, c, b]);
+        // b and a (in that order) before c, where a is already before it.
+        let op = reparent(&o, &[b, a], g, Some(c)).unwrap();
+        round(&mut o, &w, op);
+        assert_eq!(children(&o, g), vec![b, a, c]);
+        // Before a moved node: before the first child after it not moved.
+        let op = reparent(&o, &[b], g, Some(b)).unwrap();
+        round(&mut o, &w, op);
+        assert_eq!(children(&o, g), vec![b, a, c]);
+        // The group and one of its children out to the root's end: the child goes with it.
+        let op = reparent(&o, &[a, g], ObjectTree::ROOT, None).unwrap();
+        round(&mut o, &w, op);
+        assert_eq!(children(&o, ObjectTree::ROOT), vec![g]);
+        assert_eq!(children(&o, g), vec![b, a, c]);
+        assert_eq!(world(&o), before);
+        // Refusals.
+        assert!(matches!(
+            reparent(&o, &[a], g, Some(g)),
+            Err(ObjectError::Tree(TreeError::NotAChild { .. }))
+        ));
+        assert!(reparent(&o, &[ObjectTree::ROOT], g, None).is_err());
+        assert!(matches!(
+            reparent(&o, &[g], a, None),
+            Err(ObjectError::Tree(TreeError::NotAGroup(_)))
+        ));
+        assert!(matches!(
+            reparent(&o, &[g], g, None),
+            Err(ObjectError::Tree(TreeError::IntoItself { .. }))
+        ));
+        assert_eq!(children(&o, ObjectTree::ROOT), vec![g]);
     }
 
     #[test]

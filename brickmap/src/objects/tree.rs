@@ -134,6 +134,14 @@ pub enum TreeError {
         /// Its children.
         len: usize,
     },
+    /// A node named as a group's child is not one of its children.
+    #[error("node #{} is not a child of group #{}", .node.0, .group.0)]
+    NotAChild {
+        /// The node.
+        node: NodeId,
+        /// The group.
+        group: NodeId,
+    },
     /// Deeper than [`MAX_DEPTH`].
     #[error("the tree would be deeper than {MAX_DEPTH} levels")]
     TooDeep,
