@@ -3,7 +3,8 @@
 //! of sleeping: mouse strokes, keys and selections replay headlessly to the saved scene; a
 //! drag whose moves arrive faster than frames is one connected stroke that reaches the release
 //! point; an editor killed after an autosave offers it on the next start, and recovering gives
-//! the autosaved content. Without Xvfb, xdotool or a Vulkan driver the tests skip, saying so,
+//! the autosaved content; objects are picked and turned in arrange mode, duplicated and
+//! reordered in the Objects window (found by the `widget` lines of the log) and edited. Without Xvfb, xdotool or a Vulkan driver the tests skip, saying so,
 //! unless VOXBRICK_REQUIRE_GPU=1 (CI) makes that a failure.
 
 mod window;
@@ -168,6 +169,33 @@ impl Session {
             eprintln!("{chord} went missing: sent again");
         }
         self.report.wait(chord, |l| l.starts_with(answer));
+    }
+
+    /// Where the widget labelled `label` shows (its centre, as the editor last said), once a
+    /// frame after every line consumed so far was shown.
+    fn widget(&mut self, label: &str) -> (i32, i32) {
+        self.report.frame();
+        let parse = |l: &str| -> Option<(i32, i32)> {
+            let rest = l.strip_prefix("widget ")?;
+            let mut parts = rest.splitn(3, ' ');
+            let (x, y, name) = (parts.next()?, parts.next()?, parts.next()?);
+            if name != label {
+                return None;
+            }
+            Some((x.parse().ok()?, y.parse().ok()?))
+        };
+        if let Some(at) = self.report.lines().iter().rev().find_map(|l| parse(l)) {
+            return at;
+        }
+        let line = self.report.wait(label, |l| parse(l).is_some());
+        parse(&line).unwrap()
+    }
+
+    /// A left click at `p`, handled.
+    fn click(&mut self, p: (i32, i32)) {
+        self.mouse_to(p);
+        self.press();
+        self.release();
     }
 
     /// Quits with Ctrl+Q (sent again if the key went missing) and returns the output.
@@ -460,6 +488,94 @@ fn a_drag_faster_than_the_frames_is_one_connected_stroke_reaching_the_release_po
         .find(|l| l.starts_with("stroke begin "))
         .unwrap();
     assert!(added.contains(&voxel_of(begin)), "{begin}");
+}
+
+/// Both modes and the Objects window, by mouse and keys: Tab, a click picks the terrain
+/// object, Alt + Y turns it; View → Objects, Duplicate, the copy dragged above the original
+/// (reordered), a double-click on the original edits it (the brush again) and a stroke
+/// draws on it. The saved project holds both objects in the new order, and the recorded
+/// session replays headlessly to the same scene.
+#[test]
+fn objects_are_arranged_in_the_viewport_and_the_objects_window_and_edited() {
+    let Some(x) = tools_ready() else { return };
+    let dir = scratch("objects");
+    let (work, session) = (dir.join("work.ron"), dir.join("session.ron"));
+    let Some(mut s) = Session::recorded(&x, &dir, "960x540") else {
+        return;
+    };
+    s.key("Tab", "Tab", "input key Code(Tab) down");
+    s.click((480, 300));
+    s.report.frame();
+    s.key("alt+y", "KeyY", "edited command Turn #1 90° about Y: ok");
+    let view = s.widget("View");
+    s.click(view);
+    let objects = s.widget("Objects");
+    s.click(objects);
+    let duplicate = s.widget("Duplicate");
+    s.click(duplicate);
+    s.report.wait("the copy", |l| {
+        l.starts_with("edited command Duplicate #1: ok")
+    });
+    // The copy's row dragged onto the upper part of the original's: it goes before it.
+    let original = s.widget("scene");
+    let copy = s.widget("scene copy");
+    let steps: Vec<(i32, i32)> = (0..=6)
+        .map(|k| (copy.0, copy.1 + (original.1 - 4 - copy.1) * k / 6))
+        .collect();
+    s.drag(&steps, Some("edited command Move #2 into #0: ok"));
+    // A double-click on the original's row: edit its voxels with the brush.
+    let original = s.widget("scene");
+    s.mouse_to(original);
+    s.xdotool(&["click", "--repeat", "2", "--delay", "60", "1"]);
+    s.report.frame();
+    s.drag(
+        &[(640, 420), (650, 425), (660, 430)],
+        Some("edited stroke end"),
+    );
+    s.key("ctrl+s", "KeyS", "saved ");
+    let out = s.quit();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "the editor failed: {stderr}");
+    assert!(!stderr.contains("vulkan "), "validation messages: {stderr}");
+    let text = std::fs::read_to_string(&session).expect("the session was recorded");
+    for what in ["Turn(", "Duplicate(", "Reparent(", "Stroke("] {
+        assert!(text.contains(what), "{what} missing:\n{text}");
+    }
+    // The saved tree: the copy first, then the original, which the stroke changed.
+    let scene = app::formats::load(&work, 1).unwrap();
+    let objects = scene.objects();
+    let tree = objects.tree();
+    let names: Vec<&str> = tree
+        .node(brickmap::objects::ObjectTree::ROOT)
+        .unwrap()
+        .children()
+        .iter()
+        .map(|c| tree.node(*c).unwrap().name.as_str())
+        .collect();
+    assert_eq!(names, ["scene copy", "scene"]);
+    let solid = |name: &str| {
+        tree.subtree(brickmap::objects::ObjectTree::ROOT)
+            .unwrap()
+            .into_iter()
+            .find_map(|n| match tree.node(n).unwrap() {
+                node if node.name != name => None,
+                node => match node.kind {
+                    brickmap::objects::NodeKind::Object { model, .. } => {
+                        Some(objects.model(model).unwrap().solid_count())
+                    }
+                    _ => None,
+                },
+            })
+            .unwrap()
+    };
+    assert_ne!(
+        solid("scene"),
+        solid("scene copy"),
+        "the stroke drew on one"
+    );
+    let replayed = dir.join("replayed");
+    window::replay(env!("CARGO_BIN_EXE_voxbrick"), &session, &replayed);
+    assert_eq!(hash(&work), hash(&replayed.join("work.ron")));
 }
 
 #[test]

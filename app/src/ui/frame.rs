@@ -133,6 +133,13 @@ impl Editor {
             title: String::new(),
         });
         self.refresh_stats();
+        // The accessibility tree names the widgets drawn: a headless driver asks for them
+        // (`Editor::widget`), a report file is told where they are.
+        if matches!(self.gfx.as_ref().map(|g| &g.host), Some(Host::Headless(_)))
+            || self.report.to_file()
+        {
+            self.egui.enable_accesskit();
+        }
         Ok(())
     }
 
@@ -393,6 +400,14 @@ impl Editor {
             pixels_per_point,
             viewport_output,
         } = output;
+        // A driver outside the process learns where the labelled widgets are.
+        let mut platform_output = platform_output;
+        if self.report.to_file()
+            && let Some(update) = platform_output.accesskit_update.take()
+        {
+            let widgets = super::host::labelled_widgets(&update);
+            self.report.widgets(&widgets, pixels_per_point);
+        }
         gfx.host.handle_platform_output(platform_output);
         // Texture changes wait here until a frame with the UI applies them.
         self.frames.textures.append(textures_delta);

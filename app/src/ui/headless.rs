@@ -42,8 +42,6 @@ impl Editor {
         let size = (size.0.max(1), size.1.max(1));
         let presenter = Presenter::offscreen(ctx.clone(), size)?;
         editor.attach(ctx, presenter, Host::Headless(Headless::new(size)), size)?;
-        // Its accessibility tree names the widgets drawn (see [`Editor::widget`]).
-        editor.egui.enable_accesskit();
         Ok(editor)
     }
 

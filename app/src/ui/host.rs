@@ -164,24 +164,30 @@ impl Host {
                 egui_state, window, ..
             } => egui_state.handle_platform_output(window, output),
             Host::Headless(h) => {
-                if let Some(update) = output.accesskit_update {
-                    h.widgets = update
-                        .nodes
-                        .iter()
-                        .filter_map(|(_, node)| {
-                            let label = node.label().or(node.value())?;
-                            let b = node.bounds()?;
-                            let rect = egui::Rect::from_min_max(
-                                egui::pos2(b.x0 as f32, b.y0 as f32),
-                                egui::pos2(b.x1 as f32, b.y1 as f32),
-                            );
-                            Some((label.to_string(), rect))
-                        })
-                        .collect();
+                if let Some(update) = &output.accesskit_update {
+                    h.widgets = labelled_widgets(update);
                 }
             }
         }
     }
+}
+
+/// The widgets of an accessibility update that have a label (or a value), with their
+/// rectangles in points, in the update's order.
+pub fn labelled_widgets(update: &egui::accesskit::TreeUpdate) -> Vec<(String, egui::Rect)> {
+    update
+        .nodes
+        .iter()
+        .filter_map(|(_, node)| {
+            let label = node.label().or(node.value())?;
+            let b = node.bounds()?;
+            let rect = egui::Rect::from_min_max(
+                egui::pos2(b.x0 as f32, b.y0 as f32),
+                egui::pos2(b.x1 as f32, b.y1 as f32),
+            );
+            Some((label.to_string(), rect))
+        })
+        .collect()
 }
 
 #[cfg(test)]
