@@ -106,6 +106,15 @@ impl Scene {
         self.active
     }
 
+    /// The size of the active object's model, in voxels (`None` without one).
+    pub fn active_size(&self) -> Option<IVec3> {
+        let objects = self.objects();
+        match objects.tree().node(self.active?).ok()?.kind {
+            NodeKind::Object { model, .. } => objects.model(model).map(|m| m.size()),
+            NodeKind::Group { .. } => None,
+        }
+    }
+
     /// Makes `node` the object voxel edits act on (`None`: none).
     pub fn set_active(&mut self, node: Option<NodeId>) {
         self.active = node;

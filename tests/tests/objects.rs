@@ -513,3 +513,53 @@ fn an_imported_vox_file_joins_the_scene_as_its_objects() {
     assert_eq!(doc.scene.world.dims(), grid);
     assert_eq!(objects_in_order(&doc).len(), before);
 }
+
+/// A new empty object away from the origin (its size not whole bricks), then a terrain
+/// generated into it: the terrain fills the object's own box, the world shows exactly the
+/// objects, and undo takes the terrain and then the object away exactly.
+#[test]
+fn a_new_object_takes_a_terrain_of_its_own_size_wherever_it_stands() {
+    let (mut doc, _) = small_default();
+    let first = doc.scene.active().unwrap();
+    let hash = doc.scene.world.read().content_hash();
+    let (at, size) = (IVec3::new(21, 3, 37), IVec3::new(45, 20, 30));
+    doc.execute(Command::Object(ObjectCommand::NewObject {
+        name: "hill".into(),
+        size,
+        at,
+    }))
+    .unwrap();
+    let hill = doc.scene.active().unwrap();
+    assert_ne!(hill, first, "the new object is the one brushes edit");
+    assert_eq!(doc.scene.world.read().content_hash(), hash, "it is empty");
+    doc.execute(Command::GenerateTerrain(
+        app::editor::command::TerrainSpec {
+            seed: 7,
+            scale: 24.0,
+            octaves: 3,
+            height_range: (2, 18),
+            water_level: 0,
+            noise: Default::default(),
+            bands: Default::default(),
+        },
+    ))
+    .unwrap();
+    assert_composite(&doc, "terrain in an object");
+    let objects = doc.scene.objects();
+    let NodeKind::Object { model, .. } = objects.tree().node(hill).unwrap().kind else {
+        panic!("an object")
+    };
+    let m = objects.model(model).unwrap();
+    assert_eq!(m.size(), size);
+    assert!(m.solid_count() > 0, "the terrain is in the new object");
+    // Its columns stand on the model's floor: the lowest layer is full.
+    for (x, z) in [(0, 0), (44, 29), (20, 15)] {
+        assert!(m.voxel(IVec3::new(x, 0, z)).is_some(), "column {x}, {z}");
+    }
+    drop(objects);
+    doc.undo().unwrap();
+    assert_eq!(doc.scene.world.read().content_hash(), hash);
+    doc.undo().unwrap();
+    assert_eq!(doc.scene.active(), Some(first));
+    assert_eq!(objects_in_order(&doc), vec![first]);
+}

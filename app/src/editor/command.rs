@@ -452,16 +452,23 @@ impl Command {
             Command::GenerateTerrain(t) => {
                 let before = world.materials().clone();
                 let result = (|| {
+                    // The terrain fills the active object's model, wherever it stands.
+                    let node = scene
+                        .active()
+                        .ok_or(brickmap::objects::ObjectError::NoActiveObject)?;
+                    let size = scene
+                        .active_size()
+                        .ok_or(brickmap::objects::ObjectError::NotAnObject(node))?;
+                    let dims = brickmap::GridDims::from_voxels(size.as_uvec3())?;
                     let materials = crate::builtin::terrain_materials(world)?;
-                    let mut params =
-                        crate::builtin::thesis_terrain(materials, world.dims().voxels().y as u32);
+                    let mut params = crate::builtin::thesis_terrain(materials, size.y as u32);
                     (params.seed, params.noise, params.scale, params.octaves) =
                         (t.seed, t.noise, t.scale, t.octaves);
                     (params.height_range, params.water_level) = (t.height_range, t.water_level);
                     (params.rock_line, params.snow_line, params.soil_depth) =
                         (t.bands.rock_line, t.bands.snow_line, t.bands.soil_depth);
-                    let b = world.dims().bricks();
-                    let edit = match NoiseTerrain::new(params, world.dims())?.edit() {
+                    let b = dims.bricks();
+                    let edit = match NoiseTerrain::new(params, dims)?.edit() {
                         EditOp::Generate(g) => {
                             EditOp::Generate(brickmap::edit::Generator(std::sync::Arc::new(
                                 super::progress::Counted::new(g.0, progress.clone(), (b.x, b.z)),
@@ -469,7 +476,7 @@ impl Command {
                         }
                         other => other,
                     };
-                    let out = scene.edit(edit);
+                    let out = scene.apply(brickmap::objects::ObjectOp::EditInModel { node, edit });
                     progress.finish();
                     Ok::<_, EditError>(out?)
                 })();

@@ -126,6 +126,16 @@ pub enum ObjectCommand {
     },
     /// A new layer at the end of the list, shown.
     AddLayer(String),
+    /// A new empty object of its own model, its lowest corner at `at` (world voxels), at
+    /// the end of the drawing order; brushes edit it next.
+    NewObject {
+        /// Its name.
+        name: String,
+        /// Its model's size in voxels.
+        size: IVec3,
+        /// Where its lowest corner goes.
+        at: IVec3,
+    },
     /// Shows or hides a layer.
     ShowLayer {
         /// The layer.
@@ -168,6 +178,9 @@ impl ObjectCommand {
             }
             Self::SetLayer { nodes, layer } => format!("Put {} on layer {}", names(nodes), layer.0),
             Self::AddLayer(name) => format!("Add layer {name:?}"),
+            Self::NewObject { name, size, .. } => {
+                format!("New object {name:?} {}×{}×{}", size.x, size.y, size.z)
+            }
             Self::ShowLayer { layer, visible } => format!(
                 "{} layer {}",
                 if *visible { "Show" } else { "Hide" },
@@ -192,7 +205,16 @@ impl ObjectCommand {
                 changed_voxels: 0,
             });
         }
+        let new_node = lowest_free(&scene.objects());
         let (inverse, changed_voxels) = apply_growing(scene, |scene| self.op(scene))?;
+        // A new object is the one brushes edit.
+        if matches!(self, Self::NewObject { .. }) {
+            scene.set_active(Some(new_node));
+            return Ok(Applied {
+                inverse: Inverse::Compound(vec![inverse, Inverse::Active(before)]),
+                changed_voxels,
+            });
+        }
         // The active object gone (deleted, merged, ungrouped away): the first one left.
         let gone = before.is_some_and(|n| {
             !scene
@@ -311,6 +333,28 @@ impl ObjectCommand {
                     visible: true,
                 })
             }
+            Self::NewObject { name, size, at } => {
+                if name.trim().is_empty() {
+                    return Err(invalid("a name needs at least one visible character"));
+                }
+                let model = objects.free_model_id();
+                let voxels = brickmap::objects::Model::new(*size)?;
+                let layer = active_layer(scene, &objects);
+                ObjectOp::Batch(vec![
+                    ObjectOp::AddModel {
+                        model,
+                        voxels: Box::new(voxels),
+                    },
+                    ObjectOp::Add {
+                        parent: brickmap::objects::ObjectTree::ROOT,
+                        index: None,
+                        name: name.clone(),
+                        // The model's centre (its pivot) goes at the corner plus half its size.
+                        placement: Placement::at(*at + *size / 2),
+                        new: brickmap::objects::NewNode::Object { model, layer },
+                    },
+                ])
+            }
             Self::ShowLayer { layer, visible } => ObjectOp::ShowLayer {
                 layer: *layer,
                 visible: *visible,
@@ -399,13 +443,7 @@ pub(super) fn import_ops(
         });
     }
     let file = &into.tree;
-    let layer = scene
-        .active()
-        .and_then(|n| match tree.node(n).ok()?.kind {
-            NodeKind::Object { layer, .. } => Some(layer),
-            NodeKind::Group { .. } => None,
-        })
-        .unwrap_or(LayerId(0));
+    let layer = active_layer(scene, &objects);
     let mut node_ids = std::collections::BTreeMap::new();
     let mut flags = Vec::new();
     for id in file.subtree(ObjectTree::ROOT)? {
@@ -448,6 +486,25 @@ pub(super) fn import_ops(
     }
     ops.extend(flags);
     Ok(ObjectOp::Batch(ops))
+}
+
+/// The layer of the object brushes edit (new objects go on it), else the first.
+fn active_layer(scene: &Scene, objects: &brickmap::objects::Objects) -> LayerId {
+    scene
+        .active()
+        .and_then(|n| match objects.tree().node(n).ok()?.kind {
+            NodeKind::Object { layer, .. } => Some(layer),
+            NodeKind::Group { .. } => None,
+        })
+        .unwrap_or(LayerId(0))
+}
+
+/// The id the tree gives its next new node (the lowest free).
+fn lowest_free(objects: &brickmap::objects::Objects) -> NodeId {
+    (0u32..)
+        .map(NodeId)
+        .find(|n| objects.tree().node(*n).is_err())
+        .expect("fewer than 2^32 nodes")
 }
 
 /// The largest grid, in voxels.

@@ -185,7 +185,8 @@ pub fn draw(
 ) {
     if let Some(spec) = &mut state.terrain {
         let mut open = true;
-        let height = doc.scene.world.dims().voxels().y as u32;
+        // The terrain fills the object brushes edit.
+        let height = doc.scene.active_size().map_or(0, |s| s.y as u32);
         window(area, "Terrain and water")
             .open(&mut open)
             .show(ctx, |ui| terrain(ui, spec, height, out));
@@ -655,7 +656,9 @@ fn terrain(ui: &mut egui::Ui, spec: &mut TerrainSpec, height: u32, out: &mut Vec
     b.snow_line = b.snow_line.max(b.rock_line);
     ui.add(egui::Slider::new(&mut b.soil_depth, 0..=32).text("soil depth (grass, dirt)"));
     ui.label("Sand lines the water; colours are in the palette after generating.");
-    ui.label("Replaces every voxel of the scene (one undoable step), on the workers.");
+    ui.label(
+        "Replaces every voxel of the object brushes edit, filling its box (one undoable step).",
+    );
     if ui.button("Generate").clicked() {
         out.push(UiEvent::Generate(spec.clone()));
     }

@@ -26,6 +26,8 @@ pub struct OutlinerState {
     pub renaming: Option<(NodeId, String)>,
     /// How far the move buttons move, in voxels.
     pub step: i32,
+    /// The size of a new object.
+    pub new_size: [i32; 3],
 }
 
 impl Default for OutlinerState {
@@ -36,6 +38,7 @@ impl Default for OutlinerState {
             picked: Vec::new(),
             renaming: None,
             step: 1,
+            new_size: [32, 32, 32],
         }
     }
 }
@@ -72,6 +75,7 @@ pub fn draw(
     window(area, "Objects").open(&mut open).show(ctx, |ui| {
         let objects = doc.scene.objects();
         state.picked.retain(|n| objects.tree().node(*n).is_ok());
+        new_object(ui, state, doc.scene.world.dims().voxels(), out);
         commands(ui, state, &objects, out);
         ui.separator();
         layers(ui, &objects, out);
@@ -83,6 +87,28 @@ pub fn draw(
 
 fn send(out: &mut Vec<UiEvent>, c: ObjectCommand) {
     out.push(UiEvent::Objects(c));
+}
+
+/// A new empty object of the size asked, standing on the grid's floor at its centre.
+fn new_object(ui: &mut egui::Ui, state: &mut OutlinerState, grid: IVec3, out: &mut Vec<UiEvent>) {
+    ui.horizontal(|ui| {
+        let new = ui.button("New object");
+        for v in &mut state.new_size {
+            ui.add(egui::DragValue::new(v).range(1..=256));
+        }
+        if new.clicked() {
+            let size = IVec3::from_array(state.new_size);
+            let at = IVec3::new((grid.x - size.x) / 2, 0, (grid.z - size.z) / 2);
+            send(
+                out,
+                ObjectCommand::NewObject {
+                    name: "object".into(),
+                    size,
+                    at,
+                },
+            );
+        }
+    });
 }
 
 /// The arrange buttons, on the picked nodes.

@@ -96,6 +96,13 @@ pub struct Composite {
 }
 
 impl Composite {
+    /// Bytes it holds on the heap: its entries and the index's region lists.
+    pub fn heap_bytes(&self) -> usize {
+        self.entries.capacity() * std::mem::size_of::<Entry>()
+            + self.index.capacity() * std::mem::size_of::<([i32; 3], Vec<u32>)>()
+            + self.index.values().map(|v| v.capacity() * 4).sum::<usize>()
+    }
+
     /// The composite of a tree's visible objects for a world of `grid` voxels. Refuses an
     /// object outside the grid or naming a missing model.
     pub fn new(

@@ -19,6 +19,14 @@ pub enum ObjectOp {
         /// The edit, in world voxels.
         edit: EditOp,
     },
+    /// An edit in an object's model's own voxels (its frame, not the world's: a generator
+    /// made for the model's size fills it wherever the object stands).
+    EditInModel {
+        /// The object.
+        node: NodeId,
+        /// The edit, in model voxels.
+        edit: EditOp,
+    },
     /// Puts back what a model edit changed (the inverse of `Edit`, in the model's frame).
     RestoreModel {
         /// The model.

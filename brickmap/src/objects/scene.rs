@@ -139,6 +139,11 @@ impl Objects {
                 let carried = p.edit_to_model(&edit, size)?;
                 self.edit_model(world, model, &carried, table, changed)
             }
+            ObjectOp::EditInModel { node, edit } => {
+                self.unlocked(node)?;
+                let model = self.object_model(node)?;
+                self.edit_model(world, model, &edit, table, changed)
+            }
             ObjectOp::RestoreModel { model, inverse } => {
                 self.edit_model(world, model, &EditOp::Restore(inverse), table, changed)
             }
@@ -456,6 +461,14 @@ impl Objects {
     /// The object whose voxel shows at world cell `v`, if any (what a click picks).
     pub fn object_at(&self, v: IVec3) -> Option<NodeId> {
         self.composite.object_at(v, &self.models)
+    }
+
+    /// Bytes the objects hold beside the world they composite into: the models' bricks
+    /// (each model once, however many objects place it), and the tree with the composite's
+    /// index (its entries and region lists).
+    pub fn bytes(&self) -> (usize, usize) {
+        let models = self.models.values().map(Model::brick_bytes).sum();
+        (models, self.tree.heap_bytes() + self.composite.heap_bytes())
     }
 
     /// The grid the composite fills, in voxels.

@@ -86,6 +86,15 @@ impl Node {
         self.parent
     }
 
+    /// Bytes it holds on the heap (its name, its child list).
+    fn heap_bytes(&self) -> usize {
+        self.name.capacity()
+            + match &self.kind {
+                NodeKind::Group { children } => children.capacity() * 4,
+                NodeKind::Object { .. } => 0,
+            }
+    }
+
     /// The children (none for an object).
     pub fn children(&self) -> &[NodeId] {
         match &self.kind {
@@ -180,13 +189,7 @@ impl Detached {
             + self
                 .nodes
                 .iter()
-                .map(|(_, n)| {
-                    n.name.capacity()
-                        + match &n.kind {
-                            NodeKind::Group { children } => children.capacity() * 4,
-                            NodeKind::Object { .. } => 0,
-                        }
-                })
+                .map(|(_, n)| n.heap_bytes())
                 .sum::<usize>()
     }
 }
@@ -216,6 +219,19 @@ impl Default for ObjectTree {
 }
 
 impl ObjectTree {
+    /// Bytes it holds on the heap (the nodes, their names and child lists, the layers).
+    pub fn heap_bytes(&self) -> usize {
+        self.nodes.capacity() * std::mem::size_of::<Option<Node>>()
+            + self
+                .nodes
+                .iter()
+                .flatten()
+                .map(Node::heap_bytes)
+                .sum::<usize>()
+            + self.layers.capacity() * std::mem::size_of::<Layer>()
+            + self.layers.iter().map(|l| l.name.capacity()).sum::<usize>()
+    }
+
     /// The root group alone, with one visible layer.
     pub fn new() -> Self {
         Self {

@@ -4,6 +4,8 @@
 //! scene. Reports GPU time per frame (timestamp queries), host time to record and submit a
 //! frame, and camera move → first frame showing it (frames and ms, submit to completion).
 
+mod objects;
+
 use super::{args, emit, with_progress};
 use anyhow::{Result, bail};
 use app::builtin::{SceneSize, default_scene, thesis_scene};
@@ -491,6 +493,7 @@ fn edits(
     }
     text += &first_clicks(&mut vp, &mut doc, size, &params, radii)?;
     text += &selection_edits(&mut vp, &mut doc, size, &params)?;
+    text += &objects::object_edits(&mut vp, &mut doc, size, &params)?;
     Ok(text)
 }
 
@@ -601,13 +604,13 @@ fn selection_edits(
     use app::editor::command::Command;
     use app::selection::SelectOp;
     use glam::IVec3;
-    const REPEATS: usize = 7;
     let req = edit_request(params, size, 0.5);
     let (min, max) = (IVec3::new(64, 48, 64), IVec3::new(319, 111, 319));
     // `undo`: the operation changes voxels, is shown, then undone for the next run.
     let select = Command::Select(SelectOp::Replace { min, max });
     let mut text = format!(
-        "\nselection {min} … {max} (256 x 64 x 256), internal scale 0.5, {REPEATS} runs each\noperation                 voxels changed   apply ms median (max)   edit → frame ms median (max), frames   uploaded MB\n"
+        "\nselection {min} … {max} (256 x 64 x 256), internal scale 0.5, {} runs each\noperation                 voxels changed   apply ms median (max)   edit → frame ms median (max), frames   uploaded MB\n",
+        objects::REPEATS
     );
     let cases = [
         ("select", select.clone(), false),
@@ -635,36 +638,19 @@ fn selection_edits(
     doc.execute(Command::Copy)?;
     frames_until_shown(vp, &doc.scene.world, &req)?;
     for (name, command, undo) in cases {
-        let (mut apply, mut shown, mut frames, mut mb, mut changed) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), 0);
-        for _ in 0..REPEATS {
-            let event = Instant::now();
-            let done = doc.execute(command.clone())?;
-            apply.push(event.elapsed().as_secs_f64() * 1e3);
-            changed = done.changed_voxels;
-            if !undo {
-                // Selecting and copying change no voxel: nothing to show.
-                continue;
-            }
-            let (n, bytes) = frames_until_shown(vp, &doc.scene.world, &req)?;
-            shown.push(event.elapsed().as_secs_f64() * 1e3);
-            frames.push(n as f64);
-            mb.push(bytes as f64 / 1e6);
-            {
-                doc.undo()?;
-                frames_until_shown(vp, &doc.scene.world, &req)?;
-            }
-        }
-        let (_, a50, _, amax) = stats(apply);
+        let t = objects::timed(vp, doc, &req, &command, undo)?;
         let shown_text = if undo {
-            let (_, s50, _, smax) = stats(shown);
-            let (_, f50, _, _) = stats(frames);
-            let (_, m50, _, _) = stats(mb);
-            format!("{s50:.1} ({smax:.1}), {f50:.0}                 {m50:.2}")
+            format!(
+                "{:.1} ({:.1}), {:.0}                 {:.2}",
+                t.shown.0, t.shown.1, t.frames, t.mb
+            )
         } else {
             "- (no voxel changes)".into()
         };
-        text += &format!("{name:<25} {changed:<16} {a50:.1} ({amax:.1})            {shown_text}\n");
+        text += &format!(
+            "{name:<25} {:<16} {:.1} ({:.1})            {shown_text}\n",
+            t.changed, t.apply.0, t.apply.1
+        );
     }
     Ok(text)
 }
