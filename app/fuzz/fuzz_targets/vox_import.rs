@@ -1,5 +1,5 @@
-//! Any bytes given to the .vox importer (flattened, and as objects): an error or a scene,
-//! never a panic or a hang.
+//! Any bytes given to the .vox importer (flattened, as objects, and as objects added to a
+//! scene): an error or a scene, never a panic or a hang.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -14,5 +14,14 @@ fuzz_target!(|data: &[u8]| {
     // Imported as objects: an error or objects whose composite keeps the invariants.
     if let Ok(import) = app::formats::vox::import_objects(data, std::path::Path::new("fuzz.vox"), 1) {
         import.scene.world.read().validate().expect("the composite keeps the world's invariants");
+    }
+    // Added to a scene (File → Import): an error, or models that fit and a tree.
+    let world = brickmap::World::new(
+        brickmap::GridDims::new(8, 4, 8).unwrap(),
+        brickmap::WorldConfig::with_workers(1),
+    )
+    .unwrap();
+    if let Ok(into) = app::formats::vox::objects_into(&world, data, glam::IVec3::new(3, 0, 5)) {
+        assert!(into.tree.len() >= 1);
     }
 });
