@@ -6,8 +6,10 @@
 //! with its undo), and the whole composite rebuilt (every object written into an empty
 //! world of the grid's size).
 //!
-//! Run: `cargo bench -p app --bench objects_scene`. With `VOXBRICK_BENCH_OUT=FILE` the
-//! project is also written there (for `voxbrick render` on another machine).
+//! Run: `cargo bench -p app --bench objects_scene`. With `VOXBRICK_BENCH_OUT=DIR` the
+//! project goes there, with the replay script that builds it from `assets/vox` (`DIR` one
+//! folder below the repository's root: `voxbrick replay DIR/objects-scene.ron --save …`
+//! on another machine).
 
 use app::editor::Document;
 use app::editor::command::Command;
@@ -93,6 +95,11 @@ fn scene() -> &'static (Document, PathBuf) {
         // 2048 in z.
         let (mut x, mut z, mut y, mut row_depth, mut layer_height) = (0, 0, 0, 0, 0);
         let mut imports = 0;
+        let mut script = String::from(
+            "// 1,000 objects: every readable .vox of assets/vox imported side by side, round\n\
+             // after round (written by app/benches/objects_scene.rs).\n\
+             (format_version: 1, start: New(size: (1024, 128, 1024)), workers: None, steps: [\n",
+        );
         while count(&doc.scene.objects()) < OBJECTS {
             for (path, size) in &files {
                 if x + size.x > 2048 {
@@ -110,6 +117,10 @@ fn scene() -> &'static (Document, PathBuf) {
                     offset: IVec3::new(x, y, z),
                 })
                 .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+                let name = path.file_name().unwrap().to_string_lossy();
+                script += &format!(
+                    "    Do(ImportVox(path: \"../assets/vox/{name}\", offset: ({x}, {y}, {z}))),\n"
+                );
                 imports += 1;
                 x += size.x + 8;
                 row_depth = row_depth.max(size.z);
@@ -120,9 +131,12 @@ fn scene() -> &'static (Document, PathBuf) {
             "{imports} imports in {:.1} s",
             started.elapsed().as_secs_f64()
         );
-        let file = std::env::var_os("VOXBRICK_BENCH_OUT")
+        let dir = std::env::var_os("VOXBRICK_BENCH_OUT")
             .map(PathBuf::from)
-            .unwrap_or_else(|| std::env::temp_dir().join("voxbrick-thousand-objects.ron"));
+            .unwrap_or_else(std::env::temp_dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("objects-scene.ron"), script + "])\n").unwrap();
+        let file = dir.join("objects-scene-project.ron");
         doc.save(&file).unwrap();
         (doc, file)
     })
@@ -151,8 +165,10 @@ fn composite_every_object(bencher: Bencher) {
     let (doc, _) = scene();
     let objects = doc.scene.objects();
     let dims = doc.scene.world.dims();
+    let table = doc.scene.world.materials().clone();
     bencher.bench(|| {
         let world = World::new(dims, WorldConfig::with_workers(0)).unwrap();
+        world.replace_materials(table.clone()).unwrap();
         Objects::new(objects.tree().clone(), objects.models().clone(), &world).unwrap()
     });
 }
