@@ -1,7 +1,7 @@
 //! `bench-viewport --edits`, objects: a 256 × 64 × 256 part of the default scene split into
-//! an object of its own (about 2 M voxels); moved by a voxel; a sphere drawn into it with
-//! one instance of its model and with 100 instances; the bytes the objects hold beside the
-//! world. Each operation applied (timed), shown (timed, to the first frame with all of it
+//! an object of its own (about 2 M voxels) and moved by a voxel; a 40 × 64 × 40 column split
+//! off, a sphere drawn into it with one instance of its model and with 100 instances (on a
+//! lattice over the terrain); the bytes the objects hold beside the world. Each operation applied (timed), shown (timed, to the first frame with all of it
 //! uploaded) and undone (not timed), several times.
 
 use super::{edit_request, frames_until_shown, stats};
@@ -10,6 +10,7 @@ use app::editor::Document;
 use app::editor::command::{BrushMode, BrushShape, Command, Mirror, Stroke};
 use app::editor::objects::ObjectCommand;
 use app::selection::SelectOp;
+use brickmap::objects::{NodeId, NodeKind};
 use glam::{DVec3, IVec3};
 use render::viewport::{FrameRequest, Viewport};
 use std::time::Instant;
@@ -68,8 +69,48 @@ pub(super) fn timed(
     })
 }
 
-/// The object cases (see the module doc); `doc` is the default scene, left with the part
-/// split off and its instances added.
+/// The selection `min..=max` of the active object split into an object of its own (the
+/// world shows the same: nothing to draw); the new object brushes edit is the original.
+/// Returns the new object and the split's milliseconds.
+fn split_off(doc: &mut Document, min: IVec3, max: IVec3) -> Result<(NodeId, f64)> {
+    let before: Vec<NodeId> = objects_of(doc);
+    doc.execute(Command::Select(SelectOp::Replace { min, max }))?;
+    let started = Instant::now();
+    doc.execute(Command::Object(ObjectCommand::SplitSelection))?;
+    let ms = started.elapsed().as_secs_f64() * 1e3;
+    doc.execute(Command::Select(SelectOp::None))?;
+    let part = objects_of(doc)
+        .into_iter()
+        .find(|n| !before.contains(n))
+        .ok_or_else(|| anyhow::anyhow!("the split made no object"))?;
+    Ok((part, ms))
+}
+
+/// The scene's objects, in drawing order.
+fn objects_of(doc: &Document) -> Vec<NodeId> {
+    let objects = doc.scene.objects();
+    let tree = objects.tree();
+    tree.subtree(brickmap::objects::ObjectTree::ROOT)
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|n| {
+            tree.node(*n)
+                .is_ok_and(|n| matches!(n.kind, NodeKind::Object { .. }))
+        })
+        .collect()
+}
+
+/// An object's model's solid voxels.
+fn solid(doc: &Document, node: NodeId) -> u64 {
+    let objects = doc.scene.objects();
+    match objects.tree().node(node).map(|n| &n.kind) {
+        Ok(NodeKind::Object { model, .. }) => objects.model(*model).map_or(0, |m| m.solid_count()),
+        _ => 0,
+    }
+}
+
+/// The object cases (see the module doc); `doc` is the default scene, left with the parts
+/// split off and the instances added.
 pub(super) fn object_edits(
     vp: &mut Viewport,
     doc: &mut Document,
@@ -78,45 +119,15 @@ pub(super) fn object_edits(
 ) -> Result<String> {
     let req = edit_request(params, size, 0.5);
     let (min, max) = (IVec3::new(64, 48, 64), IVec3::new(319, 111, 319));
-    doc.execute(Command::Select(SelectOp::Replace { min, max }))?;
-    let started = Instant::now();
-    doc.execute(Command::Object(ObjectCommand::SplitSelection))?;
-    // The world shows the same voxels: nothing to show.
-    let split = started.elapsed().as_secs_f64() * 1e3;
-    let part = doc.scene.active().expect("an object");
-    let objects_now = |doc: &Document| {
-        let objects = doc.scene.objects();
-        let node = objects.tree().node(part).expect("the part");
-        let solid = match node.kind {
-            brickmap::objects::NodeKind::Object { model, .. } => {
-                objects.model(model).map_or(0, |m| m.solid_count())
-            }
-            brickmap::objects::NodeKind::Group { .. } => 0,
-        };
-        (solid, objects.bytes(), objects.tree().len())
-    };
-    // The split leaves the part after the rest: brushes edit the scene's first object.
-    doc.execute(Command::Object(ObjectCommand::Activate(Some(part))))?;
-    let (solid, _, _) = objects_now(doc);
+    let (part, split) = split_off(doc, min, max)?;
     let mut text = format!(
-        "\nobjects: {min} … {max} split into an object of its own ({solid} voxels) in {split:.1} ms; internal scale 0.5, {REPEATS} runs each\noperation                         voxels changed   apply ms median (max)   edit → frame ms median (max), frames   uploaded MB   model / tree + index MB\n"
+        "\nobjects: internal scale 0.5, {REPEATS} runs each; a box of the default scene split into an object of its own, then\noperation                         model voxels changed   apply ms median (max)   edit → frame ms median (max), frames   uploaded MB   models / tree + index MB\n"
     );
-    let centre = (min.as_dvec3() + max.as_dvec3()) * 0.5;
-    let sphere = Command::Stroke(Stroke {
-        mode: BrushMode::Attach,
-        shape: BrushShape::Sphere,
-        size: 16.0,
-        material: 1,
-        mirror: Mirror::default(),
-        points: vec![DVec3::new(centre.x, 100.0, centre.z)],
-        axis: Default::default(),
-        in_selection: false,
-    });
     let row = |doc: &mut Document, vp: &mut Viewport, name: &str, c: &Command| {
         let t = timed(vp, doc, &req, c, true)?;
-        let (_, (models, index), _) = objects_now(doc);
+        let (models, index) = doc.scene.objects().bytes();
         anyhow::Ok(format!(
-            "{name:<33} {:<16} {:.1} ({:.1})            {:.1} ({:.1}), {:.0}                 {:.2}          {:.2} / {:.3}\n",
+            "{name:<33} {:<22} {:.1} ({:.1})            {:.1} ({:.1}), {:.0}                 {:.2}          {:.2} / {:.3}\n",
             t.changed,
             t.apply.0,
             t.apply.1,
@@ -128,30 +139,51 @@ pub(super) fn object_edits(
             index as f64 / 1e6
         ))
     };
+    text += &format!(
+        "({min} … {max}: {} voxels, split in {split:.0} ms)\n",
+        solid(doc, part)
+    );
     let by_one = Command::Object(ObjectCommand::Translate {
         nodes: vec![part],
         by: IVec3::X,
     });
     text += &row(doc, vp, "move the object by (1,0,0)", &by_one)?;
+    // A column of the rest, a tree's size, to be placed 100 times over the terrain.
+    let (min, max) = (IVec3::new(8, 48, 8), IVec3::new(47, 111, 47));
+    let (column, split) = split_off(doc, min, max)?;
+    text += &format!(
+        "({min} … {max}: {} voxels, split in {split:.0} ms)\n",
+        solid(doc, column)
+    );
+    let centre = (min.as_dvec3() + max.as_dvec3()) * 0.5;
+    let sphere = Command::Stroke(Stroke {
+        mode: BrushMode::Attach,
+        shape: BrushShape::Sphere,
+        size: 16.0,
+        material: 1,
+        mirror: Mirror::default(),
+        points: vec![DVec3::new(centre.x, centre.y, centre.z)],
+        axis: Default::default(),
+        in_selection: false,
+    });
+    doc.execute(Command::Object(ObjectCommand::Activate(Some(column))))?;
     text += &row(doc, vp, "sphere r 16, 1 instance", &sphere)?;
-    // 99 more objects placing the same model, spread over the grid (overlapping: the later
-    // one shows), none past it.
+    // 99 more objects placing the same model, on a 10 × 10 lattice 48 voxels apart (apart
+    // from each other, over the terrain).
     let started = Instant::now();
-    for k in 0..99 {
-        let offset = IVec3::new(
-            (k * 37) % 256 - 64,
-            (k * 13) % 144 - 48,
-            (k * 53) % 256 - 64,
-        );
+    for k in 1..100 {
+        let offset = IVec3::new(48 * (k % 10), 0, 48 * (k / 10));
         doc.execute(Command::Object(ObjectCommand::Instance {
-            node: part,
+            node: column,
             offset,
         }))?;
     }
     let added = started.elapsed().as_secs_f64() * 1e3;
     frames_until_shown(vp, &doc.scene.world, &req)?;
     text += &row(doc, vp, "sphere r 16, 100 instances", &sphere)?;
-    let (_, _, nodes) = objects_now(doc);
-    text += &format!("(99 instances added in {added:.0} ms; {nodes} nodes)\n");
+    text += &format!(
+        "(99 instances added in {added:.0} ms; {} nodes)\n",
+        doc.scene.objects().tree().len()
+    );
     Ok(text)
 }
