@@ -11,6 +11,7 @@ use app::builtin::{SceneSize, default_scene};
 use app::editor::Document;
 use app::editor::command::{BrushMode, BrushShape, Command, Mirror, Stroke};
 use app::editor::history::History;
+use app::editor::objects::ObjectCommand;
 use app::selection::SelectOp;
 use divan::Bencher;
 use glam::{DVec3, IVec3};
@@ -103,6 +104,33 @@ fn paste(bencher: Bencher) {
 fn move_selection(bencher: Bencher, step: i32) {
     let by = IVec3::new(step, 0, step);
     run(bencher, selected(), Command::MoveSelection(by));
+}
+
+/// The selection split into an object of its own (3.4 M voxels), then the object moved (a
+/// voxel, a brick) along x and z.
+#[divan::bench(args = [1, 8], sample_count = 20, sample_size = 1)]
+fn move_object(bencher: Bencher, step: i32) {
+    let mut doc = selected();
+    doc.execute(Command::Object(ObjectCommand::SplitSelection))
+        .unwrap();
+    let objects = doc.scene.objects();
+    let part = objects
+        .tree()
+        .subtree(brickmap::objects::ObjectTree::ROOT)
+        .unwrap()
+        .into_iter()
+        .find(|n| objects.tree().node(*n).unwrap().name.ends_with(" part"))
+        .unwrap();
+    drop(objects);
+    let by = IVec3::new(step, 0, step);
+    run(
+        bencher,
+        doc,
+        Command::Object(ObjectCommand::Translate {
+            nodes: vec![part],
+            by,
+        }),
+    );
 }
 
 #[divan::bench(sample_count = 20, sample_size = 1)]

@@ -25,7 +25,11 @@ fn dims() -> GridDims {
 }
 
 fn world() -> World {
-    let w = World::new(dims(), WorldConfig::with_workers(workers())).unwrap();
+    world_of(dims())
+}
+
+fn world_of(grid: GridDims) -> World {
+    let w = World::new(grid, WorldConfig::with_workers(workers())).unwrap();
     for c in [2, 3, 4] {
         w.push_material(brickmap::Material::lambertian(c)).unwrap();
     }
@@ -81,24 +85,34 @@ fn main() {
     divan::main();
 }
 
-/// The whole terrain composited into an empty world (every brick written).
-#[divan::bench(args = ["identity", "turned"], sample_count = 5, sample_size = 1)]
+/// The whole terrain composited into an empty world (every brick written): placed at the
+/// origin, turned a quarter about y, or moved one voxel along x (a world a brick wider).
+#[divan::bench(args = ["identity", "turned", "shifted"], sample_count = 5, sample_size = 1)]
 fn composite_terrain(bencher: Bencher, how: &str) {
     let (model, _) = terrain_model();
     let size = model.size();
     // Turned about y, the model's x and z swap: a square model still fits the grid.
     let rot = match how {
-        "identity" => Orientation::IDENTITY,
-        _ => Orientation::quarter_turn(Axis::Y, 1),
+        "turned" => Orientation::quarter_turn(Axis::Y, 1),
+        _ => Orientation::IDENTITY,
     };
-    let tree = one_object(rot, size);
+    let mut tree = one_object(rot, size);
+    let mut grid = dims();
+    if how == "shifted" {
+        let node = tree.node(ObjectTree::ROOT).unwrap().children()[0];
+        tree.node_mut(node).unwrap().placement.t += IVec3::X;
+        let b = grid.bricks();
+        grid = GridDims::new(b.x + 1, b.y, b.z).unwrap();
+    }
     let models = BTreeMap::from([(ModelId(0), model)]);
-    let composite = Composite::new(&tree, &models, dims().voxels()).unwrap();
+    let composite = Composite::new(&tree, &models, grid.voxels()).unwrap();
     let all = composite.all_bricks();
-    bencher.with_inputs(world).bench_local_values(|w| {
-        composite.write(&w, &all, &models).unwrap();
-        w
-    });
+    bencher
+        .with_inputs(|| world_of(grid))
+        .bench_local_values(|w| {
+            composite.write(&w, &all, &models).unwrap();
+            w
+        });
 }
 
 /// A sphere brush in the terrain model, then its re-composite (what a stroke segment costs

@@ -53,6 +53,43 @@ impl Mask {
     pub fn clear(&mut self, i: usize) {
         self.0[i >> 5] &= !(1 << (i & 31));
     }
+    /// The mask moved by `o` voxels (each component in −7..=7): voxel v is set in the result
+    /// where v − o is set here; voxels moved past the brick's sides are dropped.
+    pub fn shifted(&self, o: glam::IVec3) -> Mask {
+        debug_assert!(o.abs().max_element() < 8);
+        // A z-slice is one u64 (bit x + 8·y); x keeps to its row: after the shift only the
+        // bits whose new x lies in 0..8 are kept, per byte.
+        let keep = if o.x >= 0 {
+            (0xffu64 << o.x) & 0xff
+        } else {
+            0xffu64 >> -o.x
+        } * 0x0101_0101_0101_0101;
+        let mut out = Mask::EMPTY;
+        for z in 0..8i32 {
+            let to = z + o.z;
+            if !(0..8).contains(&to) {
+                continue;
+            }
+            let (lo, hi) = (self.0[2 * z as usize], self.0[2 * z as usize + 1]);
+            let mut slice = u64::from(lo) | (u64::from(hi) << 32);
+            if slice == 0 {
+                continue;
+            }
+            slice = if o.x >= 0 {
+                slice << o.x
+            } else {
+                slice >> -o.x
+            } & keep;
+            slice = if o.y >= 0 {
+                slice << (8 * o.y)
+            } else {
+                slice >> (8 * -o.y)
+            };
+            out.0[2 * to as usize] = slice as u32;
+            out.0[2 * to as usize + 1] = (slice >> 32) as u32;
+        }
+        out
+    }
     /// Number of set voxels.
     #[inline]
     pub fn count(&self) -> u32 {
@@ -151,6 +188,40 @@ impl BrickMaterials<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_shifted_mask_moves_every_voxel_and_drops_those_past_the_sides() {
+        let mut state = 0x1234_5678_9abc_def1u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..300 {
+            let mut m = Mask::EMPTY;
+            for w in &mut m.0 {
+                *w = next() as u32 & next() as u32;
+            }
+            let o = glam::IVec3::new(
+                (next() % 15) as i32 - 7,
+                (next() % 15) as i32 - 7,
+                (next() % 15) as i32 - 7,
+            );
+            let got = m.shifted(o);
+            for z in 0..8 {
+                for y in 0..8 {
+                    for x in 0..8 {
+                        let from = glam::IVec3::new(x, y, z) - o;
+                        let want = from.cmpge(glam::IVec3::ZERO).all()
+                            && from.cmplt(glam::IVec3::splat(8)).all()
+                            && m.get(voxel_bit(from.x, from.y, from.z));
+                        assert_eq!(got.get(voxel_bit(x, y, z)), want, "{o} at {x} {y} {z}");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn rank_counts_bits_before() {

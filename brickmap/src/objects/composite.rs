@@ -225,6 +225,30 @@ impl Composite {
                 }
                 continue;
             }
+            if p.rot == Orientation::IDENTITY {
+                // Moved by whole voxels: each model brick this world brick overlaps, its mask
+                // shifted into place (a model's voxels outside its size are never solid, so
+                // every bit lands inside the object's box).
+                let (ma, mb) = ((lo - offset) / 8, (hi - offset) / 8);
+                for z in ma.z..=mb.z {
+                    for y in ma.y..=mb.y {
+                        for x in ma.x..=mb.x {
+                            let at = IVec3::new(x, y, z);
+                            let Some(brick) = model.brick(at.as_uvec3()) else {
+                                continue;
+                            };
+                            let o = at * 8 + offset - min;
+                            let moved = brick.mask.shifted(o);
+                            let shift = (o.x + 8 * o.y + 64 * o.z) as isize;
+                            for bit in moved.ones() {
+                                mats[bit] = brick.material((bit as isize - shift) as usize);
+                            }
+                            mask = mask.or(&moved);
+                        }
+                    }
+                }
+                continue;
+            }
             // Along a world row (+x) the model voxel steps ±1 along one model axis: walk it,
             // looking a model brick up only when the walk enters another one.
             let d = p.rot.inverse().apply(IVec3::X);
