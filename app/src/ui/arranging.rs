@@ -234,6 +234,18 @@ pub fn picked_boxes(objects: &Objects, picked: &[NodeId]) -> Vec<(IVec3, IVec3)>
     out
 }
 
+/// The world box of the object brushes edit, when the scene has another one (in a scene of
+/// one object its box is the grid's).
+pub fn edited_box(scene: &crate::scene::Scene) -> Option<(IVec3, IVec3)> {
+    let active = scene.active()?;
+    let objects = scene.objects();
+    // The root and one object: nothing else to tell it from.
+    if objects.tree().len() <= 2 {
+        return None;
+    }
+    picked_boxes(&objects, &[active]).into_iter().next()
+}
+
 /// Outlines the picked objects' boxes, and the box select being dragged (`band`, in
 /// points).
 pub fn paint(

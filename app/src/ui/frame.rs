@@ -319,6 +319,11 @@ impl Editor {
                     .map(|(lo, hi)| (lo + by, hi + by))
                     .collect();
             let band = super::arranging::boxing_band(self);
+            // Outside arrange mode, the box of the object brushes edit (when it is not the
+            // scene's only object).
+            let edited = (self.settings.brush.tool != super::tools::Tool::Arrange)
+                .then(|| super::arranging::edited_box(&doc.scene))
+                .flatten();
             egui_ctx.run_ui(raw, |ui| {
                 // Under every panel and window, over the viewport image.
                 let painter = ui.ctx().layer_painter(egui::LayerId::background());
@@ -348,6 +353,20 @@ impl Editor {
                     )
                 });
                 super::arranging::paint(&painter, &self.viewing.camera, rect, &picked, band);
+                if let Some((lo, hi)) = edited {
+                    let stroke = egui::Stroke::new(
+                        1.0,
+                        egui::Color32::from_rgba_unmultiplied(255, 255, 255, 110),
+                    );
+                    preview::paint_box(
+                        &painter,
+                        &self.viewing.camera,
+                        rect,
+                        lo.as_dvec3(),
+                        hi.as_dvec3(),
+                        stroke,
+                    );
+                }
                 if empty {
                     preview::paint_floor(&painter, &self.viewing.camera, rect, dims);
                 }
