@@ -13,7 +13,7 @@ use crate::editor::command::Command;
 use crate::editor::objects::ObjectCommand;
 use crate::selection::SelectOp;
 use brickmap::objects::NodeId;
-use glam::DVec3;
+use glam::{DVec3, IVec3};
 
 impl Editor {
     pub(super) fn action(&mut self, action: Action) {
@@ -156,6 +156,19 @@ impl Editor {
             }
             UiEvent::Generate(spec) => self.execute(Command::GenerateTerrain(spec)),
             UiEvent::Objects(c) => self.execute(Command::Object(c)),
+            UiEvent::NewObject(size) => {
+                // Centred under the view's pivot, standing on it, inside the grid where it fits.
+                let grid = self.read().scene.world.dims().voxels();
+                let pivot = self.viewing.camera.pivot().floor().as_ivec3();
+                let at = IVec3::new(pivot.x - size.x / 2, pivot.y, pivot.z - size.z / 2)
+                    .min(grid - size)
+                    .max(IVec3::ZERO);
+                self.execute(Command::Object(ObjectCommand::NewObject {
+                    name: "object".into(),
+                    size,
+                    at,
+                }));
+            }
             UiEvent::EditObject(n) => {
                 if self.read().scene.active() != Some(n) {
                     self.execute(Command::Object(ObjectCommand::Activate(Some(n))));

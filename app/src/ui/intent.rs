@@ -164,6 +164,8 @@ pub enum UiEvent {
     },
     /// An object command (the Objects window).
     Objects(crate::editor::objects::ObjectCommand),
+    /// A new empty object of this size, under the view's pivot.
+    NewObject(glam::IVec3),
     /// Edit this object's voxels: it becomes the one brushes edit, arrange mode ends.
     EditObject(brickmap::objects::NodeId),
     /// Replace the scene's voxels by generated terrain (undoable).

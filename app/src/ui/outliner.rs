@@ -75,7 +75,7 @@ pub fn draw(
     window(area, "Objects").open(&mut open).show(ctx, |ui| {
         let objects = doc.scene.objects();
         state.picked.retain(|n| objects.tree().node(*n).is_ok());
-        new_object(ui, state, doc.scene.world.dims().voxels(), out);
+        new_object(ui, state, out);
         commands(ui, state, &objects, out);
         ui.separator();
         layers(ui, &objects, out);
@@ -89,24 +89,17 @@ fn send(out: &mut Vec<UiEvent>, c: ObjectCommand) {
     out.push(UiEvent::Objects(c));
 }
 
-/// A new empty object of the size asked, standing on the grid's floor at its centre.
-fn new_object(ui: &mut egui::Ui, state: &mut OutlinerState, grid: IVec3, out: &mut Vec<UiEvent>) {
+/// A new empty object of the size asked (the editor puts it under the view's pivot).
+fn new_object(ui: &mut egui::Ui, state: &mut OutlinerState, out: &mut Vec<UiEvent>) {
     ui.horizontal(|ui| {
-        let new = ui.button("New object");
+        let new = ui
+            .button("New object")
+            .on_hover_text("an empty object of this size, under the view's pivot");
         for v in &mut state.new_size {
             ui.add(egui::DragValue::new(v).range(1..=256));
         }
         if new.clicked() {
-            let size = IVec3::from_array(state.new_size);
-            let at = IVec3::new((grid.x - size.x) / 2, 0, (grid.z - size.z) / 2);
-            send(
-                out,
-                ObjectCommand::NewObject {
-                    name: "object".into(),
-                    size,
-                    at,
-                },
-            );
+            out.push(UiEvent::NewObject(IVec3::from_array(state.new_size)));
         }
     });
 }
