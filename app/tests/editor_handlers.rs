@@ -811,20 +811,6 @@ fn arrange_mode_picks_and_moves_an_object(s: &mut Session) {
     // View → Objects → New object: an empty object (32³: taller than this grid, which grows
     // for it), the one brushes edit; undo removes it and the grid shrinks back.
     let nodes = |s: &Session| s.ed.document().read().unwrap().scene.objects().tree().len();
-    let solid_before =
-        s.ed.document()
-            .read()
-            .unwrap()
-            .scene
-            .world
-            .read()
-            .solid_count();
-    let (count, active) = (nodes(s), s.ed.document().read().unwrap().scene.active());
-    s.click_on("View", MouseButton::Left);
-    s.click_on("Objects", MouseButton::Left);
-    s.click_on("New object", MouseButton::Left);
-    assert_eq!(nodes(s), count + 1, "a new object");
-    assert_ne!(s.ed.document().read().unwrap().scene.active(), active);
     let solid = |s: &Session| {
         s.ed.document()
             .read()
@@ -834,6 +820,13 @@ fn arrange_mode_picks_and_moves_an_object(s: &mut Session) {
             .read()
             .solid_count()
     };
+    let solid_before = solid(s);
+    let (count, active) = (nodes(s), s.ed.document().read().unwrap().scene.active());
+    s.click_on("View", MouseButton::Left);
+    s.click_on("Objects", MouseButton::Left);
+    s.click_on("New object", MouseButton::Left);
+    assert_eq!(nodes(s), count + 1, "a new object");
+    assert_ne!(s.ed.document().read().unwrap().scene.active(), active);
     assert_eq!(solid(s), solid_before, "it is empty");
     s.ctrl(KeyCode::KeyZ);
     s.quiet();
