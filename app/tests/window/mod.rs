@@ -48,14 +48,17 @@ impl Xvfb {
         // Tests of this file run in parallel: each takes its own number, and a server that
         // lost the race for a number (it exits at once) makes it try the next.
         static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
-        for _ in 0..20 {
+        let mut tries = 0;
+        for _ in 0..400 {
+            if tries == 20 {
+                break;
+            }
             let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let number = 90 + (std::process::id() * 7 + n) % 400;
-            if Path::new(&format!("/tmp/.X11-unix/X{number}")).exists()
-                || Path::new(&format!("/tmp/.X{number}-lock")).exists()
-            {
+            if !free_display(number) {
                 continue;
             }
+            tries += 1;
             let display = format!(":{number}");
             let child = Command::new("Xvfb")
                 .args([
@@ -94,9 +97,45 @@ impl Xvfb {
 }
 
 impl Drop for Xvfb {
+    /// Asks the server to end (it removes its lock file and socket then), and kills it if
+    /// it has not ended a second later.
     fn drop(&mut self) {
+        let _ = Command::new("kill")
+            .arg(self.child.id().to_string())
+            .stderr(Stdio::null())
+            .status();
+        let started = Instant::now();
+        while started.elapsed() < Duration::from_secs(1) {
+            if let Ok(Some(_)) = self.child.try_wait() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
         let _ = self.child.kill();
         let _ = self.child.wait();
+    }
+}
+
+/// Whether display `number` is free: no lock file, or only the lock and socket of a server
+/// that is gone (a killed one leaves both), which are removed.
+fn free_display(number: u32) -> bool {
+    let lock = format!("/tmp/.X{number}-lock");
+    let socket = format!("/tmp/.X11-unix/X{number}");
+    match std::fs::read_to_string(&lock) {
+        Ok(text) => {
+            let alive = text
+                .trim()
+                .parse::<u32>()
+                .is_ok_and(|pid| Path::new(&format!("/proc/{pid}")).exists());
+            if alive {
+                return false;
+            }
+            let _ = std::fs::remove_file(&lock);
+            let _ = std::fs::remove_file(&socket);
+            !Path::new(&lock).exists() && !Path::new(&socket).exists()
+        }
+        // No lock: free unless a socket is left without one.
+        Err(_) => !Path::new(&socket).exists(),
     }
 }
 
