@@ -205,7 +205,7 @@ impl ObjectCommand {
                 changed_voxels: 0,
             });
         }
-        let new_node = lowest_free(&scene.objects());
+        let new_node = scene.objects().tree().next_id();
         let (inverse, changed_voxels) = apply_growing(scene, |scene| self.op(scene))?;
         // A new object is the one brushes edit.
         if matches!(self, Self::NewObject { .. }) {
@@ -497,14 +497,6 @@ fn active_layer(scene: &Scene, objects: &brickmap::objects::Objects) -> LayerId 
             NodeKind::Group { .. } => None,
         })
         .unwrap_or(LayerId(0))
-}
-
-/// The id the tree gives its next new node (the lowest free).
-fn lowest_free(objects: &brickmap::objects::Objects) -> NodeId {
-    (0u32..)
-        .map(NodeId)
-        .find(|n| objects.tree().node(*n).is_err())
-        .expect("fewer than 2^32 nodes")
 }
 
 /// The largest grid, in voxels.

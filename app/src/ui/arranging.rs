@@ -183,12 +183,7 @@ pub fn in_band(
         let (a, b) = (a.as_dvec3(), b.as_dvec3());
         let mut seen: Option<((f64, f64), (f64, f64))> = None;
         for i in 0..8 {
-            let corner = DVec3::new(
-                if i & 1 == 0 { a.x } else { b.x },
-                if i & 2 == 0 { a.y } else { b.y },
-                if i & 4 == 0 { a.z } else { b.z },
-            );
-            if let Some(p) = project(corner) {
+            if let Some(p) = project(super::preview::box_corner(a, b, i)) {
                 seen = Some(match seen {
                     None => (p, p),
                     Some((l, h)) => ((l.0.min(p.0), l.1.min(p.1)), (h.0.max(p.0), h.1.max(p.1))),

@@ -226,13 +226,7 @@ pub fn paint_box(
     hi: DVec3,
     stroke: egui::Stroke,
 ) {
-    let corner = |i: usize| {
-        DVec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        )
-    };
+    let corner = |i: usize| box_corner(lo, hi, i);
     for a in 0..8usize {
         for bit in [1, 2, 4] {
             let b = a | bit;
@@ -246,6 +240,15 @@ pub fn paint_box(
             }
         }
     }
+}
+
+/// Corner `i` (0..8: bit 0 picks x, bit 1 y, bit 2 z from `hi`, else from `lo`) of a box.
+pub fn box_corner(lo: DVec3, hi: DVec3, i: usize) -> DVec3 {
+    DVec3::new(
+        if i & 1 == 0 { lo.x } else { hi.x },
+        if i & 2 == 0 { lo.y } else { hi.y },
+        if i & 4 == 0 { lo.z } else { hi.z },
+    )
 }
 
 /// Where a world point appears in `rect` (the viewport, in points), if in front.

@@ -154,7 +154,7 @@ pub fn group(o: &Objects, nodes: &[NodeId], name: &str) -> Result<ObjectOp, Obje
         }
     }
     // The group takes the lowest free id, as the add will give it.
-    let group = lowest_free(o.tree());
+    let group = o.tree().next_id();
     let mut ops = vec![ObjectOp::Add {
         parent,
         index: Some(index),
@@ -396,14 +396,6 @@ fn inverse(p: &Placement) -> Placement {
         rot,
         t: -rot.apply(p.t),
     }
-}
-
-/// The id the tree's next new node takes.
-fn lowest_free(tree: &ObjectTree) -> NodeId {
-    (0..)
-        .map(NodeId)
-        .find(|n| tree.node(*n).is_err())
-        .expect("fewer than 2^32 nodes")
 }
 
 #[cfg(test)]

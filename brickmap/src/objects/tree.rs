@@ -219,6 +219,14 @@ impl Default for ObjectTree {
 }
 
 impl ObjectTree {
+    /// The id the next added node takes: the lowest free one.
+    pub fn next_id(&self) -> NodeId {
+        match self.nodes.iter().position(Option::is_none) {
+            Some(i) => NodeId(i as u32),
+            None => NodeId(self.nodes.len() as u32),
+        }
+    }
+
     /// Bytes it holds on the heap (the nodes, their names and child lists, the layers).
     pub fn heap_bytes(&self) -> usize {
         self.nodes.capacity() * std::mem::size_of::<Option<Node>>()
@@ -341,10 +349,7 @@ impl ObjectTree {
         if self.depth(parent)? + 1 > MAX_DEPTH {
             return Err(TreeError::TooDeep);
         }
-        let id = match self.nodes.iter().position(Option::is_none) {
-            Some(i) => NodeId(i as u32),
-            None => NodeId(self.nodes.len() as u32),
-        };
+        let id = self.next_id();
         let node = Node {
             name: name.into(),
             visible: true,
