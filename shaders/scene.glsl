@@ -20,6 +20,8 @@ struct Params {
                         // uses the variant's MAX_BOUNCES; B is kept for the image key)
     uvec4 seed;         // seed, camera medium (material + 1, 0 for air), first sample index,
                         // 1 to add to the accumulation (0 to start it)
+    vec4 dim_lo;        // DIM variants: the undimmed box's low corner (voxels), w: the factor
+    vec4 dim_hi;        // camera hits outside the box are weighted by; xyz: its high corner
 };
 
 layout(std430, set = 0, binding = 5) readonly buffer ParamBuffer { Params p; };

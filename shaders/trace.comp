@@ -42,6 +42,10 @@ layout(constant_id = 10) const bool LIGHTS = false;
 // The numbers paths are made from: independent (a hash chain) or Owen-scrambled Sobol
 // points, padded in pairs of dimensions (Sequence::Sobol).
 layout(constant_id = 11) const bool SOBOL = false;
+// The editor's "dim the other objects": a path whose camera ray hits a voxel outside the box
+// [p.dim_lo, p.dim_hi) carries the weight p.dim_lo.w (a display aid, never in a reference
+// render: the CPU reference has no such weight). The sky and the sun are not dimmed.
+layout(constant_id = 12) const bool DIM = false;
 
 // Without dielectrics every ray travels in air: the traversal drops its medium branch.
 #define MEDIUM_POSSIBLE HAS_DIELECTRIC
@@ -255,6 +259,7 @@ ivec3 path_start;
 int path_medium;    // material the path is inside (AIR outside dielectrics)
 float path_pdf;     // pdf the BSDF chose path_d with; < 0: delta or camera
 bool path_camera;   // the next ray is the camera ray
+float path_dim;     // DIM: the weight the camera hit gave the path
 uint path_vertex;   // index of the vertex the next ray finds (1: the camera ray's hit)
 bool path_lights;   // the vertex path_d left sampled the light faces (MIS on a hit)
 // A pending shadow ray from path_o, starting in path_start: when nothing blocks it before
@@ -328,6 +333,7 @@ void begin_path(uvec2 px, uint index, uint s) {
     path_medium = HAS_DIELECTRIC ? camera_medium(path_o) : AIR;
     path_pdf = -1.0;
     path_camera = true;
+    path_dim = 1.0;
     path_vertex = 1u;
     path_lights = false;
     shadow_pending = false;
@@ -351,6 +357,10 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
     if (!hit) {
         pixel_sum += path_beta * sky(d);
         return false;
+    }
+    if (DIM && path_camera && (any(lessThan(vec3(voxel), p.dim_lo.xyz)) || any(greaterThanEqual(vec3(voxel), p.dim_hi.xyz)))) {
+        path_beta *= p.dim_lo.w;
+        path_dim = p.dim_lo.w;
     }
     vec3 pt = o + d * t_voxel;
     vec3 n = vec3(normal);
@@ -473,7 +483,9 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
     }
     path_camera = false;
     if (path_vertex >= 4u) {
-        float q = clamp(max(path_beta.r, max(path_beta.g, path_beta.b)), 0.05, 1.0);
+        // A dimmed path continues as the undimmed one would (the same samples, weighted).
+        vec3 b = DIM ? path_beta / path_dim : path_beta;
+        float q = clamp(max(b.r, max(b.g, b.b)), 0.05, 1.0);
         dims(vertex_dims(path_vertex) + 3u);
         if (rand() >= q) return false;
         path_beta /= q;

@@ -117,11 +117,26 @@ impl Session {
     }
 
     fn ctrl(&mut self, code: KeyCode) {
-        let ctrl = app::ui::input::Mods {
-            ctrl: true,
-            ..Default::default()
-        };
-        self.ed.input(Input::Modifiers(ctrl));
+        self.chord(true, false, false, code);
+    }
+
+    /// Tab into arrange mode and a click on the terrain (picking its object); the point.
+    fn arrange_and_pick_the_terrain(&mut self) -> (f64, f64) {
+        self.key(KeyCode::Tab, true);
+        self.key(KeyCode::Tab, false);
+        let at = self.on_the_terrain();
+        self.to(at);
+        self.frame();
+        self.left(true);
+        self.left(false);
+        self.quiet();
+        at
+    }
+
+    /// A key pressed and released with the modifiers named (Ctrl, Shift, Alt) held.
+    fn chord(&mut self, ctrl: bool, shift: bool, alt: bool, code: KeyCode) {
+        let mods = app::ui::input::Mods { ctrl, shift, alt };
+        self.ed.input(Input::Modifiers(mods));
         self.key(code, true);
         self.key(code, false);
         self.ed.input(Input::Modifiers(Default::default()));
@@ -721,14 +736,7 @@ fn arrange_mode_picks_and_moves_an_object(s: &mut Session) {
     s.quiet();
     let grid = |s: &Session| s.ed.document().read().unwrap().scene.world.dims();
     let (before, dims) = (s.state(), grid(s));
-    s.key(KeyCode::Tab, true);
-    s.key(KeyCode::Tab, false);
-    let at = s.on_the_terrain();
-    s.to(at);
-    s.frame();
-    s.left(true);
-    s.left(false);
-    s.quiet();
+    let at = s.arrange_and_pick_the_terrain();
     assert_eq!(s.state(), before, "a pick changes nothing");
     s.key(KeyCode::ArrowRight, true);
     s.key(KeyCode::ArrowRight, false);
@@ -767,15 +775,7 @@ fn arrange_mode_picks_and_moves_an_object(s: &mut Session) {
     s.left(false);
     s.quiet();
     let alt = |s: &mut Session, shift: bool| {
-        let mods = app::ui::input::Mods {
-            alt: true,
-            shift,
-            ..Default::default()
-        };
-        s.ed.input(Input::Modifiers(mods));
-        s.key(KeyCode::KeyY, true);
-        s.key(KeyCode::KeyY, false);
-        s.ed.input(Input::Modifiers(Default::default()));
+        s.chord(false, shift, true, KeyCode::KeyY);
         s.quiet();
     };
     alt(s, false);
@@ -838,6 +838,78 @@ fn arrange_mode_picks_and_moves_an_object(s: &mut Session) {
     s.quiet();
 }
 
+/// The Object menu's keys on the object picked in arrange mode: Ctrl + Shift + D duplicates
+/// it (a new model), Ctrl + Shift + I instances it (the same model), Ctrl + U gives it its own
+/// copy back, Ctrl + G groups it; what they cannot act on is said on the status line (ungroup
+/// of an object, merge of one, split without a selection); undo takes each back. The menu's
+/// entry does what its key does, and its dimming toggle is the view setting.
+fn the_object_keys_and_menu_act_on_the_picked_object(s: &mut Session) {
+    s.quiet();
+    let counts = |s: &Session| {
+        let doc = s.ed.document();
+        let d = doc.read().unwrap();
+        let objects = d.scene.objects();
+        (objects.tree().len(), objects.models().len())
+    };
+    let press = |s: &mut Session, shift: bool, code: KeyCode| {
+        s.chord(true, shift, false, code);
+        s.quiet();
+    };
+    let (before, (nodes, models)) = (s.state(), counts(s));
+    s.arrange_and_pick_the_terrain();
+    for (shift, code, (more_nodes, more_models), what) in [
+        (true, KeyCode::KeyD, (1, 1), "a duplicate: its own model"),
+        (true, KeyCode::KeyI, (2, 1), "an instance: the same model"),
+        (
+            false,
+            KeyCode::KeyU,
+            (2, 2),
+            "made unique: a model of its own",
+        ),
+        (false, KeyCode::KeyG, (3, 2), "a group"),
+    ] {
+        press(s, shift, code);
+        assert_eq!(
+            counts(s),
+            (nodes + more_nodes, models + more_models),
+            "{what}"
+        );
+    }
+    assert_eq!(s.state().1, before.1 + 4, "four steps");
+    for (shift, code, says) in [
+        (true, KeyCode::KeyG, "pick a group first"),
+        (false, KeyCode::KeyJ, "pick two objects or more"),
+        (true, KeyCode::KeyN, "select voxels first"),
+    ] {
+        press(s, shift, code);
+        assert!(
+            s.ed.notice().is_some_and(|n| n.starts_with(says)),
+            "{:?}",
+            s.ed.notice()
+        );
+    }
+    assert_eq!(s.state().1, before.1 + 4, "refusals are no steps");
+    s.click_on("Object", MouseButton::Left);
+    s.click_on("Duplicate  Ctrl+Shift+D", MouseButton::Left);
+    s.quiet();
+    assert_eq!(counts(s), (nodes + 4, models + 3), "the menu's duplicate");
+    assert!(!s.ed.settings().dim_others);
+    s.click_on("Object", MouseButton::Left);
+    s.click_on("Dim the objects not edited", MouseButton::Left);
+    assert!(s.ed.settings().dim_others, "the menu's toggle");
+    s.click_on("Object", MouseButton::Left);
+    s.click_on("Dim the objects not edited", MouseButton::Left);
+    assert!(!s.ed.settings().dim_others);
+    for _ in 0..5 {
+        s.ctrl(KeyCode::KeyZ);
+        s.quiet();
+    }
+    assert_eq!((s.state(), counts(s)), (before, (nodes, models)));
+    s.key(KeyCode::Tab, true);
+    s.key(KeyCode::Tab, false);
+    s.quiet();
+}
+
 #[test]
 fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     let dir = window::scratch("editor-handlers");
@@ -853,6 +925,7 @@ fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     a_dielectric_asks_for_the_bounces_it_needs(&mut s);
     selection_operations_land_and_a_selection_gets_a_material_of_its_own(&mut s);
     arrange_mode_picks_and_moves_an_object(&mut s);
+    the_object_keys_and_menu_act_on_the_picked_object(&mut s);
     the_docks_leave_the_viewport_framing_fits_it_and_the_palette_paints(&mut s);
     without_a_dialog_save_as_and_open_ask_in_the_browser(&mut s, &dir);
     the_first_click_on_an_empty_scene_attaches_on_the_floor(&mut s, &dir);

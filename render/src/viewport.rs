@@ -21,7 +21,7 @@ use crate::vulkan::primary::{GpuHit, PrimaryTracer};
 use crate::vulkan::progressive::Progressive;
 pub use crate::vulkan::progressive::{RenderHow, Rendered};
 use crate::vulkan::tonemap::ToneMapper;
-use crate::vulkan::trace::{PathTracer, TraceParams, Variant};
+use crate::vulkan::trace::{Dim, PathTracer, TraceParams, Variant};
 use crate::vulkan::world::{GpuWorld, UploadReport};
 use crate::vulkan::{GpuContext, GpuError};
 use ash::vk;
@@ -54,6 +54,9 @@ pub struct FrameRequest<'a> {
     /// Display the denoised accumulation ([`crate::vulkan::denoise`]; a view setting, never
     /// in reference renders).
     pub denoise: bool,
+    /// Camera hits outside this box weighted by its factor (a view setting: the editor's
+    /// dimming of the objects it is not editing).
+    pub dim: Option<Dim>,
 }
 
 /// What one interactive frame did.
@@ -460,8 +463,12 @@ impl Viewport {
         // The frame's parameters under a short read lock.
         let (base, variant) = {
             let view = world.read();
-            let base = TraceParams::new(&view, req.params, &live.job_of(1));
-            (base, Variant::for_scene(&view, req.params))
+            let base = TraceParams::new(&view, req.params, &live.job_of(1)).dimmed(req.dim);
+            let variant = Variant {
+                dim: req.dim.is_some(),
+                ..Variant::for_scene(&view, req.params)
+            };
+            (base, variant)
         };
         let slot = &mut self.frames[frame.slot];
         slot.ensure_ldr(&ctx, output.0 as u64 * output.1 as u64 * 4)?;

@@ -141,6 +141,7 @@ fn interactive_frames_display_the_denoised_image_when_asked() {
         exposure: 0.0,
         bgra: false,
         denoise: true,
+        dim: None,
     };
     let run = |vp: &mut Viewport, req: &FrameRequest<'_>, n: usize| {
         for _ in 0..n {

@@ -5,9 +5,10 @@
 mod common;
 
 use brickmap::{EditOp, Mode, Shape};
-use glam::DVec3;
+use glam::{DVec3, IVec3};
 use render::cpu::RenderJob;
 use render::viewport::{FrameRequest, RenderHow, Viewport};
+use render::vulkan::trace::Dim;
 use render::vulkan::{DeviceChoice, GpuContext};
 use std::sync::Arc;
 
@@ -54,6 +55,7 @@ fn request(
         exposure: 0.0,
         bgra: false,
         denoise: false,
+        dim: None,
     }
 }
 
@@ -117,6 +119,7 @@ fn an_edit_or_a_camera_move_restarts_and_the_edit_is_visible_the_next_frame() {
             exposure: 0.0,
             bgra: false,
             denoise: false,
+            dim: None,
         };
         frames(vp, &world, &req, n, |_| false)
     };
@@ -256,5 +259,66 @@ fn a_larger_shadow_queue_keeps_the_frame_in_flight_valid() {
     }
     vp.wait_idle().unwrap();
     assert_eq!(drawn, 6);
+    assert_eq!(ctx.validation_errors(), 0);
+}
+
+#[test]
+fn dimming_weights_exactly_the_camera_hits_outside_the_box() {
+    let Some(ctx) = context() else { return };
+    let (world, params) = common::showcase();
+    let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
+    let size = (40, 24);
+    let image = |vp: &mut Viewport, dim: Option<Dim>| {
+        let req = FrameRequest {
+            dim,
+            ..request(&params, size, 4, 8)
+        };
+        let first = frames(vp, &world, &req, 1, |_| false);
+        assert!(first[0].restarted, "a change of the box starts over");
+        frames(vp, &world, &req, 64, |v| v.samples() >= 8);
+        assert_eq!(vp.samples(), 8);
+        vp.live_hdr().unwrap().unwrap()
+    };
+    let plain = image(&mut vp, None);
+    let factor = 0.25;
+    // The low half of the grid along x at full weight, the rest dimmed.
+    let half = Dim {
+        lo: IVec3::ZERO,
+        hi: IVec3::new(24, 64, 48),
+        factor,
+    };
+    let dimmed = image(&mut vp, Some(half));
+    // A box holding the whole grid dims nothing: the same samples, the same image.
+    let all = image(
+        &mut vp,
+        Some(Dim {
+            hi: IVec3::splat(48),
+            ..half
+        }),
+    );
+    let (mut full, mut dark) = (0, 0);
+    for ((p, d), a) in plain.pixels.iter().zip(&dimmed.pixels).zip(&all.pixels) {
+        for c in 0..3 {
+            let scale = p[c].abs().max(1e-3);
+            assert!((a[c] - p[c]).abs() / scale < 1e-4, "{a:?} against {p:?}");
+            // Each sample is weighted 1 or the factor: the mean lies between.
+            let r = d[c] / p[c].max(1e-6);
+            if p[c] > 1e-3 {
+                assert!(r > factor - 1e-3 && r < 1.0 + 1e-3, "{d:?} against {p:?}");
+            }
+        }
+        let r = d[1] / p[1].max(1e-6);
+        if p[1] > 1e-3 && (r - 1.0).abs() < 1e-4 {
+            full += 1;
+        }
+        if p[1] > 1e-3 && (r - factor).abs() < 1e-4 {
+            dark += 1;
+        }
+    }
+    let n = plain.pixels.len();
+    assert!(
+        full > n / 10 && dark > n / 10,
+        "{full} full, {dark} dimmed of {n}"
+    );
     assert_eq!(ctx.validation_errors(), 0);
 }

@@ -488,6 +488,7 @@ impl Session {
             exposure: 0.0,
             bgra: false,
             denoise: self.rng.chance(0.2),
+            dim: None,
         };
         // A slot comes free when an earlier frame finishes: on a loaded CPU driver that can
         // take seconds, so wait by time, not by tries.

@@ -109,6 +109,13 @@ impl Editor {
                 quarters: -1,
             }),
             Action::Flip(axis) => self.turn_or_flip(|nodes| ObjectCommand::Flip { nodes, axis }),
+            Action::DuplicateObject
+            | Action::InstanceObject
+            | Action::MakeUnique
+            | Action::GroupObjects
+            | Action::Ungroup
+            | Action::MergeObjects
+            | Action::SplitSelection => self.object_action(action),
             Action::Help => self.panels.help_open = !self.panels.help_open,
             Action::Quit => self.guard_unsaved(Pending::Quit),
         }
@@ -116,11 +123,7 @@ impl Editor {
 
     /// A turn or a flip of the picked nodes in arrange mode, else of the object brushes edit.
     fn turn_or_flip(&mut self, command: impl FnOnce(Vec<NodeId>) -> ObjectCommand) {
-        let nodes = if self.settings.brush.tool == Tool::Arrange {
-            self.panels.outliner.picked.clone()
-        } else {
-            self.read().scene.active().into_iter().collect()
-        };
+        let nodes = self.object_targets();
         if !nodes.is_empty() {
             self.execute(Command::Object(command(nodes)));
         }

@@ -22,11 +22,15 @@ use anyhow::{Context, Result};
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use render::present::{EguiFrame, Presented, Presenter};
 use render::viewport::{FrameRequest, Viewport};
+use render::vulkan::trace::Dim;
 use render::vulkan::{ContextOptions, GpuContext, WindowHandles};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use winit::event_loop::ActiveEventLoop;
 use winit::window::Window;
+
+/// The weight of what lies outside the edited object's box when the others are dimmed.
+const DIM_FACTOR: f32 = 0.25;
 
 /// The frames' own state.
 pub(super) struct Frames {
@@ -471,6 +475,17 @@ impl Editor {
             bgra: false,
             // A script run's capture is compared with headless renders: never denoised.
             denoise: self.settings.denoise && self.script.is_none(),
+            // Likewise never dimmed.
+            dim: (self.settings.dim_others
+                && self.script.is_none()
+                && self.settings.brush.tool != super::tools::Tool::Arrange)
+                .then(|| super::arranging::edited_box(&doc.scene))
+                .flatten()
+                .map(|(lo, hi)| Dim {
+                    lo,
+                    hi,
+                    factor: DIM_FACTOR,
+                }),
         };
         let ui = (!capture_now).then(|| EguiFrame {
             primitives: &primitives,

@@ -244,6 +244,11 @@ impl Editor {
         self.gfx.as_ref().map_or(0, |g| g.viewport.samples())
     }
 
+    /// The view settings (kept in settings.ron).
+    pub fn settings(&self) -> &super::panels::ViewSettings {
+        &self.settings
+    }
+
     /// The brush's settings as the Tools window shows them.
     pub fn brush(&self) -> &tools::Brush {
         &self.settings.brush

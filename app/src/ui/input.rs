@@ -66,6 +66,15 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "Alt + X / Y / Z (Shift: back), Ctrl + Alt + X / Y / Z",
         "turn a quarter about / flip along an axis: the picked objects (arrange mode) or the edited one",
     ),
+    (
+        "Ctrl + Shift + D / Ctrl + Shift + I, Ctrl + U",
+        "duplicate / instance the picked or edited object (a copy of its model / the same model), make its model its own",
+    ),
+    (
+        "Ctrl + G / Ctrl + Shift + G, Ctrl + J",
+        "group / ungroup the picked nodes, merge the picked objects into one",
+    ),
+    ("Ctrl + Shift + N", "the selected voxels into a new object"),
     ("Ctrl+A / Ctrl+D", "select all / nothing"),
     (
         "Delete, Ctrl+F, Ctrl+P",

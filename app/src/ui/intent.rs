@@ -87,6 +87,20 @@ pub enum Action {
     TurnBack(Axis),
     /// Mirror them along an axis.
     Flip(Axis),
+    /// Another object copying the model of the picked object (arrange mode) or the edited one.
+    DuplicateObject,
+    /// Another object placing the same model as the picked or edited one.
+    InstanceObject,
+    /// The picked or edited object gets its own copy of a shared model.
+    MakeUnique,
+    /// The picked nodes into a new group.
+    GroupObjects,
+    /// The picked group's children take its place.
+    Ungroup,
+    /// The picked objects into one new object.
+    MergeObjects,
+    /// The selected voxels of the edited object into a new object.
+    SplitSelection,
     /// Show or hide the shortcut list.
     Help,
     /// Quit (asks about unsaved changes).

@@ -164,6 +164,13 @@ pub fn default_bindings() -> Vec<Binding> {
         ("Ctrl+C", Action::Copy),
         ("Ctrl+X", Action::Cut),
         ("Ctrl+V", Action::Paste),
+        ("Ctrl+Shift+D", Action::DuplicateObject),
+        ("Ctrl+Shift+I", Action::InstanceObject),
+        ("Ctrl+U", Action::MakeUnique),
+        ("Ctrl+G", Action::GroupObjects),
+        ("Ctrl+Shift+G", Action::Ungroup),
+        ("Ctrl+J", Action::MergeObjects),
+        ("Ctrl+Shift+N", Action::SplitSelection),
         ("F1", Action::Help),
     ]
     .into_iter()

@@ -36,6 +36,7 @@ mod intent;
 pub mod jobs;
 pub mod keymap;
 mod motion;
+mod object_menu;
 pub mod outliner;
 pub mod panels;
 mod pending;

@@ -34,6 +34,8 @@ pub struct ViewSettings {
     /// Show the viewport denoised (edge-aware, guided by the first hit; it gives way to the
     /// raw image between 8 and 64 spp). Renders and exports never are.
     pub denoise: bool,
+    /// Outside arrange mode, darken what lies outside the edited object's box.
+    pub dim_others: bool,
     /// Autosave period in seconds (0: off).
     pub autosave_secs: u64,
     /// The brush.
@@ -48,6 +50,7 @@ impl Default for ViewSettings {
             moving_scale: 0.5,
             exposure: 0.0,
             denoise: false,
+            dim_others: false,
             autosave_secs: 180,
             brush: Default::default(),
         }
@@ -230,6 +233,9 @@ pub fn draw(
                         d.x as u32, d.y as u32, d.z as u32,
                     )));
                 }
+            });
+            ui.menu_button("Object", |ui| {
+                super::object_menu::menu(ui, doc, view.brush.tool, &mut view.dim_others, &mut out)
             });
             if !state.busy.is_empty() {
                 ui.separator();

@@ -320,6 +320,7 @@ fn run(mut vp: Viewport, world: &World, params: &SceneParams, b: &BenchViewport)
             exposure: 0.0,
             bgra: true,
             denoise: false,
+            dim: None,
         };
         let mut cases = vec![
             ("refining (still camera)", false, false),
@@ -564,6 +565,7 @@ pub(crate) fn edit_request(
         exposure: 0.0,
         bgra: true,
         denoise: false,
+        dim: None,
     }
 }
 

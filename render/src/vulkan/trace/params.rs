@@ -3,7 +3,19 @@
 
 use super::*;
 
-/// Keep in sync with `Params` in shaders/trace.comp (std430: eleven vec4, three uvec4).
+/// A box of the world shown at full weight, the rest of what camera rays hit weighted by
+/// `factor` (the editor's dimming of the objects it is not editing).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Dim {
+    /// The box's low corner (voxels).
+    pub lo: glam::IVec3,
+    /// Its high corner (exclusive).
+    pub hi: glam::IVec3,
+    /// The weight of camera hits outside it (0..1).
+    pub factor: f32,
+}
+
+/// Keep in sync with `Params` in shaders/trace.comp (std430: eleven vec4, three uvec4, two vec4).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable, Default)]
 pub struct TraceParams {
@@ -21,8 +33,10 @@ pub struct TraceParams {
     grid: [u32; 4],
     pub(super) image: [u32; 4],
     pub(super) seed: [u32; 4],
+    dim_lo: [f32; 4],
+    dim_hi: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<TraceParams>() == 224);
+const _: () = assert!(std::mem::size_of::<TraceParams>() == 256);
 
 fn v4(v: DVec3, w: f32) -> [f32; 4] {
     [v.x as f32, v.y as f32, v.z as f32, w]
@@ -88,6 +102,20 @@ impl TraceParams {
         self.image[2] = samples;
         self.seed[2] = first;
         self.seed[3] = u32::from(add);
+        self
+    }
+
+    /// The same parameters with camera hits outside `dim`'s box weighted by its factor (read
+    /// by [`Variant::dim`] variants only).
+    pub fn dimmed(mut self, dim: Option<Dim>) -> Self {
+        if let Some(d) = dim {
+            let f = |v: glam::IVec3, w: f32| [v.x as f32, v.y as f32, v.z as f32, w];
+            self.dim_lo = f(d.lo, d.factor);
+            self.dim_hi = f(d.hi, 0.0);
+        } else {
+            self.dim_lo = [0.0; 4];
+            self.dim_hi = [0.0; 4];
+        }
         self
     }
 

@@ -31,6 +31,9 @@ pub struct Variant {
     pub experiment: u32,
     /// The numbers samples are made from (`SEQUENCE` in trace.comp).
     pub sequence: Sequence,
+    /// Weight camera hits outside a box ([`TraceParams::dimmed`]; the editor's dimming of
+    /// the objects it is not editing).
+    pub dim: bool,
 }
 
 impl Variant {
@@ -57,6 +60,7 @@ impl Variant {
             count_rays: false,
             experiment: 0,
             sequence: params.settings.sequence,
+            dim: false,
         };
         for i in 0..materials.len() {
             if let Ok(m) = materials.get(i as u8) {
@@ -85,10 +89,11 @@ impl Variant {
             count_rays: false,
             experiment: 0,
             sequence: Sequence::Independent,
+            dim: false,
         }
     }
 
-    pub(super) fn constants(&self, shadow_queue: bool) -> [u32; 12] {
+    pub(super) fn constants(&self, shadow_queue: bool) -> [u32; 13] {
         [
             self.lambertian as u32,
             self.metal as u32,
@@ -102,6 +107,7 @@ impl Variant {
             shadow_queue as u32,
             self.lights as u32,
             (self.sequence == Sequence::Sobol) as u32,
+            self.dim as u32,
         ]
     }
 }
