@@ -22,6 +22,8 @@ struct Params {
                         // 1 to add to the accumulation (0 to start it)
     vec4 dim_lo;        // DIM variants: the undimmed box's low corner (voxels), w: the factor
     vec4 dim_hi;        // camera hits outside the box are weighted by; xyz: its high corner
+    vec4 ground;        // GRID variants: line spacing (voxels), how far the grid reaches past the
+                        // world's sides (voxels), the lines' width in pixels, their radiance
 };
 
 layout(std430, set = 0, binding = 5) readonly buffer ParamBuffer { Params p; };

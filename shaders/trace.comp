@@ -46,6 +46,10 @@ layout(constant_id = 11) const bool SOBOL = false;
 // [p.dim_lo, p.dim_hi) carries the weight p.dim_lo.w (a display aid, never in a reference
 // render: the CPU reference has no such weight). The sky and the sun are not dimmed.
 layout(constant_id = 12) const bool DIM = false;
+// The editor's ground grid: camera rays that reach the plane y = 0 before any voxel, within
+// p.ground.y voxels of the world's x-z extent, and land within p.ground.z pixels of a line every
+// p.ground.x voxels see the line's radiance p.ground.w (a display aid like DIM).
+layout(constant_id = 13) const bool GRID = false;
 
 // Without dielectrics every ray travels in air: the traversal drops its medium branch.
 #define MEDIUM_POSSIBLE HAS_DIELECTRIC
@@ -347,6 +351,21 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
     vec3 o = path_o;
     vec3 d = path_d;
     if (!hit) t_voxel = 1.0 / 0.0;
+    if (GRID && path_camera && d.y != 0.0) {
+        float tg = -o.y / d.y;
+        vec2 q = (o + d * tg).xz;
+        vec2 extent = vec2(p.grid.xz) * 8.0 + p.ground.y;
+        if (tg > 0.0 && tg < t_voxel && all(greaterThanEqual(q, vec2(-p.ground.y))) && all(lessThanEqual(q, extent))) {
+            // Voxels a pixel spans there (as shaders/guides.comp finds a footprint).
+            float pixel = 2.0 * length(p.cam_up.xyz) / float(p.image.y);
+            float footprint = p.cam_pos.w > 0.5 ? pixel : pixel * tg;
+            vec2 off = abs(fract(q / p.ground.x + 0.5) - 0.5) * p.ground.x;
+            if (min(off.x, off.y) < 0.5 * p.ground.z * footprint) {
+                pixel_sum += path_beta * p.ground.w;
+                return false;
+            }
+        }
+    }
     float cos_l;
     float t_sun = sun_hit(o, d, cos_l);
     if (t_sun > 0.0 && t_sun < t_voxel) {

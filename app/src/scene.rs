@@ -62,6 +62,12 @@ impl Scene {
         Self::with_objects(world, objects, Some(node), params)
     }
 
+    /// The scene as one object: what its visible objects show (its world), the same camera,
+    /// sun, sky and settings; hidden objects are gone.
+    pub fn flattened(self) -> Self {
+        Self::new(self.world, self.params)
+    }
+
     /// A scene of objects already composited into `world`, editing `active`.
     pub fn with_objects(
         world: World,

@@ -145,6 +145,37 @@ fn new_terrain_is_deterministic_and_converts_both_ways() {
         "{scene}"
     );
     assert!(field(&scene, "objects").contains("8 layers"), "{scene}");
+    // Its tree, a line per node, the same after a conversion to a project.
+    let tree = |out: &str| -> Vec<String> {
+        out.lines()
+            .skip_while(|l| *l != "tree")
+            .skip(1)
+            .take_while(|l| l.starts_with("  "))
+            .map(String::from)
+            .collect()
+    };
+    let lines = tree(&scene);
+    assert_eq!(lines.len(), 104, "{scene}");
+    assert!(lines[0].starts_with("  #1 "), "{}", lines[0]);
+    assert!(
+        lines.iter().any(|l| l.contains(", placed by ")),
+        "shared models are named: {scene}"
+    );
+    let project = d.join("ogt.ron");
+    ok(&["convert", s(&ogt), s(&project)]);
+    assert_eq!(tree(&ok(&["info", s(&project)])), lines);
+    // --flatten: one object showing the same voxels, from the project and from the file.
+    for from in [&project, &ogt] {
+        let flat = d.join("flat.ron");
+        ok(&["convert", "--flatten", s(from), s(&flat)]);
+        let info = ok(&["info", s(&flat)]);
+        assert!(
+            field(&info, "objects").starts_with("objects      1 objects of 1 models"),
+            "{info}"
+        );
+        assert_eq!(field(&info, "solid"), field(&scene, "solid"));
+        assert_eq!(tree(&info).len(), 1);
+    }
 }
 
 #[test]

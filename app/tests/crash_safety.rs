@@ -1,4 +1,4 @@
-//! Saves survive being killed: a process writing a large project (11 MB) over an existing one
+//! Saves survive being killed: a process writing a large project (6 MB) over an existing one
 //! is killed with SIGKILL at random moments of its write, from when its temporary file appears
 //! to a little past its usual end (50 kills at least, on until 25 landed inside a write);
 //! after every kill the file on disk is byte for byte
@@ -16,7 +16,7 @@ fn new_project(seed: &str, out: &Path) -> Command {
         "new",
         "--terrain",
         "--size",
-        "1024x128x1024",
+        "768x128x768",
         "--workers",
         "2",
         "--seed",

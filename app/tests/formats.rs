@@ -321,7 +321,6 @@ fn every_sample_vox_imported_as_objects_composites_to_the_flattened_import() {
 /// resolved materials, which two imports may number differently), visibility, layer and
 /// world placement.
 fn outline(objects: &brickmap::objects::Objects, table: &brickmap::MaterialTable) -> Vec<String> {
-    use brickmap::objects::{NodeKind, ObjectTree};
     use std::hash::{Hash, Hasher};
     let content = |m: &brickmap::objects::Model| {
         let mut h = std::collections::hash_map::DefaultHasher::new();
@@ -339,28 +338,7 @@ fn outline(objects: &brickmap::objects::Objects, table: &brickmap::MaterialTable
         }
         h.finish()
     };
-    let tree = objects.tree();
-    tree.subtree(ObjectTree::ROOT)
-        .unwrap()
-        .into_iter()
-        .map(|id| {
-            let n = tree.node(id).unwrap();
-            let what = match n.kind {
-                NodeKind::Group { .. } => format!("group of {}", n.children().len()),
-                NodeKind::Object { model, layer } => format!(
-                    "model {:x} on layer {}",
-                    content(objects.model(model).unwrap()),
-                    layer.0
-                ),
-            };
-            format!(
-                "{} {what} visible {} at {:?}",
-                n.name,
-                n.visible,
-                tree.world_placement(id).unwrap()
-            )
-        })
-        .collect()
+    objects.outline(false, |_, m| format!("model {:x}", content(m)))
 }
 
 #[test]

@@ -57,6 +57,8 @@ pub struct FrameRequest<'a> {
     /// Camera hits outside this box weighted by its factor (a view setting: the editor's
     /// dimming of the objects it is not editing).
     pub dim: Option<Dim>,
+    /// A ground grid on the plane y = 0 with lines this many voxels apart (a view setting).
+    pub grid: Option<f32>,
 }
 
 /// What one interactive frame did.
@@ -463,9 +465,12 @@ impl Viewport {
         // The frame's parameters under a short read lock.
         let (base, variant) = {
             let view = world.read();
-            let base = TraceParams::new(&view, req.params, &live.job_of(1)).dimmed(req.dim);
+            let base = TraceParams::new(&view, req.params, &live.job_of(1))
+                .dimmed(req.dim)
+                .with_grid(req.grid);
             let variant = Variant {
                 dim: req.dim.is_some(),
+                grid: req.grid.is_some(),
                 ..Variant::for_scene(&view, req.params)
             };
             (base, variant)

@@ -142,6 +142,7 @@ fn interactive_frames_display_the_denoised_image_when_asked() {
         bgra: false,
         denoise: true,
         dim: None,
+        grid: None,
     };
     let run = |vp: &mut Viewport, req: &FrameRequest<'_>, n: usize| {
         for _ in 0..n {

@@ -142,6 +142,7 @@ fn what_cannot_fit_is_refused_and_the_viewport_traces_a_smaller_image() {
         bgra: false,
         denoise: true,
         dim: None,
+        grid: None,
     };
     for _ in 0..4000 {
         if vp.samples() >= 4 {

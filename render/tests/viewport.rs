@@ -56,6 +56,7 @@ fn request(
         bgra: false,
         denoise: false,
         dim: None,
+        grid: None,
     }
 }
 
@@ -120,6 +121,7 @@ fn an_edit_or_a_camera_move_restarts_and_the_edit_is_visible_the_next_frame() {
             bgra: false,
             denoise: false,
             dim: None,
+            grid: None,
         };
         frames(vp, &world, &req, n, |_| false)
     };
@@ -262,6 +264,71 @@ fn a_larger_shadow_queue_keeps_the_frame_in_flight_valid() {
     assert_eq!(ctx.validation_errors(), 0);
 }
 
+/// The image of 8 samples per pixel after a change of the request (which starts over).
+fn eight_samples(
+    vp: &mut Viewport,
+    world: &brickmap::World,
+    req: &FrameRequest<'_>,
+) -> render::Image {
+    let first = frames(vp, world, req, 1, |_| false);
+    assert!(first[0].restarted, "a change of the view aids starts over");
+    frames(vp, world, req, 64, |v| v.samples() >= 8);
+    assert_eq!(vp.samples(), 8);
+    vp.live_hdr().unwrap().unwrap()
+}
+
+/// Whether two pixels differ by more than the last bits of a variant's arithmetic.
+fn differs(a: &[f32; 3], b: &[f32; 3]) -> bool {
+    (0..3).any(|c| (a[c] - b[c]).abs() > 1e-4 * b[c].abs().max(1e-3))
+}
+
+#[test]
+fn the_ground_grid_shows_on_the_floor_and_voxels_hide_it() {
+    let Some(ctx) = context() else { return };
+    let size = (40, 24);
+    // An empty grid seen from above: the lines on its floor, the sky elsewhere.
+    let (world, params) = common::showcase();
+    let empty = common::world((6, 4, 6));
+    let mut vp = Viewport::new(ctx.clone(), &empty.read()).unwrap();
+    let grid = |grid| FrameRequest {
+        grid,
+        ..request(&params, size, 4, 8)
+    };
+    let plain = eight_samples(&mut vp, &empty, &grid(None));
+    let lined = eight_samples(&mut vp, &empty, &grid(Some(8.0)));
+    let changed = plain
+        .pixels
+        .iter()
+        .zip(&lined.pixels)
+        .filter(|(a, b)| differs(a, b))
+        .count();
+    assert!(
+        changed > 0 && changed < plain.pixels.len() / 2,
+        "{changed} of {} pixels show lines",
+        plain.pixels.len()
+    );
+    // The showcase's floor covers the plane: the same samples, the same image.
+    let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
+    let covered = eight_samples(&mut vp, &world, &grid(None));
+    let gridded = eight_samples(&mut vp, &world, &grid(Some(8.0)));
+    let differ: Vec<_> = covered
+        .pixels
+        .iter()
+        .zip(&gridded.pixels)
+        .enumerate()
+        .filter(|(_, (a, b))| differs(a, b))
+        .map(|(i, (a, b))| (i % size.0 as usize, i / size.0 as usize, *a, *b))
+        .collect();
+    // (The same samples; a variant's arithmetic may differ in the last bit.)
+    assert!(
+        differ.is_empty(),
+        "{} pixels differ: {:?}",
+        differ.len(),
+        &differ[..differ.len().min(6)]
+    );
+    assert_eq!(ctx.validation_errors(), 0);
+}
+
 #[test]
 fn dimming_weights_exactly_the_camera_hits_outside_the_box() {
     let Some(ctx) = context() else { return };
@@ -273,11 +340,7 @@ fn dimming_weights_exactly_the_camera_hits_outside_the_box() {
             dim,
             ..request(&params, size, 4, 8)
         };
-        let first = frames(vp, &world, &req, 1, |_| false);
-        assert!(first[0].restarted, "a change of the box starts over");
-        frames(vp, &world, &req, 64, |v| v.samples() >= 8);
-        assert_eq!(vp.samples(), 8);
-        vp.live_hdr().unwrap().unwrap()
+        eight_samples(vp, &world, &req)
     };
     let plain = image(&mut vp, None);
     let factor = 0.25;

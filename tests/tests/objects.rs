@@ -71,31 +71,7 @@ fn outline(doc: &Document) -> String {
 /// depth, name, flags, world placement and its model's content.
 fn content_outline(doc: &Document) -> Vec<String> {
     let objects = doc.scene.objects();
-    let tree = objects.tree();
-    tree.subtree(ObjectTree::ROOT)
-        .unwrap()
-        .into_iter()
-        .map(|id| {
-            let n = tree.node(id).unwrap();
-            let model = match n.kind {
-                NodeKind::Object { model, layer } => {
-                    format!(
-                        "{:x} layer {}",
-                        objects.model(model).unwrap().content_hash(),
-                        layer.0
-                    )
-                }
-                NodeKind::Group { .. } => format!("group of {}", n.children().len()),
-            };
-            format!(
-                "{} {} {} {:?} {model}",
-                n.name,
-                n.visible,
-                n.locked,
-                tree.world_placement(id).unwrap()
-            )
-        })
-        .collect()
+    objects.outline(true, |_, m| format!("{:x}", m.content_hash()))
 }
 
 fn objects_in_order(doc: &Document) -> Vec<NodeId> {

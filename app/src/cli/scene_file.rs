@@ -112,6 +112,9 @@ pub(crate) struct ConvertArgs {
     /// Import hidden nodes and layers too, shown (the file is flattened into one object).
     #[arg(long)]
     include_hidden: bool,
+    /// Write one object: what the input's visible objects show, as one grid.
+    #[arg(long)]
+    flatten: bool,
 }
 
 /// Reads the input (reporting what a .vox import dropped) and writes the output.
@@ -120,14 +123,17 @@ pub(crate) fn convert(a: ConvertArgs, workers: usize) -> Result<()> {
     let scene = with_progress(
         format!("reading {}", a.input.display()),
         || match Format::of(&a.input)? {
-            Format::Project => Ok(formats::project::load(&a.input, workers)?),
+            Format::Project => {
+                let scene = formats::project::load(&a.input, workers)?;
+                Ok(if a.flatten { scene.flattened() } else { scene })
+            }
             Format::Vox => {
                 let options = formats::vox::ImportOptions {
                     offset: a.offset,
                     include_hidden: a.include_hidden,
                 };
                 // Flattened where asked to (an offset, hidden nodes shown); else its objects.
-                let (scene, report) = if a.include_hidden || a.offset != IVec3::ZERO {
+                let (scene, report) = if a.flatten || a.include_hidden || a.offset != IVec3::ZERO {
                     formats::vox::import_file(&a.input, &options, workers)?
                 } else {
                     let bytes = std::fs::read(&a.input)
@@ -160,6 +166,46 @@ pub(crate) fn convert(a: ConvertArgs, workers: usize) -> Result<()> {
 pub(crate) struct InfoArgs {
     /// A .ron or .vox file.
     file: PathBuf,
+    /// Print every node of the object tree (else the first 200).
+    #[arg(long)]
+    tree: bool,
+}
+
+/// The nodes `voxbrick info` lists without `--tree`.
+const TREE_LINES: usize = 200;
+
+/// The object tree, a line per node (`Objects::outline`): each object's model with its
+/// size, voxels and how many objects place it; at most `limit` lines, then how many more.
+fn tree_text(o: &brickmap::objects::Objects, limit: usize) -> String {
+    let tree = o.tree();
+    let lines = o.outline(true, |id, m| {
+        let s = m.size();
+        let users = tree.instances(id).len();
+        let shared = if users > 1 {
+            format!(", placed by {users}")
+        } else {
+            String::new()
+        };
+        format!(
+            "model {} {}x{}x{}, {} voxels{shared}",
+            id.0,
+            s.x,
+            s.y,
+            s.z,
+            m.solid_count()
+        )
+    });
+    let mut text = String::from("tree\n");
+    for l in lines.iter().take(limit) {
+        text += &format!("  {l}\n");
+    }
+    if lines.len() > limit {
+        text += &format!(
+            "  … {} more nodes (--tree lists them all)\n",
+            lines.len() - limit
+        );
+    }
+    text
 }
 
 /// One line on a scene's objects: how many, the models they place and how many of them
@@ -204,6 +250,10 @@ pub(crate) fn info(a: InfoArgs, workers: usize) -> Result<()> {
     let mut text = format!("file         {}\n", file.display());
     text += &stats_text(&scene.world, started.elapsed().as_secs_f64());
     text += &objects_text(&scene.objects());
+    text += &tree_text(
+        &scene.objects(),
+        if a.tree { usize::MAX } else { TREE_LINES },
+    );
     let lens = match p.camera.projection {
         render::Projection::Perspective => format!("fov {:.1}", p.camera.fov_y_deg),
         render::Projection::Orthographic { height } => {

@@ -489,6 +489,7 @@ impl Session {
             bgra: false,
             denoise: self.rng.chance(0.2),
             dim: None,
+            grid: None,
         };
         // A slot comes free when an earlier frame finishes: on a loaded CPU driver that can
         // take seconds, so wait by time, not by tries.

@@ -71,6 +71,8 @@ impl Editor {
                 self.settings.brush.tool = Tool::Brush;
             }
             Action::SelectTool => self.settings.brush.tool = Tool::Select,
+            Action::MeasureTool => self.settings.brush.tool = Tool::Measure,
+            Action::ToggleGrid => self.settings.grid = !self.settings.grid,
             Action::ArrangeTool => {
                 self.settings.brush.tool = if self.settings.brush.tool == Tool::Arrange {
                     Tool::Brush

@@ -217,6 +217,7 @@ fn tools(
         }
         ui.selectable_value(&mut brush.tool, Tool::Select, "Select  M");
         ui.selectable_value(&mut brush.tool, Tool::Arrange, "Arrange  Tab");
+        ui.selectable_value(&mut brush.tool, Tool::Measure, "Measure  K");
     });
     ui.horizontal_wrapped(|ui| {
         for (s, name) in [

@@ -237,25 +237,8 @@ impl Editor {
         let shown = (self.viewing.area().2, self.viewing.area().3);
         let internal = gfx.viewport.fit_internal(self.internal_size(shown));
         let paths = internal.0 as f64 * internal.1 as f64 * self.frames.last_added as f64;
-        // Which object brushes edit, or arrange mode and how many nodes are picked.
-        let mode = if self.settings.brush.tool == super::tools::Tool::Arrange {
-            format!(
-                "arrange ({} picked; Tab: edit)",
-                self.panels.outliner.picked.len()
-            )
-        } else {
-            let doc = self.read();
-            let objects = doc.scene.objects();
-            doc.scene
-                .active()
-                .and_then(|n| objects.tree().node(n).ok())
-                .map_or_else(
-                    || "no object to edit (Tab: arrange)".to_string(),
-                    |n| format!("editing {} (Tab: arrange)", n.name),
-                )
-        };
-        self.panels.status = format!(
-            "{mode} · {samples}/{} spp · GPU {gpu_ms:.2} ms/frame · {:.1} Mpaths/s · internal {}x{}{} · {}{}",
+        let figures = format!(
+            "{samples}/{} spp · GPU {gpu_ms:.2} ms/frame · {:.1} Mpaths/s · internal {}x{}{} · {}{}",
             self.settings.target_spp,
             if gpu_ms > 0.0 {
                 paths / gpu_ms / 1e3
@@ -275,6 +258,7 @@ impl Editor {
                 l.as_secs_f64() * 1e3
             )),
         );
+        self.panels.status = self.status_line(&figures);
         gfx.set_title(files::title(&self.read()));
         let raw = gfx.host.take_egui_input();
         let egui_ctx = self.egui.clone();
@@ -323,6 +307,13 @@ impl Editor {
                     .map(|(lo, hi)| (lo + by, hi + by))
                     .collect();
             let band = super::arranging::boxing_band(self);
+            // The ruler (Measure tool): its ends, the second following the cursor.
+            let ruler = (self.settings.brush.tool == super::tools::Tool::Measure)
+                .then(|| {
+                    let hovered = self.hovered().map(|(v, _)| v);
+                    self.pointer.ruler.ends(hovered)
+                })
+                .flatten();
             // Outside arrange mode, the box of the object brushes edit (when it is not the
             // scene's only object).
             let edited = (self.settings.brush.tool != super::tools::Tool::Arrange)
@@ -376,6 +367,9 @@ impl Editor {
                 }
                 if let Some(layer) = layer {
                     preview::paint_layer(&painter, &self.viewing.camera, rect, layer, dims);
+                }
+                if let Some(ends) = ruler {
+                    super::measure::paint(&painter, &self.viewing.camera, rect, ends);
                 }
                 // A box being dragged says its size beside the cursor.
                 let cursor = egui::pos2(
@@ -486,6 +480,8 @@ impl Editor {
                     hi,
                     factor: DIM_FACTOR,
                 }),
+            grid: (self.settings.grid && self.script.is_none())
+                .then_some(self.settings.grid_spacing as f32),
         };
         let ui = (!capture_now).then(|| EguiFrame {
             primitives: &primitives,

@@ -236,6 +236,10 @@ impl Editor {
             self.arrange_press();
             return;
         }
+        if self.settings.brush.tool == Tool::Measure {
+            self.measure_press();
+            return;
+        }
         let (origin, dir) = self.cursor_ray();
         let doc = self.doc.clone();
         let doc = doc.read().unwrap_or_else(|p| p.into_inner());

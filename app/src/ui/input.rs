@@ -75,6 +75,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "group / ungroup the picked nodes, merge the picked objects into one",
     ),
     ("Ctrl + Shift + N", "the selected voxels into a new object"),
+    (
+        "K",
+        "measure: click two voxels for the distance along each axis and in all (Esc ends it)",
+    ),
     ("Ctrl+A / Ctrl+D", "select all / nothing"),
     (
         "Delete, Ctrl+F, Ctrl+P",
@@ -100,6 +104,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("W A S D, Q / E", "fly (Shift: faster)"),
     ("F", "frame the scene"),
     ("O, Numpad 5", "perspective / orthographic"),
+    (
+        "G",
+        "the ground grid on and off (its spacing: Render settings)",
+    ),
     ("Ctrl + 1..9 / 1..9", "store / recall a camera slot"),
     ("Ctrl + Z", "undo"),
     ("Ctrl + Shift + Z, Ctrl + Y", "redo"),

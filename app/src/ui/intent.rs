@@ -60,6 +60,10 @@ pub enum Action {
     RemoveUnusedMaterials,
     /// The selection tool.
     SelectTool,
+    /// Show or hide the ground grid.
+    ToggleGrid,
+    /// The ruler (Measure tool).
+    MeasureTool,
     /// Arrange mode (pick and move objects), or back to the brush.
     ArrangeTool,
     /// Select the whole grid.

@@ -156,6 +156,8 @@ pub fn default_bindings() -> Vec<Binding> {
         ("R", Action::Shape(BrushShape::Box)),
         ("M", Action::SelectTool),
         ("Tab", Action::ArrangeTool),
+        ("K", Action::MeasureTool),
+        ("G", Action::ToggleGrid),
         ("Ctrl+A", Action::SelectAll),
         ("Ctrl+D", Action::SelectNone),
         ("Delete", Action::DeleteSelection),

@@ -36,6 +36,10 @@ pub struct ViewSettings {
     pub denoise: bool,
     /// Outside arrange mode, darken what lies outside the edited object's box.
     pub dim_others: bool,
+    /// The ground grid on the scene's floor (G).
+    pub grid: bool,
+    /// Its lines' spacing in voxels.
+    pub grid_spacing: u32,
     /// Autosave period in seconds (0: off).
     pub autosave_secs: u64,
     /// The brush.
@@ -51,6 +55,8 @@ impl Default for ViewSettings {
             exposure: 0.0,
             denoise: false,
             dim_others: false,
+            grid: true,
+            grid_spacing: 8,
             autosave_secs: 180,
             brush: Default::default(),
         }
@@ -211,6 +217,7 @@ pub fn draw(
                 if ui.button("Perspective / orthographic  O").clicked() {
                     out.push(UiEvent::Action(Action::ToggleProjection));
                 }
+                ui.checkbox(&mut view.grid, "Ground grid  G");
                 if ui.button("Use this view as the scene camera").clicked() {
                     out.push(UiEvent::UseViewAsSceneCamera);
                 }
@@ -298,6 +305,14 @@ pub fn draw(
                 );
                 ui.add(egui::Slider::new(&mut view.moving_scale, 0.125..=1.0).text("while moving"));
                 ui.add(egui::Slider::new(&mut view.exposure, -8.0..=8.0).text("exposure (stops)"));
+                ui.horizontal(|ui| {
+                    ui.checkbox(&mut view.grid, "ground grid  G");
+                    ui.add(
+                        egui::DragValue::new(&mut view.grid_spacing)
+                            .range(1..=256)
+                            .suffix(" voxels"),
+                    );
+                });
                 ui.checkbox(&mut view.denoise, "denoise the viewport")
                     .on_hover_text("Edge-aware filter guided by the first hit's normal, albedo and depth; between 8 and 64 samples it gives way to the path-traced image. Renders and exports are never denoised.");
                 let mut settings = doc.scene.params.settings.clone();

@@ -43,6 +43,8 @@ pub(super) struct Pointer {
     pub(super) moving: Option<MoveDrag>,
     /// A box select of objects (arrange mode): where it started, in window pixels.
     pub(super) boxing: Option<(f64, f64)>,
+    /// The ruler's ends (the Measure tool).
+    pub(super) ruler: super::measure::Ruler,
 }
 
 impl Pointer {
@@ -51,11 +53,13 @@ impl Pointer {
         let was = self.pasting
             || self.selecting.is_some()
             || self.moving.is_some()
-            || self.boxing.is_some();
+            || self.boxing.is_some()
+            || self.ruler.a.is_some();
         self.pasting = false;
         self.selecting = None;
         self.moving = None;
         self.boxing = None;
+        self.ruler = Default::default();
         was
     }
 

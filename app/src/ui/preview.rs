@@ -252,7 +252,7 @@ pub fn box_corner(lo: DVec3, hi: DVec3, i: usize) -> DVec3 {
 }
 
 /// Where a world point appears in `rect` (the viewport, in points), if in front.
-fn screen_point(view: &ViewCamera, rect: egui::Rect, p: DVec3) -> Option<egui::Pos2> {
+pub fn screen_point(view: &ViewCamera, rect: egui::Rect, p: DVec3) -> Option<egui::Pos2> {
     let aspect = (rect.width() / rect.height().max(1.0)) as f64;
     view.project(p, aspect).map(|(u, v)| {
         egui::pos2(

@@ -48,6 +48,8 @@ pub enum Tool {
     Select,
     /// Pick and move objects (arrange mode).
     Arrange,
+    /// Measure between two voxels (the ruler).
+    Measure,
 }
 
 impl Default for Brush {

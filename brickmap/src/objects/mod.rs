@@ -13,6 +13,7 @@ pub mod frame;
 pub mod model;
 pub mod op;
 pub mod orient;
+mod outline;
 pub mod scene;
 #[cfg(test)]
 mod testing;

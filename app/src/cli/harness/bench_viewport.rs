@@ -321,6 +321,7 @@ fn run(mut vp: Viewport, world: &World, params: &SceneParams, b: &BenchViewport)
             bgra: true,
             denoise: false,
             dim: None,
+            grid: None,
         };
         let mut cases = vec![
             ("refining (still camera)", false, false),
@@ -566,6 +567,7 @@ pub(crate) fn edit_request(
         bgra: true,
         denoise: false,
         dim: None,
+        grid: None,
     }
 }
 

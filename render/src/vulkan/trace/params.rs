@@ -15,7 +15,12 @@ pub struct Dim {
     pub factor: f32,
 }
 
-/// Keep in sync with `Params` in shaders/trace.comp (std430: eleven vec4, three uvec4, two vec4).
+/// The ground grid's lines: their width in pixels and their radiance (a grey that reads on
+/// the default sky and on dark floors alike).
+const GRID_LINE_PIXELS: f32 = 1.5;
+const GRID_RADIANCE: f32 = 0.35;
+
+/// Keep in sync with `Params` in shaders/trace.comp (std430: eleven vec4, three uvec4, three vec4).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable, Default)]
 pub struct TraceParams {
@@ -35,8 +40,9 @@ pub struct TraceParams {
     pub(super) seed: [u32; 4],
     dim_lo: [f32; 4],
     dim_hi: [f32; 4],
+    ground: [f32; 4],
 }
-const _: () = assert!(std::mem::size_of::<TraceParams>() == 256);
+const _: () = assert!(std::mem::size_of::<TraceParams>() == 272);
 
 fn v4(v: DVec3, w: f32) -> [f32; 4] {
     [v.x as f32, v.y as f32, v.z as f32, w]
@@ -116,6 +122,22 @@ impl TraceParams {
             self.dim_lo = [0.0; 4];
             self.dim_hi = [0.0; 4];
         }
+        self
+    }
+
+    /// The same parameters with a ground grid of lines `spacing` voxels apart on the plane
+    /// y = 0, reaching half the world's larger side past its sides, in whole spacings (read by
+    /// [`Variant::grid`] variants only).
+    pub fn with_grid(mut self, spacing: Option<f32>) -> Self {
+        self.ground = match spacing {
+            Some(s) => {
+                let s = s.max(1.0);
+                let side = (self.grid[0].max(self.grid[2]) * 8) as f32;
+                let margin = (0.5 * side / s).ceil() * s;
+                [s, margin, GRID_LINE_PIXELS, GRID_RADIANCE]
+            }
+            None => [0.0; 4],
+        };
         self
     }
 

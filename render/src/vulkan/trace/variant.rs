@@ -34,6 +34,8 @@ pub struct Variant {
     /// Weight camera hits outside a box ([`TraceParams::dimmed`]; the editor's dimming of
     /// the objects it is not editing).
     pub dim: bool,
+    /// The ground grid ([`TraceParams::with_grid`]).
+    pub grid: bool,
 }
 
 impl Variant {
@@ -61,6 +63,7 @@ impl Variant {
             experiment: 0,
             sequence: params.settings.sequence,
             dim: false,
+            grid: false,
         };
         for i in 0..materials.len() {
             if let Ok(m) = materials.get(i as u8) {
@@ -90,10 +93,11 @@ impl Variant {
             experiment: 0,
             sequence: Sequence::Independent,
             dim: false,
+            grid: false,
         }
     }
 
-    pub(super) fn constants(&self, shadow_queue: bool) -> [u32; 13] {
+    pub(super) fn constants(&self, shadow_queue: bool) -> [u32; 14] {
         [
             self.lambertian as u32,
             self.metal as u32,
@@ -108,6 +112,7 @@ impl Variant {
             self.lights as u32,
             (self.sequence == Sequence::Sobol) as u32,
             self.dim as u32,
+            self.grid as u32,
         ]
     }
 }
