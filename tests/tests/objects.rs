@@ -71,7 +71,7 @@ fn outline(doc: &Document) -> String {
 /// depth, name, flags, world placement and its model's content.
 fn content_outline(doc: &Document) -> Vec<String> {
     let objects = doc.scene.objects();
-    objects.outline(true, |_, m| format!("{:x}", m.content_hash()))
+    objects.outline(false, |_, m| format!("{:x}", m.content_hash()))
 }
 
 fn objects_in_order(doc: &Document) -> Vec<NodeId> {
