@@ -286,7 +286,7 @@ fn differs(a: &[f32; 3], b: &[f32; 3]) -> bool {
 fn the_ground_grid_shows_on_the_floor_and_voxels_hide_it() {
     let Some(ctx) = context() else { return };
     let size = (40, 24);
-    // An empty grid seen from above: the lines on its floor, the sky elsewhere.
+    // An empty grid seen from above: lines on its floor and around it, the sky beyond.
     let (world, params) = common::showcase();
     let empty = common::world((6, 4, 6));
     let mut vp = Viewport::new(ctx.clone(), &empty.read()).unwrap();
@@ -303,7 +303,7 @@ fn the_ground_grid_shows_on_the_floor_and_voxels_hide_it() {
         .filter(|(a, b)| differs(a, b))
         .count();
     assert!(
-        changed > 0 && changed < plain.pixels.len() / 2,
+        changed > plain.pixels.len() / 10 && changed < plain.pixels.len(),
         "{changed} of {} pixels show lines",
         plain.pixels.len()
     );
