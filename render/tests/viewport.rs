@@ -307,7 +307,15 @@ fn the_ground_grid_shows_on_the_floor_and_voxels_hide_it() {
         "{changed} of {} pixels show lines",
         plain.pixels.len()
     );
-    // The showcase's floor covers the plane: the same samples, the same image.
+    // Looking down onto the showcase's floor, which covers the plane there: the same
+    // samples, the same image.
+    let mut params = params.clone();
+    params.camera.position = DVec3::new(24.0, 24.0, 24.0);
+    params.camera.pitch_deg = -89.0;
+    let grid = |grid| FrameRequest {
+        grid,
+        ..request(&params, size, 4, 8)
+    };
     let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
     let covered = eight_samples(&mut vp, &world, &grid(None));
     let gridded = eight_samples(&mut vp, &world, &grid(Some(8.0)));
