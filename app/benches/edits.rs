@@ -106,6 +106,22 @@ fn move_selection(bencher: Bencher, step: i32) {
     run(bencher, selected(), Command::MoveSelection(by));
 }
 
+/// The 256 × 64 × 256 selection turned a quarter about y (the issue's ≤ 50 ms) and
+/// mirrored along x.
+#[divan::bench(args = ["turn", "mirror"], sample_count = 20, sample_size = 1)]
+fn transform_selection(bencher: Bencher, how: &str) {
+    use app::selection_transform::SelectionTransform;
+    use brickmap::objects::Axis;
+    let t = match how {
+        "turn" => SelectionTransform::Turn {
+            axis: Axis::Y,
+            quarters: 1,
+        },
+        _ => SelectionTransform::Flip(Axis::X),
+    };
+    run(bencher, selected(), Command::TransformSelection(t));
+}
+
 /// The selection split into an object of its own (3.4 M voxels), then the object moved (a
 /// voxel, a brick) along x and z.
 #[divan::bench(args = [1, 8], sample_count = 20, sample_size = 1)]

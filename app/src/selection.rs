@@ -212,17 +212,53 @@ struct Target {
 /// Builds the one `Restore` edit that writes whole target bricks (each brick once, so its
 /// inverse is exact).
 #[derive(Default)]
-struct Writes {
+pub(crate) struct Writes {
     targets: HashMap<(u32, u32, u32), Target>,
 }
 
 impl Writes {
+    /// Makes each voxel `v` of `writes` solid with its material (nothing outside a grid of
+    /// `voxels`). Meant for the voxels of one source brick, which land in a few target bricks:
+    /// each is gathered here first and joins the edit once.
+    pub(crate) fn set_all(&mut self, voxels: IVec3, writes: impl IntoIterator<Item = (IVec3, u8)>) {
+        let mut local: Vec<(UVec3, Mask, [u8; 512])> = Vec::with_capacity(8);
+        let mut last = 0;
+        for (v, m) in writes {
+            if v.cmplt(IVec3::ZERO).any() || v.cmpge(voxels).any() {
+                continue;
+            }
+            let b = (v / 8).as_uvec3();
+            if local.get(last).is_none_or(|e| e.0 != b) {
+                last = match local.iter().position(|e| e.0 == b) {
+                    Some(i) => i,
+                    None => {
+                        local.push((b, Mask::EMPTY, [0; 512]));
+                        local.len() - 1
+                    }
+                };
+            }
+            let bit = ((v.x & 7) + 8 * (v.y & 7) + 64 * (v.z & 7)) as usize;
+            let (_, mask, mats) = &mut local[last];
+            mask.set(bit);
+            mats[bit] = m;
+        }
+        for (b, mask, mats) in local {
+            let t = self.target(b);
+            t.touched = t.touched.or(&mask);
+            t.solid = t.solid.or(&mask);
+            let dense = t.dense.get_or_insert_with(|| Box::new([0; 512]));
+            for bit in mask.ones() {
+                dense[bit] = mats[bit];
+            }
+        }
+    }
+
     fn target(&mut self, b: UVec3) -> &mut Target {
         self.targets.entry((b.x, b.y, b.z)).or_default()
     }
 
     /// Empties the voxels `mask` of brick `b`.
-    fn clear(&mut self, b: UVec3, mask: &Mask) {
+    pub(crate) fn clear(&mut self, b: UVec3, mask: &Mask) {
         let t = self.target(b);
         t.touched = t.touched.or(mask);
         t.solid = t.solid.and_not(mask);
@@ -284,7 +320,7 @@ impl Writes {
         }
     }
 
-    fn into_edit(self) -> EditOp {
+    pub(crate) fn into_edit(self) -> EditOp {
         let mut bricks: Vec<BrickUndo> = self
             .targets
             .into_iter()

@@ -908,6 +908,23 @@ fn the_object_keys_and_menu_act_on_the_picked_object(s: &mut Session) {
     s.key(KeyCode::Tab, true);
     s.key(KeyCode::Tab, false);
     s.quiet();
+    // Back in edit mode with a selection, Alt + Y turns the selection, not the object.
+    s.ctrl(KeyCode::KeyA);
+    s.quiet();
+    let selected = s.state();
+    s.chord(false, false, true, KeyCode::KeyY);
+    s.quiet();
+    let last = |s: &Session| {
+        let doc = s.ed.document();
+        let d = doc.read().unwrap();
+        d.history.undo_steps().last().map(|st| st.label.clone())
+    };
+    assert_eq!(s.state().1, selected.1 + 1);
+    assert_eq!(last(s).as_deref(), Some("Turn selection 90° about Y"));
+    s.ctrl(KeyCode::KeyZ);
+    s.ctrl(KeyCode::KeyD);
+    s.quiet();
+    assert_eq!(s.state().0, before.0);
 }
 
 #[test]

@@ -8,6 +8,8 @@ use app::editor::Document;
 use app::editor::command::{BrushMode, BrushShape, Command, Mirror, Stroke};
 use app::editor::history::History;
 use app::selection::SelectOp;
+use app::selection_transform::SelectionTransform;
+use brickmap::objects::{Axis, Orientation};
 use glam::{DVec3, IVec3};
 
 fn document() -> Document {
@@ -179,6 +181,72 @@ fn operations_match_a_voxel_by_voxel_reference() {
     }
 }
 
+/// Turns and mirrors of the selection about its centre (the region's box is 41 × 31 × 41:
+/// its centre is a voxel's, so every turn is exact) against a voxel-by-voxel reference; four
+/// quarter turns, a turn and its reverse, and two mirrors of a cube give back the scene and
+/// the region.
+#[test]
+fn turns_and_mirrors_of_the_selection_match_a_voxel_by_voxel_reference() {
+    let voxel = |i: usize| {
+        let (i, d) = (i as i32, DIMS);
+        IVec3::new(i / (d.y * d.z), i / d.z % d.y, i % d.z)
+    };
+    let centre = IVec3::new(40, 25, 50);
+    let turn = |axis, quarters| SelectionTransform::Turn { axis, quarters };
+    for t in [
+        turn(Axis::Y, 1),
+        turn(Axis::X, -1),
+        turn(Axis::Z, 2),
+        SelectionTransform::Flip(Axis::X),
+    ] {
+        let back: Orientation = t.orientation().inverse();
+        let mut doc = document();
+        let boxes = select_region(&mut doc);
+        let old = snapshot(&doc);
+        doc.execute(Command::TransformSelection(t)).unwrap();
+        let new = snapshot(&doc);
+        let mut changed = 0;
+        for (i, got) in new.iter().enumerate() {
+            let v = voxel(i);
+            let from = centre + back.apply(v - centre);
+            let want = if inside(from) && selected(from, boxes) && old[index(from)].is_some() {
+                old[index(from)]
+            } else if selected(v, boxes) {
+                None
+            } else {
+                old[i]
+            };
+            assert_eq!(*got, want, "{t:?} at {v}");
+            changed += (want != old[i]) as u64;
+        }
+        assert!(changed > 1000, "{t:?} changes {changed}");
+        assert_eq!(
+            doc.history.undo_steps().last().map(|s| s.changed_voxels),
+            Some(changed)
+        );
+        doc.scene.world.read().validate().unwrap();
+    }
+    for steps in [
+        vec![turn(Axis::Y, 1); 4],
+        vec![turn(Axis::X, 1), turn(Axis::X, -1)],
+        vec![SelectionTransform::Flip(Axis::Z); 2],
+    ] {
+        // A cube, whose turned self is itself (a region with a hole turns its voxels over
+        // what lay outside it: those are overwritten, as a move overwrites).
+        let mut doc = document();
+        doc.execute(Command::Select(SelectOp::Replace {
+            min: IVec3::new(20, 10, 30),
+            max: IVec3::new(50, 40, 60),
+        }))
+        .unwrap();
+        let before = state(&doc);
+        for t in &steps {
+            doc.execute(Command::TransformSelection(*t)).unwrap();
+        }
+        assert_eq!(state(&doc), before, "{steps:?}");
+    }
+}
+
 #[test]
 fn paste_puts_the_copy_down_over_what_is_there_and_selects_it() {
     let dims = DIMS;
@@ -248,6 +316,11 @@ fn every_selection_operation_undoes_and_redoes_exactly() {
             at: IVec3::new(90, 30, 90),
         },
         sphere(BrushMode::Paint, DVec3::new(40.0, 30.0, 50.0), 20.0, true),
+        Command::TransformSelection(SelectionTransform::Turn {
+            axis: Axis::Y,
+            quarters: 1,
+        }),
+        Command::TransformSelection(SelectionTransform::Flip(Axis::Z)),
     ];
     for command in commands {
         let mut doc = document();

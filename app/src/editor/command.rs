@@ -157,6 +157,8 @@ pub enum Command {
     PaintSelection(u8),
     /// Move the selected solid voxels (and the selection) by an offset.
     MoveSelection(IVec3),
+    /// Turn or mirror the selected solid voxels (and the selection) about its centre.
+    TransformSelection(crate::selection_transform::SelectionTransform),
     /// Copy the selected solid voxels to the clipboard (no history step: nothing changes).
     Copy,
     /// Copy, then delete the selection.
@@ -274,6 +276,14 @@ impl Command {
             Command::FillSelection(m) => format!("Fill selection with material {m}"),
             Command::PaintSelection(m) => format!("Paint selection with material {m}"),
             Command::MoveSelection(d) => format!("Move selection by {d}"),
+            Command::TransformSelection(t) => match t {
+                crate::selection_transform::SelectionTransform::Turn { axis, quarters } => {
+                    format!("Turn selection {}° about {axis:?}", 90 * quarters)
+                }
+                crate::selection_transform::SelectionTransform::Flip(axis) => {
+                    format!("Mirror selection along {axis:?}")
+                }
+            },
             Command::Copy => "Copy".into(),
             Command::Cut => "Cut".into(),
             Command::Paste { at } => format!("Paste at {at}"),
@@ -347,6 +357,17 @@ impl Command {
                 let moved =
                     Selection::new(selection.region.translated(*offset), world.dims().voxels());
                 with_selection(scene, edit, Some(moved))?
+            }
+            Command::TransformSelection(t) => {
+                let selection = selected(scene)?.clone();
+                let alone = scene.active_world()?;
+                let source = alone.as_ref().unwrap_or(world);
+                let (edit, region) =
+                    crate::selection_transform::transform_edit(&source.read(), &selection, *t)
+                        .ok_or(super::error::EditError::NothingToDo("nothing is selected"))?;
+                let turned = Selection::new(region, world.dims().voxels());
+                let turned = (!turned.voxels.is_empty()).then_some(turned);
+                with_selection(scene, edit, turned)?
             }
             Command::Copy => {
                 let alone = scene.active_world()?;

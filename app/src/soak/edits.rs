@@ -291,6 +291,19 @@ impl Session {
             4 => Command::DeleteSelection,
             5 => Command::FillSelection(m(&mut self.rng)),
             6 => Command::PaintSelection(m(&mut self.rng)),
+            7 if self.rng.chance(0.3) => {
+                use crate::selection_transform::SelectionTransform;
+                use brickmap::objects::Axis as Turn;
+                let axis = self.rng.pick(&[Turn::X, Turn::Y, Turn::Z]);
+                Command::TransformSelection(if self.rng.chance(0.3) {
+                    SelectionTransform::Flip(axis)
+                } else {
+                    SelectionTransform::Turn {
+                        axis,
+                        quarters: self.rng.range(-2, 2) as i32,
+                    }
+                })
+            }
             7 => Command::MoveSelection(IVec3::new(
                 self.rng.range(-9, 9) as i32,
                 self.rng.range(-3, 3) as i32,
@@ -537,7 +550,8 @@ impl Session {
                     Command::DeleteSelection
                     | Command::FillSelection(_)
                     | Command::PaintSelection(_)
-                    | Command::MoveSelection(_) => "selection operation",
+                    | Command::MoveSelection(_)
+                    | Command::TransformSelection(_) => "selection operation",
                     Command::Copy | Command::Cut | Command::Paste { .. } => "clipboard",
                     Command::SetColour { .. }
                     | Command::AddMaterial(_)

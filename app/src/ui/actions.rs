@@ -12,7 +12,7 @@ use super::{Editor, content_bounds};
 use crate::editor::command::Command;
 use crate::editor::objects::ObjectCommand;
 use crate::selection::SelectOp;
-use brickmap::objects::NodeId;
+use crate::selection_transform::SelectionTransform;
 use glam::{DVec3, IVec3};
 
 impl Editor {
@@ -100,17 +100,11 @@ impl Editor {
             Action::Paste => self.pointer.pasting = true,
             Action::Nudge(n) if self.settings.brush.tool == Tool::Arrange => self.arrange_nudge(n),
             Action::Nudge(n) => self.nudge(n),
-            Action::Turn(axis) => self.turn_or_flip(|nodes| ObjectCommand::Turn {
-                nodes,
-                axis,
-                quarters: 1,
-            }),
-            Action::TurnBack(axis) => self.turn_or_flip(|nodes| ObjectCommand::Turn {
-                nodes,
-                axis,
-                quarters: -1,
-            }),
-            Action::Flip(axis) => self.turn_or_flip(|nodes| ObjectCommand::Flip { nodes, axis }),
+            Action::Turn(axis) => self.turn_or_flip(SelectionTransform::Turn { axis, quarters: 1 }),
+            Action::TurnBack(axis) => {
+                self.turn_or_flip(SelectionTransform::Turn { axis, quarters: -1 })
+            }
+            Action::Flip(axis) => self.turn_or_flip(SelectionTransform::Flip(axis)),
             Action::DuplicateObject
             | Action::InstanceObject
             | Action::MakeUnique
@@ -123,12 +117,25 @@ impl Editor {
         }
     }
 
-    /// A turn or a flip of the picked nodes in arrange mode, else of the object brushes edit.
-    fn turn_or_flip(&mut self, command: impl FnOnce(Vec<NodeId>) -> ObjectCommand) {
-        let nodes = self.object_targets();
-        if !nodes.is_empty() {
-            self.execute(Command::Object(command(nodes)));
+    /// A turn or a flip of the picked nodes in arrange mode; else of the selection's voxels
+    /// when there is a selection, of the object brushes edit when not.
+    fn turn_or_flip(&mut self, t: SelectionTransform) {
+        if self.settings.brush.tool != Tool::Arrange && self.read().scene.selection.is_some() {
+            self.execute(Command::TransformSelection(t));
+            return;
         }
+        let nodes = self.object_targets();
+        if nodes.is_empty() {
+            return;
+        }
+        self.execute(Command::Object(match t {
+            SelectionTransform::Turn { axis, quarters } => ObjectCommand::Turn {
+                nodes,
+                axis,
+                quarters,
+            },
+            SelectionTransform::Flip(axis) => ObjectCommand::Flip { nodes, axis },
+        }));
     }
 
     pub(super) fn ui_event(&mut self, e: UiEvent) {

@@ -369,6 +369,23 @@ fn selection(ui: &mut egui::Ui, brush: &mut Brush, doc: &Document, out: &mut Vec
                 }
             }
         });
+        ui.horizontal_wrapped(|ui| {
+            use brickmap::objects::Axis::{X, Y, Z};
+            ui.label("turn");
+            for (name, a) in [
+                ("X", Action::Turn(X)),
+                ("Y", Action::Turn(Y)),
+                ("Z", Action::Turn(Z)),
+                ("mirror X", Action::Flip(X)),
+                ("Y", Action::Flip(Y)),
+                ("Z", Action::Flip(Z)),
+            ] {
+                let tip = "about the selection's centre: Alt + X / Y / Z (Shift: back), mirror: Ctrl + Alt";
+                if ui.button(name).on_hover_text(tip).clicked() {
+                    out.push(UiEvent::Action(a));
+                }
+            }
+        });
     });
 }
 

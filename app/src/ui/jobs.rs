@@ -223,6 +223,7 @@ impl Landing {
             | Command::FillSelection(_)
             | Command::PaintSelection(_)
             | Command::MoveSelection(_)
+            | Command::TransformSelection(_)
             | Command::Cut
             | Command::Paste { .. } => Some(Landing::Changed),
             _ => None,
