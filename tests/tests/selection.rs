@@ -111,7 +111,28 @@ fn operations_match_a_voxel_by_voxel_reference() {
     let sphere_has = move |v: IVec3| (v.as_dvec3() + 0.5 - centre).length_squared() <= 14.0 * 14.0;
     let mut probe = document();
     let boxes = select_region(&mut probe);
+    // The material most of the selected voxels have (replaced by 3 below).
+    let mut counts = [0u64; 256];
+    for (i, m) in snapshot(&probe).iter().enumerate() {
+        if let Some(m) = m
+            && selected(voxel(i), boxes)
+        {
+            counts[*m as usize] += 1;
+        }
+    }
+    let common = (0..=255u8).max_by_key(|m| counts[*m as usize]).unwrap();
+    assert_ne!(common, 3);
     let cases: Vec<(Command, Rule)> = vec![
+        (
+            Command::ReplaceMaterial {
+                from: common,
+                to: 3,
+            },
+            Box::new(move |old, sel, v| match old[index(v)] {
+                Some(m) if sel && m == common => Some(3),
+                other => other,
+            }),
+        ),
         (
             Command::DeleteSelection,
             Box::new(|old, sel, v| if sel { None } else { old[index(v)] }),
@@ -244,6 +265,36 @@ fn turns_and_mirrors_of_the_selection_match_a_voxel_by_voxel_reference() {
             doc.execute(Command::TransformSelection(*t)).unwrap();
         }
         assert_eq!(state(&doc), before, "{steps:?}");
+    }
+}
+
+/// Without a selection, a replacement covers the whole object; a material no voxel has, or
+/// a material replaced by itself, is refused and changes nothing; undo is exact.
+#[test]
+fn a_material_is_replaced_across_the_object_and_refusals_change_nothing() {
+    let mut doc = document();
+    let old = snapshot(&doc);
+    let used = old.iter().flatten().copied().max().unwrap();
+    let before = state(&doc);
+    doc.execute(Command::ReplaceMaterial { from: used, to: 3 })
+        .unwrap();
+    let new = snapshot(&doc);
+    for (o, n) in old.iter().zip(&new) {
+        assert_eq!(*n, o.map(|m| if m == used { 3 } else { m }));
+    }
+    doc.undo().unwrap();
+    assert_eq!(state(&doc), before);
+    let count = doc.scene.world.materials().len() as u8;
+    let unused = (0..count)
+        .find(|m| !old.contains(&Some(*m)))
+        .expect("the scene leaves a material of its table unused");
+    for (from, to) in [(unused, 3), (3, 3)] {
+        let steps = doc.history.undo_len();
+        assert!(doc.execute(Command::ReplaceMaterial { from, to }).is_err());
+        assert_eq!(
+            (state(&doc), doc.history.undo_len()),
+            (before.clone(), steps)
+        );
     }
 }
 

@@ -99,6 +99,14 @@ pub enum Command {
         /// The new material.
         material: u8,
     },
+    /// Give every solid voxel of material `from` in the selection (without one: in the
+    /// object brushes edit) material `to`.
+    ReplaceMaterial {
+        /// The material replaced.
+        from: u8,
+        /// The material it becomes.
+        to: u8,
+    },
     /// Append a material.
     AddMaterial(MaterialSpec),
     /// Replace a material.
@@ -252,6 +260,9 @@ impl Command {
             Command::FloodFill { start, material } => {
                 format!("Fill from {start} with material {material}")
             }
+            Command::ReplaceMaterial { from, to } => {
+                format!("Replace material {from} by {to}")
+            }
             Command::AddMaterial(_) => "Add material".into(),
             Command::SetMaterial { index, .. } => format!("Edit material {index}"),
             Command::SetColour { index, .. } => format!("Edit colour {index}"),
@@ -398,6 +409,11 @@ impl Command {
                 let pasted = Selection::new(clip.region.translated(*at), voxels);
                 let pasted = (!pasted.voxels.is_empty()).then_some(pasted);
                 with_selection(scene, edit, pasted)?
+            }
+            Command::ReplaceMaterial { from, to } => {
+                world.materials().check(*to as u32)?;
+                let edits = super::replace::replace_edits(scene, *from, *to)?;
+                apply_all(scene, vec![EditOp::Voxels(edits)])?
             }
             Command::FloodFill { start, material } => {
                 world.materials().check(*material as u32)?;

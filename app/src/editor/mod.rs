@@ -10,6 +10,7 @@ mod inverse;
 pub mod live;
 pub mod objects;
 pub mod progress;
+mod replace;
 pub mod script;
 
 pub use error::{EditError, Result};

@@ -141,6 +141,10 @@ impl Editor {
     pub(super) fn ui_event(&mut self, e: UiEvent) {
         match e {
             UiEvent::Action(a) => self.action(a),
+            UiEvent::ReplaceMaterial { from } => self.execute(Command::ReplaceMaterial {
+                from,
+                to: self.settings.brush.material,
+            }),
             UiEvent::OpenRecent(p) => self.guard_unsaved(Pending::Open(Some(p))),
             UiEvent::SetSun(s) => self.execute(Command::SetSun(s)),
             UiEvent::SetSky(s) => self.execute(Command::SetSky(s)),

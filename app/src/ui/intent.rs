@@ -133,6 +133,11 @@ pub enum Nudge {
 pub enum UiEvent {
     /// A shortcut's action (menus name the same actions).
     Action(Action),
+    /// Replace a material by the brush's in the selection or the edited object.
+    ReplaceMaterial {
+        /// The material replaced.
+        from: u8,
+    },
     /// Open a recent file.
     OpenRecent(PathBuf),
     /// The sun changed (one undo step per drag: commands coalesce).

@@ -209,6 +209,19 @@ pub fn draw(
                         out.push(UiEvent::Action(action));
                     }
                 }
+                ui.menu_button("Replace by the current material", |ui| {
+                    ui.label(if selected {
+                        "in the selection:"
+                    } else {
+                        "in the edited object:"
+                    });
+                    let count = doc.scene.world.materials().len();
+                    for from in (0..count as u8).filter(|m| *m != view.brush.material) {
+                        if ui.button(format!("material {from}")).clicked() {
+                            out.push(UiEvent::ReplaceMaterial { from });
+                        }
+                    }
+                });
             });
             ui.menu_button("View", |ui| {
                 if ui.button("Frame the scene  F").clicked() {
