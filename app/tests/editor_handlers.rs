@@ -927,6 +927,31 @@ fn the_object_keys_and_menu_act_on_the_picked_object(s: &mut Session) {
     assert_eq!(s.state().0, before.0);
 }
 
+/// The Shortcuts window (F1) switches to the Blender-like key map: A selects all, Alt + A
+/// nothing; and back.
+fn the_blender_key_map_is_chosen_in_the_shortcuts_window(s: &mut Session) {
+    use app::ui::keymap::KeyPreset;
+    let selected = |s: &Session| s.ed.document().read().unwrap().scene.selection.is_some();
+    s.quiet();
+    s.key(KeyCode::F1, true);
+    s.key(KeyCode::F1, false);
+    s.quiet();
+    s.click_on("Blender-like", MouseButton::Left);
+    assert_eq!(s.ed.settings().key_preset, KeyPreset::Blender);
+    s.key(KeyCode::KeyA, true);
+    s.key(KeyCode::KeyA, false);
+    s.quiet();
+    assert!(selected(s), "A selects all");
+    s.chord(false, false, true, KeyCode::KeyA);
+    s.quiet();
+    assert!(!selected(s), "Alt + A selects nothing");
+    s.click_on("MagicaVoxel", MouseButton::Left);
+    assert_eq!(s.ed.settings().key_preset, KeyPreset::MagicaVoxel);
+    s.key(KeyCode::F1, true);
+    s.key(KeyCode::F1, false);
+    s.quiet();
+}
+
 #[test]
 fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     let dir = window::scratch("editor-handlers");
@@ -943,6 +968,7 @@ fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     selection_operations_land_and_a_selection_gets_a_material_of_its_own(&mut s);
     arrange_mode_picks_and_moves_an_object(&mut s);
     the_object_keys_and_menu_act_on_the_picked_object(&mut s);
+    the_blender_key_map_is_chosen_in_the_shortcuts_window(&mut s);
     the_docks_leave_the_viewport_framing_fits_it_and_the_palette_paints(&mut s);
     without_a_dialog_save_as_and_open_ask_in_the_browser(&mut s, &dir);
     the_first_click_on_an_empty_scene_attaches_on_the_floor(&mut s, &dir);

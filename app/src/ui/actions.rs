@@ -141,6 +141,10 @@ impl Editor {
     pub(super) fn ui_event(&mut self, e: UiEvent) {
         match e {
             UiEvent::Action(a) => self.action(a),
+            UiEvent::KeyPreset(p) => {
+                self.settings.key_preset = p;
+                self.load_keys();
+            }
             UiEvent::ReplaceMaterial { from } => self.execute(Command::ReplaceMaterial {
                 from,
                 to: self.settings.brush.material,

@@ -86,14 +86,17 @@ impl ConfigDir {
     /// The key map: keys.ron, written with the defaults when there is none (so the user
     /// has a file to edit). A broken file is an error naming it, and the defaults are used
     /// (the file is left alone).
-    pub fn keymap(&self) -> (super::keymap::KeyMap, Option<String>) {
+    pub fn keymap(
+        &self,
+        preset: super::keymap::KeyPreset,
+    ) -> (super::keymap::KeyMap, Option<String>) {
         use super::keymap::{KeyMap, default_bindings};
         let f = self.0.join("keys.ron");
         match std::fs::read_to_string(&f) {
-            Ok(text) => match KeyMap::parse(&text) {
+            Ok(text) => match KeyMap::parse(&text, preset) {
                 Ok(map) => (map, None),
                 Err(e) => (
-                    KeyMap::default(),
+                    KeyMap::of(preset),
                     Some(format!("{}: {e}; using the default keys", f.display())),
                 ),
             },
@@ -106,10 +109,10 @@ impl ConfigDir {
                 let note = written
                     .err()
                     .map(|e| format!("writing {}: {e}", f.display()));
-                (KeyMap::default(), note)
+                (KeyMap::of(preset), note)
             }
             Err(e) => (
-                KeyMap::default(),
+                KeyMap::of(preset),
                 Some(format!("reading {}: {e}", f.display())),
             ),
         }

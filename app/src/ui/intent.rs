@@ -111,6 +111,19 @@ pub enum Action {
     Quit,
 }
 
+/// The key map the editor starts from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum KeyPreset {
+    /// MagicaVoxel's shortcuts where it has them.
+    #[default]
+    MagicaVoxel,
+    /// Blender's where an action matches one of its own: A / Alt + A select all / none, X and
+    /// Delete delete, Shift + D duplicate, Alt + D instance, P separate the selection into an
+    /// object, B the selection tool (Shift + B the sphere brush), Shift + X erase, Home and
+    /// Numpad . frame; the rest as MagicaVoxel's.
+    Blender,
+}
+
 /// A move of the selection by a key.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Nudge {
@@ -133,6 +146,8 @@ pub enum Nudge {
 pub enum UiEvent {
     /// A shortcut's action (menus name the same actions).
     Action(Action),
+    /// Another key map preset.
+    KeyPreset(KeyPreset),
     /// Replace a material by the brush's in the selection or the edited object.
     ReplaceMaterial {
         /// The material replaced.

@@ -5,8 +5,13 @@
 //! their default chords where the file does not use them. A file that does not parse, or
 //! names a key that does not exist, is an error naming the binding; the defaults are used
 //! and the file is left as it is. Flying (W A S D, Q / E, held) is not an action and not
-//! remapped.
+//! remapped; a preset that binds one of those keys takes it.
+//!
+//! Two presets: MagicaVoxel's (the default) and a Blender-like one (`KeyPreset`, chosen in
+//! the Shortcuts window). keys.ron's bindings win over either; with the Blender-like preset
+//! the file's lines that are MagicaVoxel defaults (as the first start wrote them) give way.
 
+pub use super::intent::KeyPreset;
 use super::intent::{Action, Mods, Nudge};
 use crate::editor::command::{BrushMode, BrushShape};
 use brickmap::objects::Axis;
@@ -69,7 +74,69 @@ pub enum KeyMapError {
     },
 }
 
+impl KeyPreset {
+    /// Both, for a chooser.
+    pub const ALL: [KeyPreset; 2] = [KeyPreset::MagicaVoxel, KeyPreset::Blender];
+
+    /// Its name in the Shortcuts window.
+    pub fn name(self) -> &'static str {
+        match self {
+            KeyPreset::MagicaVoxel => "MagicaVoxel",
+            KeyPreset::Blender => "Blender-like",
+        }
+    }
+
+    /// Its bindings.
+    pub fn bindings(self) -> Vec<Binding> {
+        match self {
+            KeyPreset::MagicaVoxel => default_bindings(),
+            KeyPreset::Blender => blender_bindings(),
+        }
+    }
+}
+
+/// Blender's chords for the actions it has, then MagicaVoxel's defaults whose chord and action
+/// those leave free.
+fn blender_bindings() -> Vec<Binding> {
+    let own = [
+        ("A", Action::SelectAll),
+        ("Alt+A", Action::SelectNone),
+        ("X", Action::DeleteSelection),
+        ("Delete", Action::DeleteSelection),
+        ("Shift+D", Action::DuplicateObject),
+        ("Alt+D", Action::InstanceObject),
+        ("P", Action::SplitSelection),
+        ("B", Action::SelectTool),
+        ("Shift+B", Action::Shape(BrushShape::Sphere)),
+        ("Shift+X", Action::Mode(BrushMode::Erase)),
+        ("Home", Action::Frame),
+        ("NumpadDecimal", Action::Frame),
+    ];
+    let mut out: Vec<Binding> = own
+        .iter()
+        .map(|(k, a)| Binding {
+            keys: k.to_string(),
+            action: *a,
+        })
+        .collect();
+    for d in default_bindings() {
+        let chord = parse_chord(&d.keys).expect("the defaults parse");
+        let taken = own
+            .iter()
+            .any(|(k, a)| *a == d.action || parse_chord(k).is_ok_and(|c| c == chord));
+        if !taken {
+            out.push(d);
+        }
+    }
+    out
+}
+
 impl KeyMap {
+    /// A preset's map.
+    pub fn of(preset: KeyPreset) -> Self {
+        Self::from_bindings(&preset.bindings()).expect("the presets parse")
+    }
+
     /// The map of these bindings; an error names the first bad chord.
     pub fn from_bindings(bindings: &[Binding]) -> Result<Self, KeyMapError> {
         let chords = bindings
@@ -112,11 +179,16 @@ impl KeyMap {
     /// Parses keys.ron's text. An action the file does not bind keeps its default chord when
     /// the file does not use that chord for something else (a file written by an older
     /// version still gets the shortcuts added since).
-    pub fn parse(text: &str) -> Result<Self, KeyMapError> {
+    pub fn parse(text: &str, preset: KeyPreset) -> Result<Self, KeyMapError> {
         let mut bindings: Vec<Binding> =
             ron::from_str(text).map_err(|e| KeyMapError::Syntax(e.to_string()))?;
+        if preset != KeyPreset::MagicaVoxel {
+            // The defaults the first start wrote are not the user's choice.
+            let defaults = default_bindings();
+            bindings.retain(|b| !defaults.contains(b));
+        }
         let user = Self::from_bindings(&bindings)?;
-        for d in default_bindings() {
+        for d in preset.bindings() {
             let chord = parse_chord(&d.keys)?;
             let taken = user.chords.iter().any(|(c, _)| *c == chord);
             if !taken && !bindings.iter().any(|b| b.action == d.action) {
@@ -283,6 +355,7 @@ fn key_code(name: &str) -> Option<KeyCode> {
         Numpad9,
         NumpadAdd,
         NumpadSubtract,
+        NumpadDecimal,
         Escape,
         Space,
         Tab,
@@ -327,9 +400,61 @@ mod tests {
     };
 
     #[test]
+    fn the_blender_preset_binds_its_own_keys_and_the_written_defaults_give_way() {
+        let map = KeyMap::of(KeyPreset::Blender);
+        let none = Mods::default();
+        let alt = Mods { alt: true, ..none };
+        let shift = Mods {
+            shift: true,
+            ..none
+        };
+        assert_eq!(map.action(KeyCode::KeyA, none), Some(Action::SelectAll));
+        assert_eq!(map.action(KeyCode::KeyA, alt), Some(Action::SelectNone));
+        assert_eq!(
+            map.action(KeyCode::KeyD, shift),
+            Some(Action::DuplicateObject)
+        );
+        assert_eq!(
+            map.action(KeyCode::KeyX, none),
+            Some(Action::DeleteSelection)
+        );
+        assert_eq!(
+            map.action(KeyCode::KeyX, shift),
+            Some(Action::Mode(BrushMode::Erase))
+        );
+        assert_eq!(
+            map.action(KeyCode::NumpadDecimal, none),
+            Some(Action::Frame)
+        );
+        // MagicaVoxel's chords it does not take stay; those of actions it moved are free.
+        assert_eq!(map.action(KeyCode::KeyZ, CTRL), Some(Action::Undo));
+        assert_eq!(map.action(KeyCode::KeyM, none), None);
+        assert_eq!(map.action(KeyCode::KeyF, none), None);
+        // No chord is bound twice.
+        let chords: Vec<_> = map.chords.iter().map(|(c, _)| *c).collect();
+        for (i, c) in chords.iter().enumerate() {
+            assert!(!chords[i + 1..].contains(c), "{c:?} twice");
+        }
+        // keys.ron as the first start wrote it (the MagicaVoxel defaults) and one line the
+        // user changed: the preset's keys, and the user's.
+        let mut written = default_bindings();
+        written.push(Binding {
+            keys: "Ctrl+K".into(),
+            action: Action::Copy,
+        });
+        let text = KeyMap::to_ron(&written);
+        let map = KeyMap::parse(&text, KeyPreset::Blender).unwrap();
+        assert_eq!(map.action(KeyCode::KeyA, none), Some(Action::SelectAll));
+        assert_eq!(map.action(KeyCode::KeyK, CTRL), Some(Action::Copy));
+        let map = KeyMap::parse(&text, KeyPreset::MagicaVoxel).unwrap();
+        assert_eq!(map.action(KeyCode::KeyA, CTRL), Some(Action::SelectAll));
+        assert_eq!(map.action(KeyCode::KeyA, none), None);
+    }
+
+    #[test]
     fn the_default_file_round_trips_and_means_the_defaults() {
         let text = KeyMap::to_ron(&default_bindings());
-        let map = KeyMap::parse(&text).unwrap();
+        let map = KeyMap::parse(&text, KeyPreset::MagicaVoxel).unwrap();
         assert_eq!(map.bindings(), default_bindings().as_slice());
         assert_eq!(map.action(KeyCode::KeyZ, CTRL), Some(Action::Undo));
         assert_eq!(
@@ -359,9 +484,11 @@ mod tests {
     #[test]
     fn an_older_file_keeps_its_bindings_and_gets_the_new_defaults() {
         // Binds Copy elsewhere and takes Ctrl+V for Undo: neither default comes back.
-        let map =
-            KeyMap::parse(r#"[(keys: "Ctrl+K", action: Copy), (keys: "Ctrl+V", action: Undo)]"#)
-                .unwrap();
+        let map = KeyMap::parse(
+            r#"[(keys: "Ctrl+K", action: Copy), (keys: "Ctrl+V", action: Undo)]"#,
+            KeyPreset::MagicaVoxel,
+        )
+        .unwrap();
         assert_eq!(map.action(KeyCode::KeyK, CTRL), Some(Action::Copy));
         assert_eq!(map.action(KeyCode::KeyC, CTRL), None);
         assert_eq!(map.action(KeyCode::KeyV, CTRL), Some(Action::Undo));
@@ -376,9 +503,11 @@ mod tests {
 
     #[test]
     fn a_user_binding_replaces_the_defaults_and_bad_ones_are_named() {
-        let map =
-            KeyMap::parse(r#"[(keys: "Alt+U", action: Undo), (keys: "shift+f", action: Frame)]"#)
-                .unwrap();
+        let map = KeyMap::parse(
+            r#"[(keys: "Alt+U", action: Undo), (keys: "shift+f", action: Frame)]"#,
+            KeyPreset::MagicaVoxel,
+        )
+        .unwrap();
         let alt = Mods {
             alt: true,
             ..Mods::default()
@@ -394,7 +523,11 @@ mod tests {
             None,
             "the defaults are replaced"
         );
-        let err = KeyMap::parse(r#"[(keys: "Ctrl+Banana", action: Undo)]"#).unwrap_err();
+        let err = KeyMap::parse(
+            r#"[(keys: "Ctrl+Banana", action: Undo)]"#,
+            KeyPreset::MagicaVoxel,
+        )
+        .unwrap_err();
         assert_eq!(
             err,
             KeyMapError::UnknownKey {
@@ -406,17 +539,21 @@ mod tests {
             err.to_string().contains("no key is called \"Banana\""),
             "{err}"
         );
-        let err = KeyMap::parse(r#"[(keys: "Hyper+Z", action: Undo)]"#).unwrap_err();
+        let err = KeyMap::parse(
+            r#"[(keys: "Hyper+Z", action: Undo)]"#,
+            KeyPreset::MagicaVoxel,
+        )
+        .unwrap_err();
         assert!(
             matches!(err, KeyMapError::Modifier { ref modifier, .. } if modifier == "hyper"),
             "{err}"
         );
         assert!(matches!(
-            KeyMap::parse(r#"[(keys: "Z", action: Fly)]"#),
+            KeyMap::parse(r#"[(keys: "Z", action: Fly)]"#, KeyPreset::MagicaVoxel),
             Err(KeyMapError::Syntax(_))
         ));
         assert!(matches!(
-            KeyMap::parse(r#"[(keys: "Ctrl+", action: Undo)]"#),
+            KeyMap::parse(r#"[(keys: "Ctrl+", action: Undo)]"#, KeyPreset::MagicaVoxel),
             Err(KeyMapError::NoKey(_))
         ));
     }

@@ -313,15 +313,7 @@ impl Editor {
         editor.egui.all_styles_mut(|s| s.animation_time = 0.0);
         editor.panels.errors.extend(settings_error);
         if editor.script.is_none() {
-            let (keymap, error) = editor.config.keymap();
-            editor.keymap = keymap;
-            editor.panels.errors.extend(error);
-            editor.panels.keys = editor
-                .keymap
-                .bindings()
-                .iter()
-                .map(|b| (b.keys.clone(), format!("{:?}", b.action)))
-                .collect();
+            editor.load_keys();
         }
         if editor.script.is_some() {
             // A script run is reproducible: the defaults, whatever the user saved.
@@ -374,6 +366,19 @@ impl Editor {
     }
 
     /// The cursor's ray.
+    /// The key map: the settings' preset under keys.ron; the Shortcuts window lists it.
+    fn load_keys(&mut self) {
+        let (keymap, error) = self.config.keymap(self.settings.key_preset);
+        self.keymap = keymap;
+        self.panels.errors.extend(error);
+        self.panels.keys = self
+            .keymap
+            .bindings()
+            .iter()
+            .map(|b| (b.keys.clone(), format!("{:?}", b.action)))
+            .collect();
+    }
+
     fn cursor_ray(&self) -> (DVec3, DVec3) {
         self.viewing.ray_at(self.pointer.cursor)
     }

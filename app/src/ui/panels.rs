@@ -40,6 +40,8 @@ pub struct ViewSettings {
     pub grid: bool,
     /// Its lines' spacing in voxels.
     pub grid_spacing: u32,
+    /// The key map's preset (keys.ron's bindings win over it).
+    pub key_preset: super::intent::KeyPreset,
     /// Autosave period in seconds (0: off).
     pub autosave_secs: u64,
     /// The brush.
@@ -57,6 +59,7 @@ impl Default for ViewSettings {
             dim_others: false,
             grid: true,
             grid_spacing: 8,
+            key_preset: Default::default(),
             autosave_secs: 180,
             brush: Default::default(),
         }
@@ -380,6 +383,19 @@ pub fn draw(
             .open(&mut open)
             .default_width(width)
             .show(ctx, |ui| {
+                ui.horizontal(|ui| {
+                    ui.label("key map");
+                    for p in super::intent::KeyPreset::ALL {
+                        if ui
+                            .selectable_label(view.key_preset == p, p.name())
+                            .clicked()
+                            && view.key_preset != p
+                        {
+                            out.push(UiEvent::KeyPreset(p));
+                        }
+                    }
+                });
+                ui.separator();
                 // Scrolls when the window is short (or the UI scale large).
                 egui::ScrollArea::vertical().show(ui, |ui| {
                     // A row per shortcut: the keys in a column of their own, the description
