@@ -15,5 +15,6 @@ pub mod selection;
 pub mod selection_transform;
 pub mod soak;
 pub mod ui;
+pub mod wand;
 
 pub use scene::Scene;

@@ -18,6 +18,7 @@
 //! selection and clipboard (never saved; the editor carries the clipboard to the next
 //! document). Outside `editor/` so `scene.rs` can hold it without an import loop.
 
+use crate::wand::Combine;
 use brickmap::{BrickUndo, EditInverse, EditOp, Mask, PriorMaterials, VoxelSet, WorldView};
 use glam::{IVec3, UVec3};
 use serde::{Deserialize, Serialize};
@@ -39,6 +40,10 @@ pub struct RegionBox {
 /// selection); only voxels inside it are selected.
 #[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Region {
+    /// Voxels chosen as a set (a magic wand, by material, inverted, grown, shrunk), before
+    /// the boxes apply. Not saved in scripts: their steps compute it again.
+    #[serde(skip)]
+    pub base: Option<Arc<VoxelSet>>,
     /// The boxes, applied in order.
     pub boxes: Vec<RegionBox>,
 }
@@ -47,6 +52,7 @@ impl Region {
     /// The region moved by `offset`.
     pub fn translated(&self, offset: IVec3) -> Region {
         Region {
+            base: self.base.as_ref().map(|b| Arc::new(b.shifted(offset))),
             boxes: self
                 .boxes
                 .iter()
@@ -62,6 +68,15 @@ impl Region {
     /// The region's voxels inside a grid of `voxels`.
     pub fn voxels(&self, voxels: IVec3) -> VoxelSet {
         let mut set = VoxelSet::new();
+        if let Some(base) = &self.base {
+            // Whole bricks: a grid is a whole number of them.
+            let bricks = (voxels / 8).as_uvec3();
+            for (b, m) in base.iter() {
+                if b.cmplt(bricks).all() {
+                    set.set_brick(b, *m);
+                }
+            }
+        }
         for b in &self.boxes {
             set.apply_box(b.min, b.max, voxels, b.subtract);
         }
@@ -97,6 +112,30 @@ pub enum SelectOp {
     All,
     /// Nothing.
     None,
+    /// The magic wand from `start` ([`crate::wand::wand`]).
+    Wand {
+        /// The clicked voxel.
+        start: IVec3,
+        /// Only voxels of its material (else every solid voxel).
+        by_material: bool,
+        /// Connected through edges and corners too (26), not only faces (6).
+        diagonal: bool,
+        /// How it combines with the selection.
+        how: Combine,
+    },
+    /// Every voxel of a material.
+    Material {
+        /// The material.
+        material: u8,
+        /// How it combines with the selection.
+        how: Combine,
+    },
+    /// Every voxel of the grid that is not selected.
+    Invert,
+    /// One voxel more on every side (through faces).
+    Grow,
+    /// One voxel less on every side.
+    Shrink,
 }
 
 /// A region and its voxels (shared: edits and the viewport read it without copying).
@@ -119,8 +158,13 @@ impl Selection {
     }
 }
 
-/// The selection after `op`, in a grid of `voxels` (None: nothing selected).
-pub fn select(current: Option<&Selection>, op: SelectOp, voxels: IVec3) -> Option<Selection> {
+/// The selection after `op` on the voxels of `view` (None: nothing selected).
+pub fn select(
+    current: Option<&Selection>,
+    op: SelectOp,
+    view: &WorldView<'_>,
+) -> Option<Selection> {
+    let voxels = view.dims().voxels();
     let boxed = |a: IVec3, b: IVec3, subtract| RegionBox {
         min: a.min(b),
         max: a.max(b),
@@ -129,13 +173,49 @@ pub fn select(current: Option<&Selection>, op: SelectOp, voxels: IVec3) -> Optio
     let mut region = current.map(|s| s.region.clone()).unwrap_or_default();
     match op {
         SelectOp::None => return None,
-        SelectOp::All => region.boxes = vec![boxed(IVec3::ZERO, voxels - 1, false)],
-        SelectOp::Replace { min, max } => region.boxes = vec![boxed(min, max, false)],
+        SelectOp::All => {
+            region = Region {
+                base: None,
+                boxes: vec![boxed(IVec3::ZERO, voxels - 1, false)],
+            }
+        }
+        SelectOp::Replace { min, max } => {
+            region = Region {
+                base: None,
+                boxes: vec![boxed(min, max, false)],
+            }
+        }
         SelectOp::Add { min, max } => region.boxes.push(boxed(min, max, false)),
         SelectOp::Subtract { min, max } => {
             // Nothing selected stays nothing.
             current?;
             region.boxes.push(boxed(min, max, true));
+        }
+        // The set-based ones: the result becomes the region's set, without boxes.
+        _ => {
+            let now = current.map(|s| s.voxels.as_ref());
+            let set = match op {
+                SelectOp::Wand {
+                    start,
+                    by_material,
+                    diagonal,
+                    how,
+                } => how.apply(now, crate::wand::wand(view, start, by_material, diagonal)),
+                SelectOp::Material { material, how } => {
+                    how.apply(now, crate::wand::of_material(view, material))
+                }
+                SelectOp::Invert => now.map_or_else(
+                    || VoxelSet::new().complement(voxels),
+                    |s| s.complement(voxels),
+                ),
+                SelectOp::Grow => now?.grown(voxels),
+                SelectOp::Shrink => now?.shrunk(),
+                _ => unreachable!("the box operations are above"),
+            };
+            region = Region {
+                base: Some(Arc::new(set)),
+                boxes: Vec::new(),
+            };
         }
     }
     let selection = Selection::new(region, voxels);

@@ -121,6 +121,21 @@ pub fn transform_edit(
         w.set_all(voxels, moved);
     }
     let region = Region {
+        base: selection.region.base.as_ref().map(|set| {
+            let mut out = brickmap::VoxelSet::new();
+            for (b, m) in set.iter() {
+                let min = b.as_ivec3() * 8;
+                let origin = ax * min.x + ay * min.y + az * min.z + k;
+                for bit in m.ones() {
+                    let (x, y, z) = (bit as i32 & 7, (bit as i32 >> 3) & 7, bit as i32 >> 6);
+                    let v = origin + ax * x + ay * y + az * z;
+                    if v.cmpge(IVec3::ZERO).all() {
+                        out.insert(v);
+                    }
+                }
+            }
+            std::sync::Arc::new(out)
+        }),
         boxes: selection
             .region
             .boxes

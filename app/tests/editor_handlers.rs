@@ -952,6 +952,55 @@ fn the_blender_key_map_is_chosen_in_the_shortcuts_window(s: &mut Session) {
     s.quiet();
 }
 
+/// The selection tool's magic wand: a click on the terrain selects the connected voxels of
+/// its material (one step, named in the History); Shift + Ctrl + click intersects; back to
+/// boxes.
+fn the_magic_wand_selects_with_a_click(s: &mut Session) {
+    let count = |s: &Session| {
+        let doc = s.ed.document();
+        let d = doc.read().unwrap();
+        d.scene.selection.as_ref().map_or(0, |s| s.voxels.count())
+    };
+    s.quiet();
+    s.key(KeyCode::KeyM, true);
+    s.key(KeyCode::KeyM, false);
+    s.quiet();
+    s.click_on("wand: colour", MouseButton::Left);
+    let at = s.on_the_terrain();
+    s.to(at);
+    s.frame();
+    s.left(true);
+    s.left(false);
+    s.quiet();
+    let picked = count(s);
+    assert!(picked > 0, "the wand selected nothing");
+    let label = {
+        let doc = s.ed.document();
+        let d = doc.read().unwrap();
+        d.history.undo_steps().last().map(|st| st.label.clone())
+    };
+    assert!(label.is_some_and(|l| l.starts_with("Magic wand at")));
+    // The same click intersected with itself keeps it all.
+    s.ed.input(Input::Modifiers(app::ui::input::Mods {
+        ctrl: true,
+        shift: true,
+        alt: false,
+    }));
+    s.left(true);
+    s.left(false);
+    s.ed.input(Input::Modifiers(Default::default()));
+    s.quiet();
+    assert_eq!(count(s), picked);
+    s.ctrl(KeyCode::KeyD);
+    s.quiet();
+    assert_eq!(count(s), 0);
+    s.click_on("box", MouseButton::Left);
+    assert_eq!(s.ed.brush().select_mode, app::ui::tools::SelectMode::Box);
+    s.key(KeyCode::KeyT, true);
+    s.key(KeyCode::KeyT, false);
+    s.quiet();
+}
+
 #[test]
 fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     let dir = window::scratch("editor-handlers");
@@ -969,6 +1018,7 @@ fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     arrange_mode_picks_and_moves_an_object(&mut s);
     the_object_keys_and_menu_act_on_the_picked_object(&mut s);
     the_blender_key_map_is_chosen_in_the_shortcuts_window(&mut s);
+    the_magic_wand_selects_with_a_click(&mut s);
     the_docks_leave_the_viewport_framing_fits_it_and_the_palette_paints(&mut s);
     without_a_dialog_save_as_and_open_ask_in_the_browser(&mut s, &dir);
     the_first_click_on_an_empty_scene_attaches_on_the_floor(&mut s, &dir);

@@ -41,5 +41,5 @@ pub use material::{Material, MaterialKind, MaterialTable};
 pub use raycast::{Occupancy, Ray, RayHit, cast, cast_from_cell};
 pub use shape::Shape;
 pub use storage::BucketSizes;
-pub use voxel_set::VoxelSet;
+pub use voxel_set::{FACES, VoxelSet};
 pub use world::{BrickMaterials, DirtySet, GpuBuffer, MemoryStats, World, WorldConfig, WorldView};

@@ -192,9 +192,156 @@ impl VoxelSet {
     }
 }
 
+/// Set operations, brick by brick (a selection's magic wand, invert, grow and shrink).
+impl VoxelSet {
+    /// The voxels of either set.
+    pub fn union(&self, o: &VoxelSet) -> VoxelSet {
+        let mut out = self.clone();
+        for (&(x, y, z), m) in &o.bricks {
+            let b = UVec3::new(x, y, z);
+            out.set_brick(b, out.brick(b).or(m));
+        }
+        out
+    }
+
+    /// The voxels of this set that are not in `o`.
+    pub fn difference(&self, o: &VoxelSet) -> VoxelSet {
+        let mut out = VoxelSet::new();
+        for (b, m) in self.iter() {
+            out.set_brick(b, m.and_not(&o.brick(b)));
+        }
+        out
+    }
+
+    /// The voxels in both sets.
+    pub fn intersection(&self, o: &VoxelSet) -> VoxelSet {
+        let mut out = VoxelSet::new();
+        for (b, m) in self.iter() {
+            out.set_brick(b, m.and(&o.brick(b)));
+        }
+        out
+    }
+
+    /// The voxels of a grid of `voxels` not in the set.
+    pub fn complement(&self, voxels: IVec3) -> VoxelSet {
+        let mut all = VoxelSet::new();
+        all.apply_box(IVec3::ZERO, voxels - 1, voxels, false);
+        all.difference(self)
+    }
+
+    /// The set moved by `offset`; voxels that land below 0 on an axis are dropped.
+    pub fn shifted(&self, offset: IVec3) -> VoxelSet {
+        let whole = offset.div_euclid(IVec3::splat(8));
+        let r = offset.rem_euclid(IVec3::splat(8));
+        let mut out = VoxelSet::new();
+        for (b, m) in self.iter() {
+            // The source brick's part that lands in each of the (up to) 8 target bricks.
+            for k in 0..8 {
+                let k = IVec3::new(k & 1, k >> 1 & 1, k >> 2);
+                if (k.cmpeq(IVec3::ONE) & r.cmpeq(IVec3::ZERO)).any() {
+                    continue;
+                }
+                let t = b.as_ivec3() + whole + k;
+                if t.cmplt(IVec3::ZERO).any() {
+                    continue;
+                }
+                let part = m.shifted(r - 8 * k);
+                if !part.is_empty() {
+                    let t = t.as_uvec3();
+                    out.set_brick(t, out.brick(t).or(&part));
+                }
+            }
+        }
+        out
+    }
+
+    /// The set and every voxel sharing a face with it, inside a grid of `voxels`.
+    pub fn grown(&self, voxels: IVec3) -> VoxelSet {
+        let mut out = self.clone();
+        for d in FACES {
+            out = out.union(&self.shifted(d));
+        }
+        out.intersection(&VoxelSet::new().complement(voxels))
+    }
+
+    /// The voxels of the set whose six face neighbours are all in it.
+    pub fn shrunk(&self) -> VoxelSet {
+        let mut out = self.clone();
+        for d in FACES {
+            out = out.intersection(&self.shifted(d));
+        }
+        out
+    }
+}
+
+/// The six face directions (a voxel's face neighbours are it plus each).
+pub const FACES: [IVec3; 6] = [
+    IVec3::X,
+    IVec3::NEG_X,
+    IVec3::Y,
+    IVec3::NEG_Y,
+    IVec3::Z,
+    IVec3::NEG_Z,
+];
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A few scattered voxels and a block across brick sides.
+    fn sample() -> VoxelSet {
+        let mut s = VoxelSet::new();
+        s.apply_box(
+            IVec3::new(5, 6, 7),
+            IVec3::new(12, 9, 17),
+            IVec3::splat(64),
+            false,
+        );
+        for v in [IVec3::ZERO, IVec3::new(31, 0, 8), IVec3::new(8, 40, 63)] {
+            s.insert(v);
+        }
+        s
+    }
+
+    #[test]
+    fn set_operations_agree_with_voxel_by_voxel_ones() {
+        let grid = IVec3::splat(64);
+        let a = sample();
+        let b = a.shifted(IVec3::new(3, -2, 9));
+        let has = |s: &VoxelSet, v: IVec3| s.contains(v);
+        let (u, d, i, c) = (
+            a.union(&b),
+            a.difference(&b),
+            a.intersection(&b),
+            a.complement(grid),
+        );
+        let (g, k) = (a.grown(grid), a.shrunk());
+        let faces = |v: IVec3| FACES.map(|f| v + f);
+        for x in -1..66 {
+            for y in -1..66 {
+                for z in -1..66 {
+                    let v = IVec3::new(x, y, z);
+                    let inside = v.cmpge(IVec3::ZERO).all() && v.cmplt(grid).all();
+                    let from = v - IVec3::new(3, -2, 9);
+                    assert_eq!(
+                        has(&b, v),
+                        from.cmpge(IVec3::ZERO).all() && has(&a, from),
+                        "{v}"
+                    );
+                    assert_eq!(has(&u, v), has(&a, v) || has(&b, v));
+                    assert_eq!(has(&d, v), has(&a, v) && !has(&b, v));
+                    assert_eq!(has(&i, v), has(&a, v) && has(&b, v));
+                    assert_eq!(has(&c, v), inside && !has(&a, v));
+                    let near = has(&a, v) || faces(v).iter().any(|n| has(&a, *n));
+                    assert_eq!(has(&g, v), inside && near, "grown at {v}");
+                    let deep = has(&a, v) && faces(v).iter().all(|n| has(&a, *n));
+                    assert_eq!(has(&k, v), deep, "shrunk at {v}");
+                }
+            }
+        }
+        assert_eq!(b.shifted(IVec3::new(-3, 2, -9)).difference(&a).count(), 0);
+        assert!(k.count() > 0 && g.count() > a.count());
+    }
 
     #[test]
     fn components_count_pieces_touching_by_corners_across_bricks() {

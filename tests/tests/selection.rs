@@ -298,6 +298,137 @@ fn a_material_is_replaced_across_the_object_and_refusals_change_nothing() {
     }
 }
 
+/// The selected voxels, as a set.
+fn selected_set(doc: &Document) -> std::collections::HashSet<IVec3> {
+    doc.scene
+        .selection
+        .as_ref()
+        .map(|s| s.voxels.voxels().collect())
+        .unwrap_or_default()
+}
+
+/// The magic wand (by material and solid, through faces and corners), select by material,
+/// invert, grow and shrink, each combined as the modifiers say, against voxel-by-voxel
+/// references on the terrain; each is one undoable step.
+#[test]
+fn set_selections_match_voxel_by_voxel_references() {
+    use app::wand::Combine;
+    use std::collections::HashSet;
+    let mut doc = document();
+    let old = snapshot(&doc);
+    let at = |v: IVec3| inside(v).then(|| old[index(v)]).flatten();
+    // The top voxel of the column at (40, 50).
+    let top = (0..DIMS.y)
+        .rev()
+        .map(|y| IVec3::new(40, y, 50))
+        .find(|v| at(*v).is_some())
+        .unwrap();
+    let reference = |by_material: bool, diagonal: bool| {
+        let m = at(top).unwrap();
+        let mut seen = HashSet::from([top]);
+        let mut stack = vec![top];
+        while let Some(v) = stack.pop() {
+            for d in 0..27 {
+                let d = IVec3::new(d % 3 - 1, d / 3 % 3 - 1, d / 9 - 1);
+                if d == IVec3::ZERO || (!diagonal && d.abs().element_sum() != 1) {
+                    continue;
+                }
+                let n = v + d;
+                if at(n).is_some_and(|k| !by_material || k == m) && seen.insert(n) {
+                    stack.push(n);
+                }
+            }
+        }
+        seen
+    };
+    let the_box = (IVec3::new(30, 0, 40), IVec3::new(50, 63, 60));
+    let boxed: HashSet<IVec3> = (the_box.0.x..=the_box.1.x)
+        .flat_map(|x| (0..DIMS.y).flat_map(move |y| (40..=60).map(move |z| IVec3::new(x, y, z))))
+        .collect();
+    for (by_material, diagonal) in [(true, false), (true, true), (false, false)] {
+        let want = reference(by_material, diagonal);
+        assert!(want.len() > 10, "{} voxels", want.len());
+        for how in [
+            Combine::Replace,
+            Combine::Add,
+            Combine::Subtract,
+            Combine::Intersect,
+        ] {
+            doc.execute(Command::Select(SelectOp::Replace {
+                min: the_box.0,
+                max: the_box.1,
+            }))
+            .unwrap();
+            let before = state(&doc);
+            doc.execute(Command::Select(SelectOp::Wand {
+                start: top,
+                by_material,
+                diagonal,
+                how,
+            }))
+            .unwrap();
+            let expected: HashSet<IVec3> = match how {
+                Combine::Replace => want.clone(),
+                Combine::Add => want.union(&boxed).copied().collect(),
+                Combine::Subtract => boxed.difference(&want).copied().collect(),
+                Combine::Intersect => boxed.intersection(&want).copied().collect(),
+            };
+            assert_eq!(
+                selected_set(&doc),
+                expected,
+                "{by_material} {diagonal} {how:?}"
+            );
+            doc.undo().unwrap();
+            assert_eq!(state(&doc), before);
+        }
+    }
+    // By material: every voxel of the top's material.
+    let m = at(top).unwrap();
+    doc.execute(Command::Select(SelectOp::Material {
+        material: m,
+        how: Combine::Replace,
+    }))
+    .unwrap();
+    let all: HashSet<IVec3> = (0..old.len())
+        .filter(|i| old[*i] == Some(m))
+        .map(|i| {
+            let i = i as i32;
+            IVec3::new(i / (DIMS.y * DIMS.z), i / DIMS.z % DIMS.y, i % DIMS.z)
+        })
+        .collect();
+    assert_eq!(selected_set(&doc), all);
+    // Grow, shrink, invert of a box inside the grid.
+    let (lo, hi) = (IVec3::new(10, 5, 12), IVec3::new(20, 15, 30));
+    let boxed: HashSet<IVec3> = (lo.x..=hi.x)
+        .flat_map(|x| {
+            (lo.y..=hi.y).flat_map(move |y| (lo.z..=hi.z).map(move |z| IVec3::new(x, y, z)))
+        })
+        .collect();
+    doc.execute(Command::Select(SelectOp::Replace { min: lo, max: hi }))
+        .unwrap();
+    let faces = brickmap::FACES;
+    doc.execute(Command::Select(SelectOp::Grow)).unwrap();
+    let grown: HashSet<IVec3> = boxed
+        .iter()
+        .flat_map(|v| faces.iter().map(move |f| *v + *f).chain([*v]))
+        .filter(|v| inside(*v))
+        .collect();
+    assert_eq!(selected_set(&doc), grown);
+    doc.execute(Command::Select(SelectOp::Shrink)).unwrap();
+    doc.execute(Command::Select(SelectOp::Shrink)).unwrap();
+    let shrunk: HashSet<IVec3> = boxed
+        .iter()
+        .filter(|v| faces.iter().all(|f| boxed.contains(&(**v + *f))))
+        .copied()
+        .collect();
+    assert_eq!(selected_set(&doc), shrunk, "grown then shrunk twice");
+    doc.execute(Command::Select(SelectOp::Invert)).unwrap();
+    let n = (DIMS.x * DIMS.y * DIMS.z) as usize;
+    let selection = selected_set(&doc);
+    assert_eq!(selection.len(), n - shrunk.len());
+    assert!(shrunk.iter().all(|v| !selection.contains(v)));
+}
+
 #[test]
 fn paste_puts_the_copy_down_over_what_is_there_and_selects_it() {
     let dims = DIMS;

@@ -282,6 +282,13 @@ impl Command {
                 SelectOp::Subtract { .. } => "Subtract box from selection".into(),
                 SelectOp::All => "Select all".into(),
                 SelectOp::None => "Select none".into(),
+                SelectOp::Wand { start, how, .. } => format!("Magic wand at {start} ({how:?})"),
+                SelectOp::Material { material, how } => {
+                    format!("Select material {material} ({how:?})")
+                }
+                SelectOp::Invert => "Invert selection".into(),
+                SelectOp::Grow => "Grow selection".into(),
+                SelectOp::Shrink => "Shrink selection".into(),
             },
             Command::DeleteSelection => "Delete selection".into(),
             Command::FillSelection(m) => format!("Fill selection with material {m}"),
@@ -345,7 +352,9 @@ impl Command {
             Command::RemoveUnusedMaterials => remove_unused_materials(scene)?,
             Command::Object(c) => c.apply(scene)?,
             Command::Select(op) => {
-                let next = select(scene.selection.as_ref(), *op, world.dims().voxels());
+                let alone = scene.active_world()?;
+                let source = alone.as_ref().unwrap_or(world);
+                let next = select(scene.selection.as_ref(), *op, &source.read());
                 unchanged(Inverse::Selection(std::mem::replace(
                     &mut scene.selection,
                     next,

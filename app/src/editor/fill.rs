@@ -2,19 +2,9 @@
 
 use super::error::{Result, invalid};
 use crate::scene::Scene;
-use brickmap::{VoxelEdit, VoxelOp};
+use brickmap::{FACES, VoxelEdit, VoxelOp};
 use glam::IVec3;
 use std::collections::VecDeque;
-
-/// The 6 face neighbours of a voxel.
-const FACES: [IVec3; 6] = [
-    IVec3::X,
-    IVec3::NEG_X,
-    IVec3::Y,
-    IVec3::NEG_Y,
-    IVec3::Z,
-    IVec3::NEG_Z,
-];
 
 /// The 26 neighbours of a voxel.
 const NEIGHBOURS: [IVec3; 26] = {

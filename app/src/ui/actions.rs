@@ -83,6 +83,13 @@ impl Editor {
             Action::RemoveUnusedMaterials => self.execute(Command::RemoveUnusedMaterials),
             Action::SelectAll => self.select(SelectOp::All),
             Action::SelectNone => self.select(SelectOp::None),
+            Action::InvertSelection => self.select(SelectOp::Invert),
+            Action::GrowSelection => self.select(SelectOp::Grow),
+            Action::ShrinkSelection => self.select(SelectOp::Shrink),
+            Action::SelectMaterial => self.select(SelectOp::Material {
+                material: self.settings.brush.material,
+                how: crate::wand::Combine::Replace,
+            }),
             Action::DeleteSelection if self.settings.brush.tool == Tool::Arrange => {
                 self.arrange_delete()
             }

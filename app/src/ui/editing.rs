@@ -15,7 +15,7 @@
 //! tools' (the user's choice returns when it is wide again). The Terrain window floats over the
 //! viewport.
 
-use super::intent::{Action, Nudge, UiEvent};
+use super::intent::{Action, UiEvent};
 use super::swatch::{DIELECTRIC_BOUNCES, swatch};
 use super::tools::{Brush, MAX_SIZE, Tool};
 use crate::editor::Document;
@@ -278,7 +278,7 @@ fn tools(
         });
     }
     ui.separator();
-    selection(ui, brush, doc, out);
+    super::selection_panel::selection(ui, brush, doc, out);
     ui.separator();
     ui.label("material (Alt + click picks one)");
     ui.horizontal_wrapped(|ui| {
@@ -298,94 +298,6 @@ fn tools(
                 brush.material = i as u8;
             }
         }
-    });
-}
-
-/// The selection section: what is selected, the tool's depth, and the operations.
-fn selection(ui: &mut egui::Ui, brush: &mut Brush, doc: &Document, out: &mut Vec<UiEvent>) {
-    let selected = doc.scene.selection.as_ref();
-    match selected.and_then(|s| s.voxels.bounds().map(|b| (b, s.voxels.count()))) {
-        Some(((lo, hi), n)) => {
-            ui.label(format!("selection: {n} voxels in {lo} … {hi}"));
-        }
-        None => {
-            ui.label("selection: none (M, then drag a box on a face)");
-        }
-    }
-    if brush.tool == Tool::Select {
-        ui.add(egui::Slider::new(&mut brush.select_depth, 1..=256).text("box depth"));
-    }
-    ui.checkbox(&mut brush.in_selection, "brush only inside the selection");
-    let has = selected.is_some();
-    let has_copy = doc.scene.clipboard.is_some();
-    ui.horizontal_wrapped(|ui| {
-        let mut button = |ui: &mut egui::Ui, enabled: bool, name: &str, hint: &str, a| {
-            if ui
-                .add_enabled(enabled, egui::Button::new(name))
-                .on_hover_text(hint)
-                .clicked()
-            {
-                out.push(UiEvent::Action(a));
-            }
-        };
-        button(ui, true, "All", "Ctrl+A", Action::SelectAll);
-        button(ui, has, "None", "Ctrl+D", Action::SelectNone);
-        button(ui, has, "Delete", "Delete", Action::DeleteSelection);
-        button(
-            ui,
-            has,
-            "Fill",
-            "Ctrl+F: the current material",
-            Action::FillSelection,
-        );
-        button(
-            ui,
-            has,
-            "Paint",
-            "Ctrl+P: the current material",
-            Action::PaintSelection,
-        );
-        button(ui, has, "Copy", "Ctrl+C", Action::Copy);
-        button(ui, has, "Cut", "Ctrl+X", Action::Cut);
-        button(ui, has_copy, "Paste", "Ctrl+V, then click", Action::Paste);
-    });
-    ui.add_enabled_ui(has, |ui| {
-        ui.horizontal_wrapped(|ui| {
-            ui.label("move");
-            for (name, n) in [
-                ("left", Nudge::Left),
-                ("right", Nudge::Right),
-                ("away", Nudge::Away),
-                ("near", Nudge::Towards),
-                ("up", Nudge::Up),
-                ("down", Nudge::Down),
-            ] {
-                if ui
-                    .button(name)
-                    .on_hover_text("arrow keys, Page Up / Down")
-                    .clicked()
-                {
-                    out.push(UiEvent::Action(Action::Nudge(n)));
-                }
-            }
-        });
-        ui.horizontal_wrapped(|ui| {
-            use brickmap::objects::Axis::{X, Y, Z};
-            ui.label("turn");
-            for (name, a) in [
-                ("X", Action::Turn(X)),
-                ("Y", Action::Turn(Y)),
-                ("Z", Action::Turn(Z)),
-                ("mirror X", Action::Flip(X)),
-                ("Y", Action::Flip(Y)),
-                ("Z", Action::Flip(Z)),
-            ] {
-                let tip = "about the selection's centre: Alt + X / Y / Z (Shift: back), mirror: Ctrl + Alt";
-                if ui.button(name).on_hover_text(tip).clicked() {
-                    out.push(UiEvent::Action(a));
-                }
-            }
-        });
     });
 }
 

@@ -70,6 +70,14 @@ pub enum Action {
     SelectAll,
     /// Select nothing.
     SelectNone,
+    /// Select what is not selected.
+    InvertSelection,
+    /// One voxel more on every side of the selection.
+    GrowSelection,
+    /// One voxel less.
+    ShrinkSelection,
+    /// Select every voxel of the current material.
+    SelectMaterial,
     /// Empty the selected voxels.
     DeleteSelection,
     /// Fill the selection with the current material.

@@ -48,6 +48,7 @@ mod recording;
 pub mod report;
 mod saves;
 mod selecting;
+mod selection_panel;
 mod status;
 mod swatch;
 pub mod tools;

@@ -116,6 +116,32 @@ impl Editor {
     /// cursor; a plain click on nothing selects nothing.
     pub(super) fn select_press(&mut self) {
         let (origin, dir) = self.cursor_ray();
+        let brush = &self.settings.brush;
+        if brush.select_mode != super::tools::SelectMode::Box {
+            // The magic wand: a click on a voxel (on nothing: a plain click selects nothing).
+            let (by_material, diagonal) = (
+                brush.select_mode == super::tools::SelectMode::WandColour,
+                brush.wand_diagonal,
+            );
+            let mods = self.pointer.mods;
+            let how = crate::wand::Combine::of(mods.shift, mods.ctrl);
+            let hit = {
+                let doc = self.read();
+                let view = doc.scene.world.read();
+                tools::pick(&view, origin, dir).map(|(h, _)| h.voxel)
+            };
+            match hit {
+                Some(start) => self.select(SelectOp::Wand {
+                    start,
+                    by_material,
+                    diagonal,
+                    how,
+                }),
+                None if how == crate::wand::Combine::Replace => self.select(SelectOp::None),
+                None => {}
+            }
+            return;
+        }
         let kind = DragKind::of(self.pointer.mods);
         let start = {
             let doc = self.read();
@@ -238,6 +264,12 @@ pub fn paint(
         }
     };
     if let Some(s) = selection {
+        // A set (a magic wand…) is outlined by its bounds.
+        if s.region.base.is_some()
+            && let Some((lo, hi)) = s.voxels.bounds()
+        {
+            outline(lo, hi, added, 1.5);
+        }
         for b in &s.region.boxes {
             outline(b.min, b.max, if b.subtract { taken } else { added }, 1.5);
         }

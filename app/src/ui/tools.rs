@@ -36,6 +36,22 @@ pub struct Brush {
     /// An attach stroke follows the surface under the cursor (each point on the face it
     /// hits) instead of keeping to the first face's layer.
     pub follow_surface: bool,
+    /// How the selection tool selects.
+    pub select_mode: SelectMode,
+    /// The magic wand joins voxels through edges and corners too (26), not only faces (6).
+    pub wand_diagonal: bool,
+}
+
+/// How the selection tool selects.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum SelectMode {
+    /// A box dragged on a face.
+    #[default]
+    Box,
+    /// A click: the connected voxels of the clicked one's material.
+    WandColour,
+    /// A click: the connected solid voxels.
+    WandSolid,
 }
 
 /// What the left button does in the viewport.
@@ -66,6 +82,8 @@ impl Default for Brush {
             tool: Tool::Brush,
             select_depth: 16,
             follow_surface: false,
+            select_mode: SelectMode::Box,
+            wand_diagonal: false,
         }
     }
 }
