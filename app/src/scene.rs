@@ -121,6 +121,21 @@ impl Scene {
         }
     }
 
+    /// The world box of the object voxel edits act on: its lowest voxel and one past its
+    /// highest (`None` without one).
+    pub fn active_box(&self) -> Option<(IVec3, IVec3)> {
+        let objects = self.objects();
+        let tree = objects.tree();
+        let node = self.active?;
+        match tree.node(node).ok()?.kind {
+            NodeKind::Object { model, .. } => {
+                let size = objects.model(model)?.size();
+                Some(tree.world_placement(node).ok()?.bounds(size))
+            }
+            NodeKind::Group { .. } => None,
+        }
+    }
+
     /// Makes `node` the object voxel edits act on (`None`: none).
     pub fn set_active(&mut self, node: Option<NodeId>) {
         self.active = node;

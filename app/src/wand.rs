@@ -6,7 +6,7 @@
 use brickmap::{BrickMaterials, Mask, VoxelSet, WorldView};
 use glam::{IVec3, UVec3};
 use serde::{Deserialize, Serialize};
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 
 /// How a new set of voxels changes the selection.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -49,42 +49,105 @@ impl Combine {
 /// The magic wand from `start`: the connected voxels that share its material (`by_material`)
 /// or are solid, joined through faces (and with `diagonal` through edges and corners too).
 /// Empty when `start` is empty or outside the grid.
+///
+/// A flood a brick at a time: the voxels a brick may take (solid, of the material) as a
+/// mask, grown inside the brick by whole-mask shifts until nothing changes, and what reaches
+/// a side handed to the brick beyond it as seeds.
 pub fn wand(view: &WorldView<'_>, start: IVec3, by_material: bool, diagonal: bool) -> VoxelSet {
     let Ok(Some(material)) = view.voxel(start) else {
         return VoxelSet::new();
     };
-    let takes = |v: IVec3| match view.voxel(v) {
-        Ok(Some(m)) => !by_material || m == material,
-        _ => false,
+    let bricks = view.dims().bricks().as_ivec3();
+    let mut allowed: HashMap<UVec3, Mask> = HashMap::new();
+    let mut allow = |b: UVec3| {
+        *allowed.entry(b).or_insert_with(|| {
+            let (mask, dense) = view.brick_voxels(b);
+            if !by_material {
+                return mask;
+            }
+            let mut m = Mask::EMPTY;
+            for bit in mask.ones() {
+                if dense[bit] == material {
+                    m.set(bit);
+                }
+            }
+            m
+        })
     };
-    let steps: Vec<IVec3> = (0..27)
+    let mut filled: HashMap<UVec3, Mask> = HashMap::new();
+    let l = start.rem_euclid(IVec3::splat(8));
+    let mut seed = Mask::EMPTY;
+    seed.set((l.x + 8 * l.y + 64 * l.z) as usize);
+    let mut queue = VecDeque::from([((start / 8).as_uvec3(), seed)]);
+    // The brick offsets a flood crosses to.
+    let offsets: Vec<IVec3> = (0..27)
         .map(|d| IVec3::new(d % 3 - 1, d / 3 % 3 - 1, d / 9 - 1))
         .filter(|d| *d != IVec3::ZERO && (diagonal || d.abs().element_sum() == 1))
         .collect();
-    let mut masks: HashMap<UVec3, Mask> = HashMap::new();
-    let mut seen = |v: IVec3| {
-        let l = v.rem_euclid(IVec3::splat(8));
-        let bit = (l.x + 8 * l.y + 64 * l.z) as usize;
-        let m = masks.entry((v / 8).as_uvec3()).or_insert(Mask::EMPTY);
-        let was = m.get(bit);
-        m.set(bit);
-        was
-    };
-    seen(start);
-    let mut stack = vec![start];
-    while let Some(v) = stack.pop() {
-        for d in &steps {
-            let n = v + *d;
-            if takes(n) && !seen(n) {
-                stack.push(n);
+    while let Some((b, seeds)) = queue.pop_front() {
+        let can = allow(b);
+        let had = filled.get(&b).copied().unwrap_or(Mask::EMPTY);
+        let new = seeds.and(&can).and_not(&had);
+        if new.is_empty() {
+            continue;
+        }
+        let mut now = had.or(&new);
+        loop {
+            let next = now.or(&grow(&now, [true; 3], diagonal).and(&can));
+            if next == now {
+                break;
+            }
+            now = next;
+        }
+        let added = now.and_not(&had);
+        filled.insert(b, now);
+        for d in &offsets {
+            let n = b.as_ivec3() + *d;
+            if n.cmplt(IVec3::ZERO).any() || n.cmpge(bricks).any() {
+                continue;
+            }
+            // Along the axes the step crosses: the far side lands on the near one; along the
+            // others (26-connected only) a neighbour may sit one voxel over.
+            let along = [d.x == 0, d.y == 0, d.z == 0];
+            let spread = if diagonal {
+                grow(&added, along, true)
+            } else {
+                added
+            };
+            let reached = spread.shifted(*d * -7);
+            if !reached.is_empty() {
+                queue.push_back((n.as_uvec3(), reached));
             }
         }
     }
     let mut out = VoxelSet::new();
-    for (b, m) in masks {
+    for (b, m) in filled {
         out.set_brick(b, m);
     }
     out
+}
+
+/// `m` and its voxels' neighbours inside the brick along the axes `along` says: one voxel
+/// either way on each (through faces), or with `diagonal` the whole 3 × 3 × 3 block over them.
+fn grow(m: &Mask, along: [bool; 3], diagonal: bool) -> Mask {
+    let axes = [IVec3::X, IVec3::Y, IVec3::Z];
+    if diagonal {
+        let mut out = *m;
+        for (a, on) in axes.iter().zip(along) {
+            if on {
+                out = out.or(&out.shifted(*a)).or(&out.shifted(-*a));
+            }
+        }
+        out
+    } else {
+        let mut out = *m;
+        for (a, on) in axes.iter().zip(along) {
+            if on {
+                out = out.or(&m.shifted(*a)).or(&m.shifted(-*a));
+            }
+        }
+        out
+    }
 }
 
 /// Every voxel of material `material`.

@@ -1001,6 +1001,56 @@ fn the_magic_wand_selects_with_a_click(s: &mut Session) {
     s.quiet();
 }
 
+/// The Extrude tool: U, a press on the terrain's top and a drag up grows its face region by
+/// the distance dragged (one step, undone exactly); Shift + click in attach mode fills the
+/// plane in front of the face.
+fn extrude_drags_a_face_and_shift_click_fills_a_plane(s: &mut Session) {
+    s.quiet();
+    let before = s.state();
+    s.key(KeyCode::KeyU, true);
+    s.key(KeyCode::KeyU, false);
+    s.quiet();
+    let at = s.on_the_terrain();
+    s.to(at);
+    s.frame();
+    s.left(true);
+    for k in 1..=6 {
+        s.to((at.0, at.1 - 12.0 * f64::from(k)));
+        s.frame();
+    }
+    assert_eq!(s.state(), before, "nothing changes before the release");
+    s.left(false);
+    s.quiet();
+    let label = |s: &Session| {
+        let doc = s.ed.document();
+        let d = doc.read().unwrap();
+        d.history.undo_steps().last().map(|st| st.label.clone())
+    };
+    assert_eq!(s.state().1, before.1 + 1, "one step");
+    assert_ne!(s.state().0, before.0);
+    assert!(label(s).is_some_and(|l| l.starts_with("Extrude the face at")));
+    s.ctrl(KeyCode::KeyZ);
+    s.quiet();
+    assert_eq!(s.state().0, before.0);
+    // Attach mode: Shift + click fills the plane in front of the clicked face.
+    s.key(KeyCode::KeyT, true);
+    s.key(KeyCode::KeyT, false);
+    s.to(at);
+    s.frame();
+    s.ed.input(Input::Modifiers(app::ui::input::Mods {
+        shift: true,
+        ..Default::default()
+    }));
+    s.left(true);
+    s.left(false);
+    s.ed.input(Input::Modifiers(Default::default()));
+    s.quiet();
+    assert!(label(s).is_some_and(|l| l.starts_with("Fill the plane at")));
+    s.ctrl(KeyCode::KeyZ);
+    s.quiet();
+    assert_eq!(s.state().0, before.0);
+}
+
 #[test]
 fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     let dir = window::scratch("editor-handlers");
@@ -1019,6 +1069,7 @@ fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     the_object_keys_and_menu_act_on_the_picked_object(&mut s);
     the_blender_key_map_is_chosen_in_the_shortcuts_window(&mut s);
     the_magic_wand_selects_with_a_click(&mut s);
+    extrude_drags_a_face_and_shift_click_fills_a_plane(&mut s);
     the_docks_leave_the_viewport_framing_fits_it_and_the_palette_paints(&mut s);
     without_a_dialog_save_as_and_open_ask_in_the_browser(&mut s, &dir);
     the_first_click_on_an_empty_scene_attaches_on_the_floor(&mut s, &dir);

@@ -482,3 +482,113 @@ fn terrain_bands_decide_the_surface_material() {
         .unwrap();
     assert_ne!(doc.scene.world.read().content_hash(), snowy);
 }
+
+/// Extrude (push-pull) and plane fill on a platform with a strip of another material: the
+/// region, the columns' materials, push-in, same-material regions, the plane's extent, the
+/// refusals; each one step, undone exactly.
+#[test]
+fn extrude_and_plane_fill_change_exactly_their_region() {
+    use app::scene::Scene;
+    use app::selection::SelectOp;
+    let mut doc = Document::new(
+        Scene::empty(brickmap::GridDims::new(4, 4, 4).unwrap(), 2).unwrap(),
+        History::default(),
+    );
+    doc.execute(Command::AddMaterial(MaterialSpec {
+        kind: KindSpec::Lambertian,
+        param: 0,
+        colour: 9,
+    }))
+    .unwrap();
+    let mut fill = |lo: [i32; 3], hi: [i32; 3], m: u8| {
+        doc.execute(Command::Select(SelectOp::Replace {
+            min: IVec3::from_array(lo),
+            max: IVec3::from_array(hi),
+        }))
+        .unwrap();
+        doc.execute(Command::FillSelection(m)).unwrap();
+        doc.execute(Command::Select(SelectOp::None)).unwrap();
+    };
+    // A platform 8 × 4 × 8, its top's first two rows (x 4..=5) of material 1.
+    fill([4, 2, 4], [11, 5, 11], 0);
+    fill([4, 5, 4], [5, 5, 11], 1);
+    let at = |doc: &Document, x, y, z| doc.scene.world.read().voxel(IVec3::new(x, y, z)).unwrap();
+    let before = state(&doc);
+    let steps = doc.history.undo_len();
+    let extrude = |distance, same_material| Command::Extrude {
+        voxel: IVec3::new(8, 5, 8),
+        normal: IVec3::Y,
+        distance,
+        same_material,
+    };
+    // Up by 3: every column of the top grows in its own material.
+    doc.execute(extrude(3, false)).unwrap();
+    for x in 0..32 {
+        for z in 0..32 {
+            for y in 6..=9 {
+                let on = (4..=11).contains(&x) && (4..=11).contains(&z) && y <= 8;
+                let want = on.then(|| if x <= 5 { 1 } else { 0 });
+                assert_eq!(at(&doc, x, y, z), want, "({x}, {y}, {z})");
+            }
+        }
+    }
+    assert_eq!(doc.history.undo_steps().last().unwrap().changed_voxels, 192);
+    doc.undo().unwrap();
+    assert_eq!(state(&doc), before);
+    // The same material only: the strip stays.
+    doc.execute(extrude(2, true)).unwrap();
+    assert_eq!(
+        doc.history.undo_steps().last().unwrap().changed_voxels,
+        6 * 8 * 2
+    );
+    assert_eq!(at(&doc, 5, 6, 8), None);
+    assert_eq!(at(&doc, 6, 7, 8), Some(0));
+    doc.undo().unwrap();
+    // Pushed in by 2: the top two layers of the region go.
+    doc.execute(extrude(-2, false)).unwrap();
+    for (y, want) in [(5, None), (4, None), (3, Some(0))] {
+        assert_eq!(at(&doc, 8, y, 8), want, "y {y}");
+    }
+    assert_eq!(doc.history.undo_steps().last().unwrap().changed_voxels, 128);
+    doc.undo().unwrap();
+    assert_eq!(state(&doc), before);
+    // Plane fill in front of the top: the whole empty layer y = 6 of the grid.
+    doc.execute(Command::PlaneFill {
+        voxel: IVec3::new(8, 5, 8),
+        normal: IVec3::Y,
+        material: 1,
+    })
+    .unwrap();
+    assert_eq!(
+        doc.history.undo_steps().last().unwrap().changed_voxels,
+        32 * 32
+    );
+    assert_eq!((at(&doc, 0, 6, 31), at(&doc, 0, 7, 31)), (Some(1), None));
+    doc.undo().unwrap();
+    assert_eq!(
+        (state(&doc), doc.history.undo_len()),
+        (before.clone(), steps)
+    );
+    // Refusals change nothing: no distance, a covered face, a normal that is no axis.
+    for c in [
+        extrude(0, false),
+        Command::Extrude {
+            voxel: IVec3::new(8, 3, 8),
+            normal: IVec3::X,
+            distance: 1,
+            same_material: false,
+        },
+        Command::Extrude {
+            voxel: IVec3::new(8, 5, 8),
+            normal: IVec3::new(1, 1, 0),
+            distance: 1,
+            same_material: false,
+        },
+    ] {
+        assert!(doc.execute(c.clone()).is_err(), "{c:?}");
+        assert_eq!(
+            (state(&doc), doc.history.undo_len()),
+            (before.clone(), steps)
+        );
+    }
+}

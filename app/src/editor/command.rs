@@ -23,71 +23,13 @@ use crate::scene::Scene;
 use crate::selection::{self, Clip, SelectOp, Selection, select};
 pub use brickmap::terrain::NoiseKind;
 use brickmap::terrain::NoiseTerrain;
-use brickmap::{EditOp, Material, MaterialKind, Mode, Shape};
+use brickmap::{EditOp, Mode, Shape};
 use glam::IVec3;
 use render::{Camera, RenderSettings, Sky, Sun};
 use serde::{Deserialize, Serialize};
 
-/// Terrain parameters a command carries (materials are added by the command).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct TerrainSpec {
-    /// Seed.
-    pub seed: u32,
-    /// Wavelength of the first octave in voxels.
-    pub scale: f64,
-    /// Octaves.
-    pub octaves: u32,
-    /// Surface height range.
-    pub height_range: (u32, u32),
-    /// Water level (0: none).
-    pub water_level: u32,
-    /// Noise function (Perlin when absent).
-    #[serde(default)]
-    pub noise: NoiseKind,
-    /// Where each material goes (the thesis scene's bands when absent).
-    #[serde(default)]
-    pub bands: Bands,
-}
+pub use super::specs::{Bands, KindSpec, MaterialSpec, TerrainSpec};
 
-/// The terrain's material bands: sand at the water's edge, grass over dirt, then rock, then
-/// snow over rock, by surface height; rock below the soil everywhere.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Bands {
-    /// Surfaces above this fraction of the height range are rock (0..=1).
-    pub rock_line: f64,
-    /// Surfaces above this fraction are snow (rock_line..=1).
-    pub snow_line: f64,
-    /// Voxels of grass and dirt over the rock.
-    pub soil_depth: u32,
-}
-
-impl Default for Bands {
-    fn default() -> Self {
-        Bands {
-            rock_line: 0.62,
-            snow_line: 0.86,
-            soil_depth: 3,
-        }
-    }
-}
-
-impl TerrainSpec {
-    /// The defaults for a grid of `size` voxels (New scene, the terrain panel): hills over
-    /// the lower five eighths of the height, water at a quarter.
-    pub fn for_size(size: (u32, u32, u32)) -> Self {
-        TerrainSpec {
-            seed: 2022,
-            scale: size.0.max(size.2) as f64 / 2.0,
-            octaves: 5,
-            height_range: (size.1 / 8, size.1 * 5 / 8),
-            water_level: size.1 / 4,
-            noise: NoiseKind::Perlin,
-            bands: Bands::default(),
-        }
-    }
-}
-
-/// Every change a document can undergo.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Command {
     /// A brush stroke.
@@ -97,6 +39,29 @@ pub enum Command {
         /// A solid voxel of the surface.
         start: IVec3,
         /// The new material.
+        material: u8,
+    },
+    /// Grow (a negative `distance`: push in) the connected exposed region of the face of
+    /// `voxel` facing `normal` along it, each column in its voxel's material
+    /// ([`super::extrude`]).
+    Extrude {
+        /// A voxel of the face.
+        voxel: IVec3,
+        /// The face's normal (one axis, ±1).
+        normal: IVec3,
+        /// Voxels to grow (negative: to push in).
+        distance: i32,
+        /// Only the region's voxels of `voxel`'s material.
+        same_material: bool,
+    },
+    /// Fill the empty connected region of the layer in front of the face of `voxel` facing
+    /// `normal` with a material.
+    PlaneFill {
+        /// The voxel whose face was clicked.
+        voxel: IVec3,
+        /// The face's normal (one axis, ±1).
+        normal: IVec3,
+        /// The material.
         material: u8,
     },
     /// Give every solid voxel of material `from` in the selection (without one: in the
@@ -181,72 +146,6 @@ pub enum Command {
     Object(super::objects::ObjectCommand),
 }
 
-/// A material in commands and scripts.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct MaterialSpec {
-    /// Type.
-    pub kind: KindSpec,
-    /// Parameter-table index.
-    pub param: u8,
-    /// Colour index.
-    pub colour: u8,
-}
-
-/// Material types in commands and scripts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum KindSpec {
-    /// Lambertian.
-    Lambertian,
-    /// Metal.
-    Metal,
-    /// Dielectric.
-    Dielectric,
-    /// Emissive.
-    Emissive,
-}
-
-impl From<KindSpec> for MaterialKind {
-    fn from(k: KindSpec) -> Self {
-        match k {
-            KindSpec::Lambertian => MaterialKind::Lambertian,
-            KindSpec::Metal => MaterialKind::Metal,
-            KindSpec::Dielectric => MaterialKind::Dielectric,
-            KindSpec::Emissive => MaterialKind::Emissive,
-        }
-    }
-}
-
-impl From<MaterialKind> for KindSpec {
-    fn from(k: MaterialKind) -> Self {
-        match k {
-            MaterialKind::Lambertian => KindSpec::Lambertian,
-            MaterialKind::Metal => KindSpec::Metal,
-            MaterialKind::Dielectric => KindSpec::Dielectric,
-            MaterialKind::Emissive => KindSpec::Emissive,
-        }
-    }
-}
-
-impl From<Material> for MaterialSpec {
-    fn from(m: Material) -> Self {
-        MaterialSpec {
-            kind: m.kind.into(),
-            param: m.param,
-            colour: m.colour,
-        }
-    }
-}
-
-impl From<MaterialSpec> for Material {
-    fn from(m: MaterialSpec) -> Self {
-        Material {
-            kind: m.kind.into(),
-            param: m.param,
-            colour: m.colour,
-        }
-    }
-}
-
 impl Command {
     /// A label for the history list.
     pub fn label(&self) -> String {
@@ -263,6 +162,12 @@ impl Command {
             Command::ReplaceMaterial { from, to } => {
                 format!("Replace material {from} by {to}")
             }
+            Command::Extrude {
+                voxel, distance, ..
+            } => format!("Extrude the face at {voxel} by {distance}"),
+            Command::PlaneFill {
+                voxel, material, ..
+            } => format!("Fill the plane at {voxel} with material {material}"),
             Command::AddMaterial(_) => "Add material".into(),
             Command::SetMaterial { index, .. } => format!("Edit material {index}"),
             Command::SetColour { index, .. } => format!("Edit colour {index}"),
@@ -418,6 +323,30 @@ impl Command {
                 let pasted = Selection::new(clip.region.translated(*at), voxels);
                 let pasted = (!pasted.voxels.is_empty()).then_some(pasted);
                 with_selection(scene, edit, pasted)?
+            }
+            Command::Extrude {
+                voxel,
+                normal,
+                distance,
+                same_material,
+            } => {
+                let edits = super::extrude::extrude_edits(
+                    scene,
+                    *voxel,
+                    *normal,
+                    *distance,
+                    *same_material,
+                )?;
+                apply_all(scene, vec![EditOp::Voxels(edits)])?
+            }
+            Command::PlaneFill {
+                voxel,
+                normal,
+                material,
+            } => {
+                world.materials().check(*material as u32)?;
+                let edits = super::extrude::plane_fill_edits(scene, *voxel, *normal, *material)?;
+                apply_all(scene, vec![EditOp::Voxels(edits)])?
             }
             Command::ReplaceMaterial { from, to } => {
                 world.materials().check(*to as u32)?;

@@ -4,6 +4,7 @@
 mod brush;
 pub mod command;
 mod error;
+mod extrude;
 mod fill;
 pub mod history;
 mod inverse;
@@ -12,6 +13,7 @@ pub mod objects;
 pub mod progress;
 mod replace;
 pub mod script;
+mod specs;
 
 pub use error::{EditError, Result};
 

@@ -72,6 +72,7 @@ impl Editor {
             }
             Action::SelectTool => self.settings.brush.tool = Tool::Select,
             Action::MeasureTool => self.settings.brush.tool = Tool::Measure,
+            Action::ExtrudeTool => self.settings.brush.tool = Tool::Extrude,
             Action::ToggleGrid => self.settings.grid = !self.settings.grid,
             Action::ArrangeTool => {
                 self.settings.brush.tool = if self.settings.brush.tool == Tool::Arrange {

@@ -218,6 +218,7 @@ fn tools(
         ui.selectable_value(&mut brush.tool, Tool::Select, "Select  M");
         ui.selectable_value(&mut brush.tool, Tool::Arrange, "Arrange  Tab");
         ui.selectable_value(&mut brush.tool, Tool::Measure, "Measure  K");
+        ui.selectable_value(&mut brush.tool, Tool::Extrude, "Extrude  U");
     });
     ui.horizontal_wrapped(|ui| {
         for (s, name) in [
@@ -246,7 +247,16 @@ fn tools(
     }
     if brush.mode == BrushMode::Attach && brush.shape != BrushShape::Box {
         ui.checkbox(&mut brush.follow_surface, "follow the surface")
-            .on_hover_text("on: each point of a stroke attaches to the face under the cursor; off: the stroke keeps to the first face's layer (shown while drawing)");
+            .on_hover_text(
+                "on: each point of a stroke attaches to the face under the cursor;
+ off: the stroke keeps to the first face's layer (shown while drawing)",
+            );
+    }
+    if brush.tool == Tool::Extrude {
+        ui.checkbox(
+            &mut brush.extrude_same_material,
+            "extrude: same material only",
+        );
     }
     ui.horizontal_wrapped(|ui| {
         ui.label("mirror");

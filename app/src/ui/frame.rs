@@ -379,6 +379,9 @@ impl Editor {
                 if let Some(b) = drawn_box.or(dragged.map(|(lo, hi, _)| (lo, hi))) {
                     preview::paint_box_size(&painter, cursor, b);
                 }
+                if let Some(d) = &self.pointer.extruding {
+                    super::extruding::paint_distance(&painter, cursor, d.distance);
+                }
                 // The voxels a click pastes, where it pastes them (the box is drawn above).
                 if let Some((at, _)) = paste {
                     self.preview

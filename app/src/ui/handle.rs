@@ -182,6 +182,9 @@ impl Editor {
                 self.motion.settling();
             }
             (false, MouseButton::Left) if self.pointer.selecting.is_some() => self.select_release(),
+            (false, MouseButton::Left) if self.pointer.extruding.is_some() => {
+                self.extrude_release()
+            }
             (false, MouseButton::Left)
                 if self.pointer.moving.is_some() || self.pointer.boxing.is_some() =>
             {
@@ -219,6 +222,7 @@ impl Editor {
         self.stroke_to_cursor();
         self.select_to_cursor();
         self.arrange_to_cursor();
+        self.extrude_to_cursor();
     }
 
     /// Left button down: a paste being placed goes down, the eyedropper (Alt), the selection
@@ -238,6 +242,10 @@ impl Editor {
         }
         if self.settings.brush.tool == Tool::Measure {
             self.measure_press();
+            return;
+        }
+        if self.settings.brush.tool == Tool::Extrude && !self.pointer.mods.alt {
+            self.extrude_press();
             return;
         }
         let (origin, dir) = self.cursor_ray();
@@ -260,6 +268,22 @@ impl Editor {
                 drop(doc);
                 self.execute(Command::FloodFill {
                     start: hit.voxel,
+                    material,
+                });
+            }
+            return;
+        }
+        if self.pointer.mods.shift
+            && self.settings.brush.mode == crate::editor::command::BrushMode::Attach
+        {
+            // Plane fill: the empty layer in front of the clicked face.
+            if let Some((hit, _)) = tools::pick(&view, origin, dir) {
+                let material = self.settings.brush.material;
+                drop(view);
+                drop(doc);
+                self.execute(Command::PlaneFill {
+                    voxel: hit.voxel,
+                    normal: hit.normal,
                     material,
                 });
             }

@@ -53,6 +53,14 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "Shift + click (paint)",
         "flood-fill the connected surface of that material",
     ),
+    (
+        "Shift + click (attach)",
+        "fill the empty plane in front of the clicked face (within the edited object)",
+    ),
+    (
+        "U, then drag a face",
+        "extrude: the face's connected region grows (or, dragged inward, sinks) by the distance dragged",
+    ),
     ("Esc (while drawing)", "cancel the stroke"),
     (
         "M",

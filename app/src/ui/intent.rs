@@ -64,6 +64,8 @@ pub enum Action {
     ToggleGrid,
     /// The ruler (Measure tool).
     MeasureTool,
+    /// The Extrude tool.
+    ExtrudeTool,
     /// Arrange mode (pick and move objects), or back to the brush.
     ArrangeTool,
     /// Select the whole grid.

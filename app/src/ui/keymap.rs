@@ -229,6 +229,7 @@ pub fn default_bindings() -> Vec<Binding> {
         ("M", Action::SelectTool),
         ("Tab", Action::ArrangeTool),
         ("K", Action::MeasureTool),
+        ("U", Action::ExtrudeTool),
         ("G", Action::ToggleGrid),
         ("Ctrl+A", Action::SelectAll),
         ("Ctrl+D", Action::SelectNone),

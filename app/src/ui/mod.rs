@@ -25,6 +25,7 @@ mod dialog_tools;
 mod document;
 mod editing;
 pub mod event;
+mod extruding;
 pub mod files;
 mod flight;
 mod frame;

@@ -45,6 +45,8 @@ pub(super) struct Pointer {
     pub(super) boxing: Option<(f64, f64)>,
     /// The ruler's ends (the Measure tool).
     pub(super) ruler: super::measure::Ruler,
+    /// A face being extruded (the Extrude tool).
+    pub(super) extruding: Option<super::extruding::ExtrudeDrag>,
 }
 
 impl Pointer {
@@ -54,12 +56,14 @@ impl Pointer {
             || self.selecting.is_some()
             || self.moving.is_some()
             || self.boxing.is_some()
-            || self.ruler.a.is_some();
+            || self.ruler.a.is_some()
+            || self.extruding.is_some();
         self.pasting = false;
         self.selecting = None;
         self.moving = None;
         self.boxing = None;
         self.ruler = Default::default();
+        self.extruding = None;
         was
     }
 

@@ -40,6 +40,8 @@ pub struct Brush {
     pub select_mode: SelectMode,
     /// The magic wand joins voxels through edges and corners too (26), not only faces (6).
     pub wand_diagonal: bool,
+    /// The Extrude tool takes only the clicked voxel's material.
+    pub extrude_same_material: bool,
 }
 
 /// How the selection tool selects.
@@ -66,6 +68,8 @@ pub enum Tool {
     Arrange,
     /// Measure between two voxels (the ruler).
     Measure,
+    /// Drag a face along its normal (extrude, push-pull).
+    Extrude,
 }
 
 impl Default for Brush {
@@ -84,6 +88,7 @@ impl Default for Brush {
             follow_surface: false,
             select_mode: SelectMode::Box,
             wand_diagonal: false,
+            extrude_same_material: false,
         }
     }
 }
