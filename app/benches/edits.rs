@@ -1,6 +1,7 @@
 //! CPU time of the editor's edits on the default scene (512 × 256 × 512 terrain): sphere
 //! strokes of radius 16 and 64 (attach and erase), and a 256 × 64 × 256 selection through the
-//! surface: select, copy, paste, move by a voxel and by a brick, delete, fill; and the brush
+//! surface: select, copy, paste, move by a voxel and by a brick, turn, mirror, delete, fill;
+//! the magic wand; and the brush
 //! preview (the voxels a click would change) for both spheres. Each timed run
 //! is one command as the editor executes it (world edit on the workers, inverse, history);
 //! the undo that puts the scene back between runs is not timed.
@@ -120,6 +121,58 @@ fn transform_selection(bencher: Bencher, how: &str) {
         _ => SelectionTransform::Flip(Axis::X),
     };
     run(bencher, selected(), Command::TransformSelection(t));
+}
+
+/// The magic wand from the terrain's top at (100, 100): the connected voxels of its
+/// material, and every connected solid voxel (the whole terrain).
+#[divan::bench(args = ["colour", "solid"], sample_count = 10, sample_size = 1)]
+fn magic_wand(bencher: Bencher, by: &str) {
+    let doc = document();
+    let top = {
+        let view = doc.scene.world.read();
+        (0..256)
+            .rev()
+            .map(|y| IVec3::new(100, y, 100))
+            .find(|v| view.voxel(*v).unwrap().is_some())
+            .unwrap()
+    };
+    let command = Command::Select(SelectOp::Wand {
+        start: top,
+        by_material: by == "colour",
+        diagonal: false,
+        how: app::wand::Combine::Replace,
+    });
+    let mut probe = document();
+    probe.execute(command.clone()).unwrap();
+    let n = probe
+        .scene
+        .selection
+        .as_ref()
+        .map_or(0, |s| s.voxels.count());
+    eprintln!("magic wand ({by}) from {top}: {n} voxels");
+    run(bencher, doc, command);
+}
+
+/// Extrude of a 256 × 256 face region by 8 voxels (a flat slab filling a 256 × 64 × 256
+/// grid's floor: 524,288 voxels added).
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn extrude_face(bencher: Bencher) {
+    let scene = app::scene::Scene::empty(brickmap::GridDims::new(32, 8, 32).unwrap(), 0).unwrap();
+    let mut doc = Document::new(scene, History::default());
+    doc.execute(Command::Select(SelectOp::Replace {
+        min: IVec3::ZERO,
+        max: IVec3::new(255, 3, 255),
+    }))
+    .unwrap();
+    doc.execute(Command::FillSelection(0)).unwrap();
+    doc.execute(Command::Select(SelectOp::None)).unwrap();
+    let command = Command::Extrude {
+        voxel: IVec3::new(128, 3, 128),
+        normal: IVec3::Y,
+        distance: 8,
+        same_material: false,
+    };
+    run(bencher, doc, command);
 }
 
 /// The selection split into an object of its own (3.4 M voxels), then the object moved (a
