@@ -527,7 +527,7 @@ fn extrude_and_plane_fill_change_exactly_their_region() {
         for z in 0..32 {
             for y in 6..=9 {
                 let on = (4..=11).contains(&x) && (4..=11).contains(&z) && y <= 8;
-                let want = on.then(|| if x <= 5 { 1 } else { 0 });
+                let want = on.then_some(if x <= 5 { 1 } else { 0 });
                 assert_eq!(at(&doc, x, y, z), want, "({x}, {y}, {z})");
             }
         }
