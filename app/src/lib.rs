@@ -12,6 +12,7 @@ pub mod scene;
 #[cfg(any(test, feature = "test-hooks"))]
 pub mod scratch;
 pub mod selection;
+pub mod selection_scale;
 pub mod selection_transform;
 pub mod soak;
 pub mod ui;

@@ -130,6 +130,8 @@ pub enum Command {
     PaintSelection(u8),
     /// Move the selected solid voxels (and the selection) by an offset.
     MoveSelection(IVec3),
+    /// Scale the selected solid voxels (and the selection) × 2 or × ½ about its centre.
+    ScaleSelection(crate::selection_scale::ScaleStep),
     /// Turn or mirror the selected solid voxels (and the selection) about its centre.
     TransformSelection(crate::selection_transform::SelectionTransform),
     /// Copy the selected solid voxels to the clipboard (no history step: nothing changes).
@@ -199,6 +201,7 @@ impl Command {
             Command::FillSelection(m) => format!("Fill selection with material {m}"),
             Command::PaintSelection(m) => format!("Paint selection with material {m}"),
             Command::MoveSelection(d) => format!("Move selection by {d}"),
+            Command::ScaleSelection(step) => format!("Scale selection ({step:?})"),
             Command::TransformSelection(t) => match t {
                 crate::selection_transform::SelectionTransform::Turn { axis, quarters } => {
                     format!("Turn selection {}° about {axis:?}", 90 * quarters)
@@ -283,17 +286,12 @@ impl Command {
                     Selection::new(selection.region.translated(*offset), world.dims().voxels());
                 with_selection(scene, edit, Some(moved))?
             }
-            Command::TransformSelection(t) => {
-                let selection = selected(scene)?.clone();
-                let alone = scene.active_world()?;
-                let source = alone.as_ref().unwrap_or(world);
-                let (edit, region) =
-                    crate::selection_transform::transform_edit(&source.read(), &selection, *t)
-                        .ok_or(super::error::EditError::NothingToDo("nothing is selected"))?;
-                let turned = Selection::new(region, world.dims().voxels());
-                let turned = (!turned.voxels.is_empty()).then_some(turned);
-                with_selection(scene, edit, turned)?
-            }
+            Command::ScaleSelection(step) => reshape(scene, |view, selection| {
+                crate::selection_scale::scale_edit(view, selection, *step)
+            })?,
+            Command::TransformSelection(t) => reshape(scene, |view, selection| {
+                crate::selection_transform::transform_edit(view, selection, *t)
+            })?,
             Command::Copy => {
                 let alone = scene.active_world()?;
                 let source = alone.as_ref().unwrap_or(world);
@@ -511,6 +509,22 @@ fn selected(scene: &Scene) -> Result<&Selection> {
 fn selection_edit(scene: &Scene, mode: Mode) -> Result<Applied> {
     let shape = Shape::Set(selected(scene)?.voxels.clone());
     apply_all(scene, vec![EditOp::Shape { shape, mode }])
+}
+
+/// A turn, mirror or scale of the selection: `make` gives the edit and the region from the
+/// edited object's voxels; the region's voxels become the selection.
+fn reshape(
+    scene: &mut Scene,
+    make: impl FnOnce(&brickmap::WorldView<'_>, &Selection) -> Option<(EditOp, selection::Region)>,
+) -> Result<Applied> {
+    let selection = selected(scene)?.clone();
+    let alone = scene.active_world()?;
+    let source = alone.as_ref().unwrap_or(&scene.world);
+    let (edit, region) = make(&source.read(), &selection)
+        .ok_or(super::error::EditError::NothingToDo("nothing is selected"))?;
+    let next = Selection::new(region, scene.world.dims().voxels());
+    let next = (!next.voxels.is_empty()).then_some(next);
+    with_selection(scene, edit, next)
 }
 
 /// Applies a voxel edit and then makes `next` the selection; the inverse puts both back.

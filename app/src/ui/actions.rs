@@ -85,6 +85,12 @@ impl Editor {
             Action::SelectAll => self.select(SelectOp::All),
             Action::SelectNone => self.select(SelectOp::None),
             Action::InvertSelection => self.select(SelectOp::Invert),
+            Action::DoubleSelection => self.execute(Command::ScaleSelection(
+                crate::selection_scale::ScaleStep::Double,
+            )),
+            Action::HalveSelection => self.execute(Command::ScaleSelection(
+                crate::selection_scale::ScaleStep::Halve,
+            )),
             Action::GrowSelection => self.select(SelectOp::Grow),
             Action::ShrinkSelection => self.select(SelectOp::Shrink),
             Action::SelectMaterial => self.select(SelectOp::Material {

@@ -72,6 +72,10 @@ pub enum Action {
     SelectAll,
     /// Select nothing.
     SelectNone,
+    /// Scale the selection's voxels × 2 about its centre.
+    DoubleSelection,
+    /// Scale them × ½ (the majority of each 2 × 2 × 2).
+    HalveSelection,
     /// Select what is not selected.
     InvertSelection,
     /// One voxel more on every side of the selection.

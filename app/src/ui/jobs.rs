@@ -224,6 +224,7 @@ impl Landing {
             | Command::PaintSelection(_)
             | Command::MoveSelection(_)
             | Command::TransformSelection(_)
+            | Command::ScaleSelection(_)
             | Command::Cut
             | Command::Paste { .. } => Some(Landing::Changed),
             _ => None,

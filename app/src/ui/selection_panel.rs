@@ -144,6 +144,8 @@ pub(super) fn selection(
                 ("mirror X", Action::Flip(X)),
                 ("Y", Action::Flip(Y)),
                 ("Z", Action::Flip(Z)),
+                ("×2", Action::DoubleSelection),
+                ("×½", Action::HalveSelection),
             ] {
                 let tip = "about the selection's centre: Alt + X / Y / Z (Shift: back), mirror: Ctrl + Alt";
                 if ui.button(name).on_hover_text(tip).clicked() {
