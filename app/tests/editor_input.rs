@@ -578,6 +578,46 @@ fn objects_are_arranged_in_the_viewport_and_the_objects_window_and_edited() {
     assert_eq!(hash(&work), hash(&replayed.join("work.ron")));
 }
 
+/// The modelling tools by mouse and keys: U and a drag up a face extrudes it; M, "wand:
+/// colour" and a click select the connected voxels of a material; Alt + Y turns them about
+/// their centre. The recorded session replays headlessly to the saved project.
+#[test]
+fn a_face_is_extruded_a_wand_selects_and_the_selection_turns() {
+    let Some(x) = tools_ready() else { return };
+    let dir = scratch("modelling");
+    let (work, session) = (dir.join("work.ron"), dir.join("session.ron"));
+    let Some(mut s) = Session::recorded(&x, &dir, "960x540") else {
+        return;
+    };
+    s.key("u", "KeyU", "input key Code(KeyU) down");
+    let up: Vec<(i32, i32)> = (0..=6).map(|k| (480, 300 - 8 * k)).collect();
+    s.drag(&up, Some("edited command Extrude the face at"));
+    s.key("m", "KeyM", "input key Code(KeyM) down");
+    let wand = s.widget("wand: colour");
+    s.click(wand);
+    s.click((480, 340));
+    s.report.wait("the wand", |l| {
+        l.starts_with("edited command Magic wand at")
+    });
+    s.key(
+        "alt+y",
+        "KeyY",
+        "edited command Turn selection 90° about Y: ok",
+    );
+    s.key("ctrl+s", "KeyS", "saved ");
+    let out = s.quit();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "the editor failed: {stderr}");
+    assert!(!stderr.contains("vulkan "), "validation messages: {stderr}");
+    let text = std::fs::read_to_string(&session).expect("the session was recorded");
+    for what in ["Extrude(", "Wand(", "TransformSelection("] {
+        assert!(text.contains(what), "{what} missing:\n{text}");
+    }
+    let replayed = dir.join("replayed");
+    window::replay(env!("CARGO_BIN_EXE_voxbrick"), &session, &replayed);
+    assert_eq!(hash(&work), hash(&replayed.join("work.ron")));
+}
+
 #[test]
 fn a_killed_editor_offers_its_autosave_and_recovering_gives_its_content() {
     let Some(x) = tools_ready() else { return };
