@@ -199,6 +199,14 @@ impl Session {
     }
 
     /// Quits with Ctrl+Q (sent again if the key went missing) and returns the output.
+    /// Quits and checks the editor ended well, without validation messages.
+    fn quit_cleanly(self) {
+        let out = self.quit();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "the editor failed: {stderr}");
+        assert!(!stderr.contains("vulkan "), "validation messages: {stderr}");
+    }
+
     fn quit(mut self) -> std::process::Output {
         let started = Instant::now();
         let mut asked = None::<Instant>;
@@ -533,10 +541,7 @@ fn objects_are_arranged_in_the_viewport_and_the_objects_window_and_edited() {
         Some("edited stroke end"),
     );
     s.key("ctrl+s", "KeyS", "saved ");
-    let out = s.quit();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "the editor failed: {stderr}");
-    assert!(!stderr.contains("vulkan "), "validation messages: {stderr}");
+    s.quit_cleanly();
     let text = std::fs::read_to_string(&session).expect("the session was recorded");
     for what in ["Turn(", "Duplicate(", "Reparent(", "Stroke("] {
         assert!(text.contains(what), "{what} missing:\n{text}");
@@ -605,10 +610,7 @@ fn a_face_is_extruded_a_wand_selects_and_the_selection_turns() {
         "edited command Turn selection 90° about Y: ok",
     );
     s.key("ctrl+s", "KeyS", "saved ");
-    let out = s.quit();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "the editor failed: {stderr}");
-    assert!(!stderr.contains("vulkan "), "validation messages: {stderr}");
+    s.quit_cleanly();
     let text = std::fs::read_to_string(&session).expect("the session was recorded");
     for what in ["Extrude(", "Wand(", "TransformSelection("] {
         assert!(text.contains(what), "{what} missing:\n{text}");
