@@ -900,7 +900,14 @@ fn the_object_keys_and_menu_act_on_the_picked_object(s: &mut Session) {
     s.click_on("Object", MouseButton::Left);
     s.click_on("Dim the objects not edited", MouseButton::Left);
     assert!(!s.ed.settings().dim_others);
-    for _ in 0..5 {
+    // Fit canvas to content: the edited object's model shrinks to its voxels.
+    let size = |s: &Session| s.ed.document().read().unwrap().scene.active_size();
+    let was = size(s);
+    s.click_on("Object", MouseButton::Left);
+    s.click_on("Fit canvas to content", MouseButton::Left);
+    s.quiet();
+    assert_ne!(size(s), was, "fitted to its voxels");
+    for _ in 0..6 {
         s.ctrl(KeyCode::KeyZ);
         s.quiet();
     }

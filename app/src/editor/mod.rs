@@ -2,6 +2,7 @@
 //! the commands that change it. The interactive editor and script replay drive it alike.
 
 mod brush;
+pub mod canvas;
 pub mod command;
 mod error;
 mod extrude;

@@ -136,6 +136,13 @@ pub enum ObjectCommand {
         /// Where its lowest corner goes.
         at: IVec3,
     },
+    /// Changes an object's model's canvas ([`super::canvas`]): fit, crop or resize.
+    Canvas {
+        /// The object.
+        node: NodeId,
+        /// What to do.
+        how: super::canvas::Canvas,
+    },
     /// Shows or hides a layer.
     ShowLayer {
         /// The layer.
@@ -181,6 +188,7 @@ impl ObjectCommand {
             Self::NewObject { name, size, .. } => {
                 format!("New object {name:?} {}×{}×{}", size.x, size.y, size.z)
             }
+            Self::Canvas { node, how } => format!("Canvas of #{}: {how:?}", node.0),
             Self::ShowLayer { layer, visible } => format!(
                 "{} layer {}",
                 if *visible { "Show" } else { "Hide" },
@@ -287,6 +295,7 @@ impl ObjectCommand {
             Self::Duplicate { node, offset } => arrange::duplicate(&objects, *node, *offset)?,
             Self::Instance { node, offset } => arrange::instance(&objects, *node, *offset)?,
             Self::MakeUnique(node) => arrange::make_unique(&objects, *node)?,
+            Self::Canvas { node, how } => super::canvas::canvas_op(&objects, *node, *how, &table)?,
             Self::Delete(nodes) => arrange::delete(&objects, nodes)?,
             Self::Group { nodes, name } => arrange::group(&objects, nodes, name)?,
             Self::Ungroup(node) => arrange::ungroup(&objects, *node)?,

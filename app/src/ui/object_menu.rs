@@ -116,12 +116,86 @@ impl Editor {
     }
 }
 
+/// The Resize canvas fields: for which object, its new size, the anchor (per axis −1 low,
+/// 0 centre, 1 high).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CanvasForm {
+    node: Option<NodeId>,
+    size: [i32; 3],
+    anchor: [i32; 3],
+}
+
+/// The canvas entries: fit, crop to the selection, resize (on the object brushes edit).
+fn canvas(ui: &mut egui::Ui, doc: &Document, form: &mut CanvasForm, out: &mut Vec<UiEvent>) {
+    use crate::editor::canvas::Canvas;
+    let Some(node) = doc.scene.active() else {
+        ui.label("canvas: no object to edit");
+        return;
+    };
+    let send = |out: &mut Vec<UiEvent>, how| {
+        out.push(UiEvent::Objects(ObjectCommand::Canvas { node, how }));
+    };
+    if ui.button("Fit canvas to content").clicked() {
+        send(out, Canvas::Fit);
+    }
+    let selected = doc.scene.selection.as_ref().and_then(|s| s.voxels.bounds());
+    if ui
+        .add_enabled(
+            selected.is_some(),
+            egui::Button::new("Crop canvas to the selection"),
+        )
+        .clicked()
+        && let Some((min, max)) = selected
+    {
+        send(out, Canvas::Crop { min, max });
+    }
+    if form.node != Some(node) {
+        let size = doc.scene.active_size().unwrap_or(IVec3::ONE);
+        *form = CanvasForm {
+            node: Some(node),
+            size: size.to_array(),
+            anchor: [0, -1, 0],
+        };
+    }
+    ui.menu_button("Resize canvas", |ui| {
+        ui.horizontal(|ui| {
+            ui.label("size");
+            for v in &mut form.size {
+                ui.add(egui::DragValue::new(v).range(1..=4096));
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.label("keep at");
+            for (a, axis) in form.anchor.iter_mut().zip(["x", "y", "z"]) {
+                let name = match *a {
+                    -1 => format!("{axis} low"),
+                    0 => format!("{axis} centre"),
+                    _ => format!("{axis} high"),
+                };
+                if ui.button(name).clicked() {
+                    *a = if *a == 1 { -1 } else { *a + 1 };
+                }
+            }
+        });
+        if ui.button("Resize").clicked() {
+            send(
+                out,
+                Canvas::Resize {
+                    size: IVec3::from_array(form.size),
+                    anchor: IVec3::from_array(form.anchor),
+                },
+            );
+        }
+    });
+}
+
 /// Draws the Object menu's entries (`dim_others`: the view setting).
 pub fn menu(
     ui: &mut egui::Ui,
     doc: &Document,
     tool: Tool,
     dim_others: &mut bool,
+    form: &mut CanvasForm,
     out: &mut Vec<UiEvent>,
 ) {
     let mut arrange = tool == Tool::Arrange;
@@ -136,6 +210,8 @@ pub fn menu(
             out.push(UiEvent::Action(action));
         }
     }
+    ui.separator();
+    canvas(ui, doc, form, out);
     ui.separator();
     ui.checkbox(dim_others, "Dim the objects not edited")
         .on_hover_text(

@@ -110,6 +110,8 @@ pub struct PanelState {
     pub outliner: super::outliner::OutlinerState,
     /// The key map's bindings (chord, action) for the shortcut list.
     pub keys: Vec<(String, String)>,
+    /// The Object menu's Resize canvas fields.
+    pub canvas: super::object_menu::CanvasForm,
     /// The viewport's rectangle: what the menu bar, the status line and the docked panels
     /// leave of the window, in points (last frame).
     pub viewport: Option<egui::Rect>,
@@ -258,7 +260,14 @@ pub fn draw(
                 }
             });
             ui.menu_button("Object", |ui| {
-                super::object_menu::menu(ui, doc, view.brush.tool, &mut view.dim_others, &mut out)
+                super::object_menu::menu(
+                    ui,
+                    doc,
+                    view.brush.tool,
+                    &mut view.dim_others,
+                    &mut state.canvas,
+                    &mut out,
+                )
             });
             if !state.busy.is_empty() {
                 ui.separator();
