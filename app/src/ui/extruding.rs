@@ -79,10 +79,5 @@ impl Editor {
 /// "+3 voxels" beside the cursor while dragging.
 pub fn paint_distance(painter: &egui::Painter, cursor: egui::Pos2, distance: i32) {
     let text = format!("{distance:+} voxels");
-    let at = cursor + egui::vec2(16.0, 12.0);
-    let font = egui::FontId::proportional(13.0);
-    let galley = painter.layout_no_wrap(text, font, egui::Color32::WHITE);
-    let back = egui::Rect::from_min_size(at, galley.size()).expand(3.0);
-    painter.rect_filled(back, 3.0, egui::Color32::from_black_alpha(170));
-    painter.galley(at, galley, egui::Color32::WHITE);
+    super::preview::paint_label(painter, cursor + egui::vec2(16.0, 12.0), text, false);
 }

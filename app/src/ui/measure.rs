@@ -64,12 +64,12 @@ pub fn paint(painter: &egui::Painter, view: &ViewCamera, rect: egui::Rect, (a, b
     for end in [p, q] {
         painter.circle_filled(end, 3.5, colour);
     }
-    let font = egui::FontId::proportional(13.0);
-    let galley = painter.layout_no_wrap(text(a, b), font, egui::Color32::WHITE);
-    let at = p.lerp(q, 0.5) + egui::vec2(8.0, -8.0 - galley.size().y);
-    let back = egui::Rect::from_min_size(at, galley.size()).expand(3.0);
-    painter.rect_filled(back, 3.0, egui::Color32::from_black_alpha(170));
-    painter.galley(at, galley, egui::Color32::WHITE);
+    super::preview::paint_label(
+        painter,
+        p.lerp(q, 0.5) + egui::vec2(8.0, -8.0),
+        text(a, b),
+        true,
+    );
 }
 
 /// "voxel [x, y, z] +y face" for a hit.

@@ -313,10 +313,24 @@ pub fn paint_layer(
 /// The size of a box being dragged (a box stroke, a selection box), in voxels along x, y
 /// and z, written beside the cursor: what the drag will make before the release.
 pub fn paint_box_size(painter: &egui::Painter, cursor: egui::Pos2, (lo, hi): (IVec3, IVec3)) {
-    let text = box_size_text(lo, hi);
-    let at = cursor + egui::vec2(16.0, 12.0);
+    paint_label(
+        painter,
+        cursor + egui::vec2(16.0, 12.0),
+        box_size_text(lo, hi),
+        false,
+    );
+}
+
+/// White text on a dark plate with its top-left corner at `at` (with `above`, its
+/// bottom-left): what a drag or the ruler says in the viewport.
+pub fn paint_label(painter: &egui::Painter, at: egui::Pos2, text: String, above: bool) {
     let font = egui::FontId::proportional(13.0);
     let galley = painter.layout_no_wrap(text, font, egui::Color32::WHITE);
+    let at = if above {
+        at - egui::vec2(0.0, galley.size().y)
+    } else {
+        at
+    };
     let back = egui::Rect::from_min_size(at, galley.size()).expand(3.0);
     painter.rect_filled(back, 3.0, egui::Color32::from_black_alpha(170));
     painter.galley(at, galley, egui::Color32::WHITE);
