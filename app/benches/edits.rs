@@ -67,6 +67,7 @@ fn sphere(mode: BrushMode, radius: f64) -> Command {
         points: vec![DVec3::new(256.0, 77.0, 256.0)],
         axis: Default::default(),
         in_selection: false,
+        paint: Default::default(),
     })
 }
 

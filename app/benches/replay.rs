@@ -52,6 +52,7 @@ fn session() -> Script {
             points,
             axis: Default::default(),
             in_selection: false,
+            paint: Default::default(),
         })));
         if i % 20 == 19 {
             steps.extend([Step::Undo, Step::Undo, Step::Undo, Step::Redo, Step::Redo]);

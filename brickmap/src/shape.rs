@@ -298,6 +298,33 @@ impl Shape {
         }
     }
 
+    /// The inside voxels that lie in a grid of `voxels` voxels, as a set (brick by brick from
+    /// the coverage and the mask).
+    pub fn voxels(&self, voxels: IVec3) -> VoxelSet {
+        let mut set = VoxelSet::new();
+        let (lo, hi) = self.voxel_bounds();
+        let (lo, hi) = (lo.max(IVec3::ZERO), hi.min(voxels - 1));
+        if lo.cmpgt(hi).any() {
+            return set;
+        }
+        let (blo, bhi) = (lo / 8, hi / 8);
+        for x in blo.x..=bhi.x {
+            for y in blo.y..=bhi.y {
+                for z in blo.z..=bhi.z {
+                    let b = IVec3::new(x, y, z);
+                    let inside = match self.coverage(b * 8) {
+                        Coverage::Outside => continue,
+                        Coverage::Inside => Mask::FULL,
+                        Coverage::Partial => self.mask(b * 8),
+                    };
+                    let grid = crate::voxel_set::box_mask(b * 8, IVec3::ZERO, voxels - 1);
+                    set.set_brick(b.as_uvec3(), inside.and(&grid));
+                }
+            }
+        }
+        set
+    }
+
     /// The voxels of the brick at `min` that are inside, as a mask.
     pub fn mask(&self, min: IVec3) -> Mask {
         let mut m = Mask::EMPTY;
@@ -441,6 +468,28 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    #[test]
+    fn a_shapes_voxel_set_is_its_inside_voxels_within_the_grid() {
+        let grid = IVec3::new(19, 14, 24);
+        for shape in shapes() {
+            let set = shape.voxels(grid);
+            let mut n = 0;
+            for x in -2..grid.x + 2 {
+                for y in -2..grid.y + 2 {
+                    for z in -2..grid.z + 2 {
+                        let v = IVec3::new(x, y, z);
+                        let inside = v.cmpge(IVec3::ZERO).all() && v.cmplt(grid).all();
+                        let want = inside && shape.contains(v);
+                        assert_eq!(set.contains(v), want, "{shape:?} at {v}");
+                        n += want as u64;
+                    }
+                }
+            }
+            assert!(n > 0, "{shape:?} has voxels in the grid");
+            assert_eq!(set.count(), n);
         }
     }
 

@@ -40,6 +40,7 @@ fn stroke(mode: BrushMode, shape: BrushShape, size: f64, points: &[[f64; 3]]) ->
         points: points.iter().map(|p| DVec3::from_array(*p)).collect(),
         axis: Default::default(),
         in_selection: false,
+        paint: Default::default(),
     })
 }
 
@@ -100,6 +101,7 @@ fn every_command() -> Vec<Command> {
             points: vec![DVec3::new(20.0, 50.0, 30.0)],
             axis: Default::default(),
             in_selection: false,
+            paint: Default::default(),
         }),
         Command::FloodFill {
             start: IVec3::new(64, 0, 0),

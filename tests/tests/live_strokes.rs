@@ -47,6 +47,7 @@ fn stroke(mode: BrushMode, shape: BrushShape, mirror: bool) -> Stroke {
         points: drag(),
         axis: Default::default(),
         in_selection: false,
+        paint: Default::default(),
     }
 }
 
@@ -237,4 +238,162 @@ fn the_preview_is_exactly_what_the_click_then_changes() {
             assert_eq!(preview, changed, "{what}");
         }
     }
+}
+
+/// The colour modes (gradient, random, darken, brighten): live == at once (a gradient at once
+/// is its first and last points), undo and redo exact, and every voxel of the grid against a
+/// voxel-by-voxel reference: covered = within the capsule's radius of the stroke (the voxel
+/// centre's distance, computed here), material by the mode's rule.
+#[test]
+fn colour_modes_match_a_voxel_by_voxel_reference_live_and_at_once() {
+    use app::editor::command::PaintMode;
+    let modes = [
+        (BrushMode::Paint, PaintMode::Gradient { to: 1 }),
+        (BrushMode::Attach, PaintMode::Gradient { to: 6 }),
+        (
+            BrushMode::Paint,
+            PaintMode::Random {
+                among: vec![1, 3, 5],
+                seed: 11,
+            },
+        ),
+        (
+            BrushMode::Attach,
+            PaintMode::Random {
+                among: vec![2, 6],
+                seed: 3,
+            },
+        ),
+        (BrushMode::Paint, PaintMode::Darken),
+        (BrushMode::Paint, PaintMode::Brighten),
+    ];
+    // Back and forth over the same voxels: darken must change each once.
+    let points: Vec<DVec3> = [30.0, 50.0, 36.0, 56.0, 40.0]
+        .iter()
+        .enumerate()
+        .map(|(i, x)| DVec3::new(*x, 33.0 + i as f64 * 0.5, 44.0 + i as f64))
+        .collect();
+    let dims = document().scene.world.dims().voxels();
+    for (mode, paint) in modes {
+        let what = format!("{mode:?} {paint:?}");
+        let s = Stroke {
+            points: points.clone(),
+            size: 4.5,
+            material: 4,
+            paint: paint.clone(),
+            ..stroke(mode, BrushShape::Sphere, false)
+        };
+        let mut live = document();
+        let before = hash(&live);
+        let table = live.scene.world.materials().clone();
+        let darker = app::editor::command::neighbours(&table, false);
+        let brighter = app::editor::command::neighbours(&table, true);
+        let old: Vec<Option<u8>> = {
+            let view = live.scene.world.read();
+            every_voxel(dims).map(|v| view.voxel(v).unwrap()).collect()
+        };
+        live.begin_stroke(Stroke {
+            points: points[..1].to_vec(),
+            ..s.clone()
+        })
+        .unwrap();
+        for p in &points[1..] {
+            live.extend_stroke(std::slice::from_ref(p)).unwrap();
+        }
+        let done = live.end_stroke().unwrap().expect("a stroke was open");
+        assert!(done.changed_voxels > 0, "{what}");
+        let after = hash(&live);
+        assert_ne!(after, before, "{what}");
+        // At once: a gradient's recorded stroke is its first and last points.
+        let mut at_once = document();
+        let whole = if matches!(paint, PaintMode::Gradient { .. }) {
+            Stroke {
+                points: vec![points[0], points[points.len() - 1]],
+                ..s.clone()
+            }
+        } else {
+            s.clone()
+        };
+        at_once.execute(Command::Stroke(whole.clone())).unwrap();
+        assert_eq!(hash(&at_once), after, "{what}: live = at once");
+        // The reference, voxel by voxel.
+        let view = live.scene.world.read();
+        let r2 = s.size * s.size;
+        let (a, b) = (whole.points[0], whole.points[whole.points.len() - 1]);
+        let mut covered_count = 0;
+        for (v, was) in every_voxel(dims).zip(&old) {
+            let c = v.as_dvec3() + 0.5;
+            let covered = whole.points.windows(2).any(|w| {
+                let ab = w[1] - w[0];
+                let t = ((c - w[0]).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
+                (c - (w[0] + ab * t)).length_squared() <= r2
+            });
+            covered_count += covered as u32;
+            let want = match (&paint, covered, mode, *was) {
+                (_, false, _, was) => was,
+                (_, true, BrushMode::Paint, None) => None,
+                (PaintMode::Gradient { to }, true, _, _) => {
+                    let t = ((c - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+                    Some((4.0 + (t * (*to as f64 - 4.0)).round()) as u8)
+                }
+                (PaintMode::Random { among, seed }, true, _, _) => {
+                    Some(among[app::editor::command::paint_hash(v, *seed) as usize % among.len()])
+                }
+                (PaintMode::Darken, true, _, Some(m)) => Some(darker[m as usize]),
+                (PaintMode::Brighten, true, _, Some(m)) => Some(brighter[m as usize]),
+                other => panic!("{other:?}"),
+            };
+            assert_eq!(view.voxel(v).unwrap(), want, "{what} at {v}");
+        }
+        assert!(covered_count > 500, "{what}: {covered_count}");
+        drop(view);
+        live.undo().unwrap();
+        assert_eq!(hash(&live), before, "{what}: undo");
+        live.redo().unwrap();
+        assert_eq!(hash(&live), after, "{what}: redo");
+    }
+}
+
+#[test]
+fn colour_modes_that_cannot_apply_are_refused_and_change_nothing() {
+    use app::editor::command::PaintMode;
+    let mut doc = document();
+    let before = hash(&doc);
+    for (mode, paint) in [
+        (BrushMode::Attach, PaintMode::Darken),
+        (BrushMode::Erase, PaintMode::Brighten),
+        (
+            BrushMode::Paint,
+            PaintMode::Random {
+                among: vec![],
+                seed: 0,
+            },
+        ),
+        (
+            BrushMode::Paint,
+            PaintMode::Random {
+                among: vec![1, 240],
+                seed: 0,
+            },
+        ),
+        (BrushMode::Attach, PaintMode::Gradient { to: 250 }),
+    ] {
+        let s = Stroke {
+            paint: paint.clone(),
+            ..stroke(mode, BrushShape::Sphere, false)
+        };
+        assert!(doc.begin_stroke(s.clone()).is_err(), "{mode:?} {paint:?}");
+        assert!(
+            doc.execute(Command::Stroke(s)).is_err(),
+            "{mode:?} {paint:?}"
+        );
+        assert_eq!(hash(&doc), before);
+        assert_eq!(doc.history.undo_len(), 0);
+    }
+}
+
+fn every_voxel(dims: glam::IVec3) -> impl Iterator<Item = glam::IVec3> {
+    (0..dims.x).flat_map(move |x| {
+        (0..dims.y).flat_map(move |y| (0..dims.z).map(move |z| glam::IVec3::new(x, y, z)))
+    })
 }

@@ -94,6 +94,7 @@ fn sphere(at: DVec3, mode: BrushMode) -> Command {
         points: vec![at],
         axis: BrushAxis::Y,
         in_selection: false,
+        paint: Default::default(),
     })
 }
 

@@ -192,6 +192,7 @@ fn a_recorded_session_replays_to_the_same_content() {
             points: vec![glam::DVec3::new(x, 16.0, 20.0)],
             axis: Default::default(),
             in_selection: false,
+            paint: Default::default(),
         })
     };
     doc.execute(stroke(20.0, BrushMode::Attach)).unwrap();

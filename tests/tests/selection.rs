@@ -74,6 +74,7 @@ fn sphere(mode: BrushMode, centre: DVec3, radius: f64, in_selection: bool) -> Co
         points: vec![centre],
         axis: Default::default(),
         in_selection,
+        paint: Default::default(),
     })
 }
 
@@ -678,6 +679,7 @@ fn a_cylinder_follows_its_axis() {
             points: vec![DVec3::splat(32.0)],
             axis,
             in_selection: false,
+            paint: Default::default(),
         }))
         .unwrap();
         let view = doc.scene.world.read();

@@ -160,6 +160,7 @@ fn two_far_points_give_exactly_the_swept_voxels_as_one_connected_piece() {
                     points: vec![a, b],
                     axis: Axis::Z,
                     in_selection: false,
+                    paint: Default::default(),
                 };
                 let mut doc = document(mode);
                 let before = voxels(&doc);
@@ -225,6 +226,7 @@ fn a_live_stroke_of_far_apart_segments_is_connected_and_replays_to_its_hash() {
             points: points[..1].to_vec(),
             axis: Axis::Y,
             in_selection: false,
+            paint: Default::default(),
         };
         let mut live = document(BrushMode::Attach);
         live.begin_stroke(stroke.clone()).unwrap();

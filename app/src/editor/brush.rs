@@ -8,6 +8,8 @@
 //! first and last points.
 
 use super::error::{EditError, Result, invalid};
+pub use super::paint::PaintMode;
+use super::paint::{Image, coloured_edits};
 use crate::selection::Selection;
 use brickmap::{EditOp, Mode, Shape};
 use glam::{DVec3, IVec3};
@@ -99,6 +101,10 @@ pub struct Stroke {
     /// Change only selected voxels (when something is selected).
     #[serde(default)]
     pub in_selection: bool,
+    /// How the covered voxels are coloured (the brush's material, a gradient, random
+    /// entries, darker or brighter neighbours).
+    #[serde(default)]
+    pub paint: PaintMode,
 }
 
 /// The most stamps one segment of a stroke takes (points farther apart than this many voxels
@@ -163,8 +169,58 @@ fn swept_boxes(stamps: &[DVec3], h: i32) -> Shape {
 }
 
 /// The world edits of a stroke, mirror images included, validated before any is applied;
-/// a stroke `in_selection` changes only voxels of `selection` (all, when none).
-pub fn stroke_edits(s: &Stroke, selection: Option<&Selection>) -> Result<Vec<EditOp>> {
+/// a stroke `in_selection` changes only voxels of `selection` (all, when none). A stroke
+/// with a colour mode ([`PaintMode`]) reads `view` (its grid; darken and brighten its
+/// materials) and leaves out the voxels of `done` (a live stroke's earlier segments).
+pub fn stroke_edits(
+    s: &Stroke,
+    selection: Option<&Selection>,
+    view: &brickmap::WorldView<'_>,
+    done: Option<&brickmap::VoxelSet>,
+) -> Result<Vec<EditOp>> {
+    let images = image_shapes(s)?;
+    let within = selection.filter(|_| s.in_selection);
+    if s.paint != PaintMode::Solid {
+        let dims = view.dims().voxels();
+        let images = images
+            .into_iter()
+            .map(|(points, shapes)| {
+                let mut voxels = brickmap::VoxelSet::new();
+                for shape in shapes {
+                    voxels = voxels.union(&shape.voxels(dims));
+                }
+                if let Some(sel) = within {
+                    voxels = voxels.intersection(&sel.voxels);
+                }
+                Image { points, voxels }
+            })
+            .collect();
+        return coloured_edits(&s.paint, s.mode, s.material, images, view, done);
+    }
+    let mode = match s.mode {
+        BrushMode::Attach => Mode::Add(s.material),
+        BrushMode::Erase => Mode::Remove,
+        BrushMode::Paint => Mode::Paint(s.material),
+    };
+    let mut edits = Vec::new();
+    for (_, shapes) in images {
+        for shape in shapes {
+            let shape = match within {
+                Some(sel) => Shape::Within {
+                    shape: Box::new(shape),
+                    set: sel.voxels.clone(),
+                },
+                None => shape,
+            };
+            edits.push(EditOp::Shape { shape, mode });
+        }
+    }
+    Ok(edits)
+}
+
+/// The brush's shapes in each mirror image of the stroke (up to 8), with the image's points;
+/// every shape validated.
+fn image_shapes(s: &Stroke) -> Result<Vec<(Vec<DVec3>, Vec<Shape>)>> {
     if s.points.is_empty() {
         return Err(invalid("a stroke needs at least one point"));
     }
@@ -175,11 +231,6 @@ pub fn stroke_edits(s: &Stroke, selection: Option<&Selection>) -> Result<Vec<Edi
     if sized && !(s.size.is_finite() && s.size > 0.0) {
         return Err(invalid(format!("brush size {} must be positive", s.size)));
     }
-    let mode = match s.mode {
-        BrushMode::Attach => Mode::Add(s.material),
-        BrushMode::Erase => Mode::Remove,
-        BrushMode::Paint => Mode::Paint(s.material),
-    };
     // Every combination of reflections across the enabled mirror planes (up to 8 images).
     let m = &s.mirror;
     let axes: Vec<usize> = [(0, m.x), (1, m.y), (2, m.z)]
@@ -196,12 +247,12 @@ pub fn stroke_edits(s: &Stroke, selection: Option<&Selection>) -> Result<Vec<Edi
         }
         q
     };
-    let mut edits = Vec::new();
+    let mut images = Vec::new();
     for combo in 0..1usize << axes.len() {
         let pts: Vec<DVec3> = s.points.iter().map(|p| reflect(*p, combo)).collect();
         let shapes: Vec<Shape> = match s.shape {
             BrushShape::Line | BrushShape::Sphere => vec![Shape::Line {
-                points: pts,
+                points: pts.clone(),
                 radius: s.size,
             }],
             BrushShape::Box => {
@@ -238,19 +289,12 @@ pub fn stroke_edits(s: &Stroke, selection: Option<&Selection>) -> Result<Vec<Edi
                 })
                 .collect(),
         };
-        for shape in shapes {
+        for shape in &shapes {
             shape.validate().map_err(EditError::World)?;
-            let shape = match selection.filter(|_| s.in_selection) {
-                Some(sel) => Shape::Within {
-                    shape: Box::new(shape),
-                    set: sel.voxels.clone(),
-                },
-                None => shape,
-            };
-            edits.push(EditOp::Shape { shape, mode });
         }
+        images.push((pts, shapes));
     }
-    Ok(edits)
+    Ok(images)
 }
 
 /// The most voxels a preview examines; a larger brush previews nothing (its outline is
@@ -300,7 +344,7 @@ pub fn preview_bricks(
     selection: Option<&Selection>,
 ) -> Result<Option<Vec<(IVec3, brickmap::Mask)>>> {
     use brickmap::shape::Coverage;
-    let edits = stroke_edits(stroke, selection)?;
+    let edits = stroke_edits(stroke, selection, view, None)?;
     let dims = view.dims().voxels();
     let mut examined = 0u64;
     // The changed voxels by brick (mirror images may lie far apart: sparse).

@@ -12,10 +12,11 @@
 //! (`changes_document` is false: recorded, no history step, the document stays clean).
 
 pub use super::brush::{
-    Axis, BrushMode, BrushShape, Mirror, PREVIEW_LIMIT, Stroke, preview, preview_bricks,
+    Axis, BrushMode, BrushShape, Mirror, PREVIEW_LIMIT, PaintMode, Stroke, preview, preview_bricks,
     stroke_edits,
 };
 pub use super::inverse::{Applied, Inverse};
+pub use super::paint::{hash as paint_hash, neighbours};
 
 use super::error::{EditError, Result};
 use super::inverse::{apply_all, with_table};
@@ -256,7 +257,10 @@ impl Command {
             changed_voxels: 0,
         };
         Ok(match self {
-            Command::Stroke(s) => apply_all(scene, stroke_edits(s, scene.selection.as_ref())?)?,
+            Command::Stroke(s) => {
+                let edits = stroke_edits(s, scene.selection.as_ref(), &scene.world.read(), None)?;
+                apply_all(scene, edits)?
+            }
             Command::RemoveUnusedMaterials => remove_unused_materials(scene)?,
             Command::Object(c) => c.apply(scene)?,
             Command::Select(op) => {

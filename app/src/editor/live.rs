@@ -23,6 +23,8 @@ pub struct LiveStroke {
     /// The stroke so far (every point given).
     pub stroke: Stroke,
     inverses: Vec<ObjectOp>,
+    /// The voxels recoloured so far, for colour modes that change each voxel once.
+    done: brickmap::VoxelSet,
     /// Voxels changed so far (by the segments; a voxel changed twice counts twice).
     pub changed_voxels: u64,
 }
@@ -36,12 +38,14 @@ impl LiveStroke {
         if stroke.mode != super::brush::BrushMode::Erase {
             scene.world.materials().check(stroke.material as u32)?;
         }
+        stroke.paint.check(stroke.mode, &scene.world.materials())?;
         let mut live = LiveStroke {
             stroke: Stroke {
                 points: Vec::new(),
                 ..stroke.clone()
             },
             inverses: Vec::new(),
+            done: brickmap::VoxelSet::new(),
             changed_voxels: 0,
         };
         live.extend(scene, &stroke.points)?;
@@ -59,8 +63,20 @@ impl LiveStroke {
             Err(e) => return Err(self.fail(scene, e)),
         };
         self.stroke.points.extend_from_slice(points);
-        if self.stroke.shape == BrushShape::Box && self.stroke.points.len() > 2 {
-            // A box is its first and latest corners.
+        if self.stroke.paint.reads_materials() {
+            for edit in &edits {
+                if let EditOp::Shape {
+                    shape: brickmap::Shape::Set(set),
+                    ..
+                } = edit
+                {
+                    self.done = self.done.union(set);
+                }
+            }
+        }
+        if self.at_the_end() && self.stroke.points.len() > 2 {
+            // A box is its first and latest corners; a gradient runs from the first point to
+            // the latest.
             let last = self.stroke.points[self.stroke.points.len() - 1];
             self.stroke.points.truncate(1);
             self.stroke.points.push(last);
@@ -77,9 +93,15 @@ impl LiveStroke {
         Ok(())
     }
 
+    /// Whether the stroke is applied only at its end: a box (its first and last corners), a
+    /// gradient (from the first point to the last).
+    fn at_the_end(&self) -> bool {
+        self.stroke.shape == BrushShape::Box || self.stroke.paint.needs_whole_stroke()
+    }
+
     /// The edits of the segment that adds `points`: the brush swept on from the last point
-    /// (so the stroke stays connected however far apart the points are); a box is applied
-    /// only at the end.
+    /// (so the stroke stays connected however far apart the points are); a stroke applied
+    /// at the end gives none.
     fn segment(&self, scene: &Scene, points: &[DVec3]) -> Result<Vec<EditOp>> {
         let mut part = Stroke {
             points: points.to_vec(),
@@ -90,13 +112,18 @@ impl LiveStroke {
         {
             part.points.insert(0, *last);
         }
-        let edits = stroke_edits(&part, scene.selection.as_ref())?;
-        // A box's corners are checked now, applied at the end.
-        Ok(if self.stroke.shape == BrushShape::Box {
-            Vec::new()
-        } else {
-            edits
-        })
+        if self.at_the_end() {
+            // Its points are checked now, its edits made at the end.
+            part.paint = super::brush::PaintMode::Solid;
+            stroke_edits(&part, None, &scene.world.read(), None)?;
+            return Ok(Vec::new());
+        }
+        stroke_edits(
+            &part,
+            scene.selection.as_ref(),
+            &scene.world.read(),
+            Some(&self.done),
+        )
     }
 
     /// Undoes what the stroke applied and returns `error` (or the failure to undo).
@@ -107,15 +134,21 @@ impl LiveStroke {
         }
     }
 
-    /// Ends the stroke: a box is applied now (its first and last points). Returns the
+    /// Ends the stroke: a box or a gradient is applied now. Returns the
     /// command for the history (the whole stroke) and its inverse; on error nothing the
     /// stroke applied remains.
     pub fn finish(mut self, scene: &Scene) -> Result<(Stroke, Inverse, u64)> {
         if self.stroke.points.is_empty() {
             return Err(invalid("a stroke needs at least one point"));
         }
-        if self.stroke.shape == BrushShape::Box {
-            for edit in stroke_edits(&self.stroke, scene.selection.as_ref())? {
+        if self.at_the_end() {
+            let edits = stroke_edits(
+                &self.stroke,
+                scene.selection.as_ref(),
+                &scene.world.read(),
+                None,
+            )?;
+            for edit in edits {
                 match scene.edit(edit) {
                     Ok((inverse, changed)) => {
                         self.changed_voxels += changed;

@@ -11,6 +11,7 @@ pub mod history;
 mod inverse;
 pub mod live;
 pub mod objects;
+mod paint;
 pub mod progress;
 mod replace;
 pub mod script;

@@ -9,7 +9,8 @@
 use super::{Rng, SoakOptions, SoakReport, rss};
 use crate::editor::Document;
 use crate::editor::command::{
-    Axis, BrushMode, BrushShape, Command, KindSpec, MaterialSpec, Mirror, Stroke, TerrainSpec,
+    Axis, BrushMode, BrushShape, Command, KindSpec, MaterialSpec, Mirror, PaintMode, Stroke,
+    TerrainSpec,
 };
 use crate::editor::history::History;
 use crate::editor::script::{Recorder, Start, Step};
@@ -164,6 +165,21 @@ impl Session {
             .rng
             .pick(&[BrushMode::Attach, BrushMode::Erase, BrushMode::Paint]);
         let m = self.rng.chance(0.3);
+        // A colour mode now and then (darken with attach, a material past the table: refused).
+        let paint = match self.rng.below(10) {
+            0 => PaintMode::Gradient {
+                to: self.rng.below(self.materials() + 1) as u8,
+            },
+            1 => PaintMode::Random {
+                among: (0..self.rng.below(4))
+                    .map(|_| self.rng.below(self.materials() + 1) as u8)
+                    .collect(),
+                seed: self.rng.below(1 << 32) as u32,
+            },
+            2 => PaintMode::Darken,
+            3 => PaintMode::Brighten,
+            _ => PaintMode::Solid,
+        };
         let stroke = Stroke {
             mode,
             shape,
@@ -182,6 +198,7 @@ impl Session {
             points: vec![self.point()],
             axis: self.rng.pick(&[Axis::X, Axis::Y, Axis::Z]),
             in_selection: self.rng.chance(0.1),
+            paint,
         };
         let before = self.state();
         let mut at = stroke.points[0];

@@ -16,7 +16,7 @@
 //! viewport.
 
 use super::intent::{Action, UiEvent};
-use super::swatch::{DIELECTRIC_BOUNCES, swatch};
+use super::swatch::{DIELECTRIC_BOUNCES, kind_name, rgb, swatch};
 use super::tools::{Brush, MAX_SIZE, Tool};
 use crate::editor::Document;
 use crate::editor::command::{
@@ -40,20 +40,6 @@ pub struct EditingState {
     pub palette_grid: Option<egui::Rect>,
     /// The terrain window, with its parameters.
     pub terrain: Option<TerrainSpec>,
-}
-
-fn rgb(table: &MaterialTable, colour: u8) -> egui::Color32 {
-    let [r, g, b] = table.colour(colour);
-    egui::Color32::from_rgb(r, g, b)
-}
-
-fn kind_name(k: MaterialKind) -> &'static str {
-    match k {
-        MaterialKind::Lambertian => "lambertian",
-        MaterialKind::Metal => "metal",
-        MaterialKind::Dielectric => "dielectric",
-        MaterialKind::Emissive => "emissive",
-    }
 }
 
 /// The docks' width in points: the palette's 16 columns of swatches and the tools' rows.
@@ -290,25 +276,7 @@ fn tools(
     ui.separator();
     super::selection_panel::selection(ui, brush, doc, out);
     ui.separator();
-    ui.label("material (Alt + click picks one)");
-    ui.horizontal_wrapped(|ui| {
-        for i in 0..table.len() {
-            let Ok(m) = table.get(i as u8) else { continue };
-            let r = swatch(
-                ui,
-                rgb(table, m.colour),
-                Some(m.kind),
-                brush.material == i as u8,
-                18.0,
-            )
-            .on_hover_text(format!("{i}: {}", kind_name(m.kind)));
-            let name = format!("material {i}: {}", kind_name(m.kind));
-            r.widget_info(|| egui::WidgetInfo::labeled(egui::WidgetType::Button, true, &name));
-            if r.clicked() {
-                brush.material = i as u8;
-            }
-        }
-    });
+    super::paint_panel::material(ui, brush, table);
 }
 
 fn palette(

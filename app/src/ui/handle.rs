@@ -20,7 +20,7 @@ use super::input::{self, Action, Drag};
 use super::jobs::Edit;
 use super::pending::Pending;
 use super::tools::{self, Tool};
-use crate::editor::command::Command;
+use crate::editor::command::{Command, PaintMode};
 use std::time::Instant;
 use winit::event::MouseButton;
 use winit::keyboard::KeyCode;
@@ -178,6 +178,10 @@ impl Editor {
                 }
                 self.pointer.drawing = None;
                 self.edits.submit(&self.doc, Edit::StrokeEnd);
+                // The next random-paint stroke varies differently.
+                if let PaintMode::Random { seed, .. } = &mut self.settings.brush.paint {
+                    *seed = seed.wrapping_add(1);
+                }
                 // Back to the full internal size shortly after, as after a move.
                 self.motion.settling();
             }
@@ -345,7 +349,10 @@ impl Editor {
             return None;
         }
         match &self.pointer.drawing {
-            Some(d) if brush.shape == crate::editor::command::BrushShape::Box => {
+            Some(d)
+                if brush.shape == crate::editor::command::BrushShape::Box
+                    || brush.paint.needs_whole_stroke() =>
+            {
                 Some(brush.stroke(vec![tools::centre(d.first), tools::centre(d.last)], dims))
             }
             Some(_) => None,

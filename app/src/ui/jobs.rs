@@ -286,6 +286,7 @@ mod tests {
             points: vec![glam::DVec3::splat(8.0)],
             axis: Default::default(),
             in_selection: false,
+            paint: Default::default(),
         })
     }
 

@@ -40,6 +40,7 @@ mod measure;
 mod motion;
 mod object_menu;
 pub mod outliner;
+mod paint_panel;
 pub mod panels;
 mod pending;
 mod pointer;

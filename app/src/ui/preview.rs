@@ -416,7 +416,7 @@ fn compute(
     };
     match preview_bricks(view, stroke, selection) {
         Ok(Some(bricks)) => shown.faces = outer_faces(&bricks),
-        Ok(None) => shown.bounds = bounds(stroke, selection),
+        Ok(None) => shown.bounds = bounds(view, stroke, selection),
         Err(_) => shown.mode = None,
     }
     shown
@@ -467,10 +467,14 @@ fn outer_faces(bricks: &[(IVec3, Mask)]) -> Vec<([DVec3; 4], IVec3)> {
 }
 
 /// The union of the stroke's shapes' voxel bounds, as a box of voxel corners.
-fn bounds(stroke: &Stroke, selection: Option<&Selection>) -> Option<(DVec3, DVec3)> {
+fn bounds(
+    view: &brickmap::WorldView<'_>,
+    stroke: &Stroke,
+    selection: Option<&Selection>,
+) -> Option<(DVec3, DVec3)> {
     let mut lo = IVec3::MAX;
     let mut hi = IVec3::MIN;
-    for edit in stroke_edits(stroke, selection).ok()? {
+    for edit in stroke_edits(stroke, selection, view, None).ok()? {
         if let EditOp::Shape { shape, .. } = edit {
             let (a, b) = shape.voxel_bounds();
             lo = lo.min(a);

@@ -3,13 +3,29 @@
 //! highlight, a lamp glowing. A plain square for every kind read as "paint with this
 //! colour", and a glass swatch then painted something else.
 
-use brickmap::MaterialKind;
+use brickmap::{MaterialKind, MaterialTable};
 use egui::{Color32, Pos2, Rect, Shape, Stroke};
 
 /// How many bounces a path needs before glass and water look like themselves in the
 /// viewport: in, out, and the light behind (measured on a glass and a water cube on a
 /// floor: black faces at 3 bounces, right from 5).
 pub const DIELECTRIC_BOUNCES: u32 = 5;
+
+/// The colour-table entry `colour` as an egui colour.
+pub fn rgb(table: &MaterialTable, colour: u8) -> Color32 {
+    let [r, g, b] = table.colour(colour);
+    Color32::from_rgb(r, g, b)
+}
+
+/// A material kind's name, as the panels write it.
+pub fn kind_name(k: MaterialKind) -> &'static str {
+    match k {
+        MaterialKind::Lambertian => "lambertian",
+        MaterialKind::Metal => "metal",
+        MaterialKind::Dielectric => "dielectric",
+        MaterialKind::Emissive => "emissive",
+    }
+}
 
 /// A square swatch of `colour` drawn as `kind` (None: a palette colour, no material);
 /// a white frame when `selected`. Returns its response (clickable).

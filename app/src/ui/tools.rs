@@ -4,7 +4,7 @@
 //! drag paints a layer instead of climbing towards the camera); erase and paint follow the
 //! surface under the cursor. Pure functions of the world and the ray, tested here.
 
-use crate::editor::command::{Axis, BrushMode, BrushShape, Mirror, Stroke};
+use crate::editor::command::{Axis, BrushMode, BrushShape, Mirror, PaintMode, Stroke};
 use brickmap::{Ray, WorldView};
 use glam::{DVec3, IVec3};
 use serde::{Deserialize, Serialize};
@@ -42,6 +42,9 @@ pub struct Brush {
     pub wand_diagonal: bool,
     /// The Extrude tool takes only the clicked voxel's material.
     pub extrude_same_material: bool,
+    /// How attach and paint strokes colour the voxels (solid, gradient, random, darken,
+    /// brighten).
+    pub paint: PaintMode,
 }
 
 /// How the selection tool selects.
@@ -89,6 +92,7 @@ impl Default for Brush {
             select_mode: SelectMode::Box,
             wand_diagonal: false,
             extrude_same_material: false,
+            paint: PaintMode::Solid,
         }
     }
 }
@@ -113,6 +117,11 @@ impl Brush {
             points,
             axis: self.axis,
             in_selection: self.in_selection,
+            paint: match (self.mode, &self.paint) {
+                (BrushMode::Erase, _) => PaintMode::Solid,
+                (BrushMode::Attach, PaintMode::Darken | PaintMode::Brighten) => PaintMode::Solid,
+                (_, p) => p.clone(),
+            },
         }
     }
 

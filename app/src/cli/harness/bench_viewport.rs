@@ -443,6 +443,7 @@ fn edits(
                 points: vec![point(k)],
                 axis: Default::default(),
                 in_selection: false,
+                paint: Default::default(),
             };
             let (mut apply, mut frames, mut ms, mut gpu, mut prev) =
                 (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -539,6 +540,7 @@ fn first_clicks(
                 points: vec![at],
                 axis: Default::default(),
                 in_selection: false,
+                paint: Default::default(),
             }))?;
             frames_until_shown(vp, &doc.scene.world, &moving)?;
             ms.push(event.elapsed().as_secs_f64() * 1e3);

@@ -165,6 +165,7 @@ pub(super) fn object_edits(
         points: vec![DVec3::new(centre.x, centre.y, centre.z)],
         axis: Default::default(),
         in_selection: false,
+        paint: Default::default(),
     });
     doc.execute(Command::Object(ObjectCommand::Activate(Some(column))))?;
     text += &row(doc, vp, "sphere r 16, 1 instance", &sphere)?;
