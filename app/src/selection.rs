@@ -257,6 +257,16 @@ impl Clip {
             .map(|(rel, mask, _)| ((self.origin + *rel).div_euclid(IVec3::splat(8)), *mask))
             .collect()
     }
+    /// Every copied solid voxel relative to the copy's minimum corner, with its material.
+    pub fn solid_voxels(&self) -> impl Iterator<Item = (IVec3, u8)> + '_ {
+        self.bricks.iter().flat_map(|(rel, mask, mats)| {
+            mask.ones().map(move |bit| {
+                let b = bit as i32;
+                (*rel + IVec3::new(b & 7, (b >> 3) & 7, b >> 6), mats[bit])
+            })
+        })
+    }
+
     /// Copies the solid voxels of `selection` (None when it selects no voxel).
     pub fn copy(view: &WorldView<'_>, selection: &Selection) -> Option<Clip> {
         let (lo, hi) = selection.voxels.bounds()?;

@@ -594,3 +594,113 @@ fn extrude_and_plane_fill_change_exactly_their_region() {
         );
     }
 }
+
+/// Stamp: the clipboard turned (by an independent formula: a quarter turn about y maps
+/// (x, y, z) in a box of size s to (z, y, s.x − 1 − x)) and put down at each place, later
+/// stamps winning, voxel by voxel against the grid before; undo exact; refusals change
+/// nothing.
+#[test]
+fn stamps_put_the_turned_clipboard_down_at_each_place() {
+    let mut doc = document();
+    let dims = doc.scene.world.dims().voxels();
+    let (lo, hi) = (IVec3::new(40, 20, 50), IVec3::new(47, 34, 53));
+    // Something of several materials in the copied box.
+    doc.execute(stroke(
+        BrushMode::Attach,
+        BrushShape::Sphere,
+        3.0,
+        &[[43.0, 30.0, 51.0]],
+    ))
+    .unwrap();
+    let empty_clipboard = doc
+        .execute(Command::Stamp {
+            at: vec![IVec3::new(5, 40, 5)],
+            quarters: 0,
+        })
+        .unwrap_err();
+    assert!(empty_clipboard.is_no_op(), "{empty_clipboard}");
+    doc.execute(Command::Select(app::selection::SelectOp::Replace {
+        min: lo,
+        max: hi,
+    }))
+    .unwrap();
+    doc.execute(Command::Copy).unwrap();
+    let clip: Vec<(IVec3, u8)> = {
+        let view = doc.scene.world.read();
+        every(lo, hi)
+            .filter_map(|v| view.voxel(v).unwrap().map(|m| (v - lo, m)))
+            .collect()
+    };
+    assert!(clip.len() > 50, "the copy holds {} voxels", clip.len());
+    let size = hi - lo + 1;
+    for quarters in [0, 1, 3] {
+        let mut doc = document();
+        doc.execute(stroke(
+            BrushMode::Attach,
+            BrushShape::Sphere,
+            3.0,
+            &[[43.0, 30.0, 51.0]],
+        ))
+        .unwrap();
+        doc.execute(Command::Select(app::selection::SelectOp::Replace {
+            min: lo,
+            max: hi,
+        }))
+        .unwrap();
+        doc.execute(Command::Copy).unwrap();
+        let before = state(&doc);
+        let old = {
+            let view = doc.scene.world.read();
+            every(IVec3::ZERO, dims - 1)
+                .map(|v| view.voxel(v).unwrap())
+                .collect::<Vec<_>>()
+        };
+        // Two overlapping stamps, one past the grid's side.
+        let at = vec![
+            IVec3::new(70, 36, 70),
+            IVec3::new(73, 38, 72),
+            IVec3::new(dims.x - 3, 40, 10),
+        ];
+        doc.execute(Command::Stamp {
+            at: at.clone(),
+            quarters,
+        })
+        .unwrap();
+        let mut want: std::collections::HashMap<IVec3, u8> = Default::default();
+        for a in &at {
+            for (p, m) in &clip {
+                let (mut p, mut s) = (*p, size);
+                for _ in 0..quarters {
+                    p = IVec3::new(p.z, p.y, s.x - 1 - p.x);
+                    s = IVec3::new(s.z, s.y, s.x);
+                }
+                want.insert(*a + p, *m);
+            }
+        }
+        let view = doc.scene.world.read();
+        for (v, was) in every(IVec3::ZERO, dims - 1).zip(&old) {
+            let expected = want.get(&v).copied().or(*was);
+            assert_eq!(view.voxel(v).unwrap(), expected, "{quarters} turns, at {v}");
+        }
+        drop(view);
+        let after = state(&doc);
+        doc.undo().unwrap();
+        assert_eq!(state(&doc), before, "{quarters}: undo");
+        doc.redo().unwrap();
+        assert_eq!(state(&doc), after, "{quarters}: redo");
+        let too_many = doc
+            .execute(Command::Stamp {
+                at: vec![IVec3::ZERO; app::editor::stamp::MAX_STAMPS + 1],
+                quarters,
+            })
+            .unwrap_err();
+        assert!(matches!(too_many, app::editor::EditError::Invalid(_)));
+        assert_eq!(state(&doc), after);
+    }
+}
+
+fn every(lo: IVec3, hi: IVec3) -> impl Iterator<Item = IVec3> {
+    (lo.x..=hi.x).flat_map(move |x| {
+        (lo.y..=hi.y).flat_map(move |y| (lo.z..=hi.z).map(move |z| IVec3::new(x, y, z)))
+    })
+}

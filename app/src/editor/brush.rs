@@ -195,7 +195,11 @@ pub fn stroke_edits(
                 Image { points, voxels }
             })
             .collect();
-        return coloured_edits(&s.paint, s.mode, s.material, images, view, done);
+        if s.mode == BrushMode::Erase {
+            return Err(invalid("erasing has no colour mode"));
+        }
+        let attach = s.mode == BrushMode::Attach;
+        return coloured_edits(&s.paint, attach, s.material, images, view, done);
     }
     let mode = match s.mode {
         BrushMode::Attach => Mode::Add(s.material),

@@ -145,6 +145,14 @@ pub enum Command {
         /// Where the copied selection's minimum corner goes.
         at: IVec3,
     },
+    /// Put the clipboard's solid voxels down at each of `at` (minimum corners), turned
+    /// `quarters` quarter turns about the vertical (the Stamp tool's drag).
+    Stamp {
+        /// Where each stamp's minimum corner goes.
+        at: Vec<IVec3>,
+        /// Quarter turns about the vertical (counter-clockwise seen from above).
+        quarters: i32,
+    },
     /// An object command (arrange mode, the Objects window).
     Object(super::objects::ObjectCommand),
 }
@@ -214,6 +222,7 @@ impl Command {
             Command::Copy => "Copy".into(),
             Command::Cut => "Cut".into(),
             Command::Paste { at } => format!("Paste at {at}"),
+            Command::Stamp { at, .. } => format!("Stamp the clipboard ({} places)", at.len()),
             Command::Object(c) => c.label(),
         }
     }
@@ -325,6 +334,15 @@ impl Command {
                 let pasted = Selection::new(clip.region.translated(*at), voxels);
                 let pasted = (!pasted.voxels.is_empty()).then_some(pasted);
                 with_selection(scene, edit, pasted)?
+            }
+            Command::Stamp { at, quarters } => {
+                let edit = super::stamp::stamp_edit(
+                    scene.clipboard.as_deref(),
+                    at,
+                    *quarters,
+                    world.dims().voxels(),
+                )?;
+                apply_all(scene, vec![edit])?
             }
             Command::Extrude {
                 voxel,

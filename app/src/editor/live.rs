@@ -38,7 +38,11 @@ impl LiveStroke {
         if stroke.mode != super::brush::BrushMode::Erase {
             scene.world.materials().check(stroke.material as u32)?;
         }
-        stroke.paint.check(stroke.mode, &scene.world.materials())?;
+        stroke.paint.check(
+            stroke.mode == super::brush::BrushMode::Erase,
+            stroke.mode == super::brush::BrushMode::Attach,
+            &scene.world.materials(),
+        )?;
         let mut live = LiveStroke {
             stroke: Stroke {
                 points: Vec::new(),

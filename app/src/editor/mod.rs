@@ -16,6 +16,7 @@ pub mod progress;
 mod replace;
 pub mod script;
 mod specs;
+pub mod stamp;
 
 pub use error::{EditError, Result};
 

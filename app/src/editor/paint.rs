@@ -19,7 +19,6 @@
 //! Every mode becomes one shape edit per material (a `Shape::Set` of the voxels that get it),
 //! so the workers apply it brick by brick like any brush and undo is the usual exact inverse.
 
-use super::brush::BrushMode;
 use super::error::{Result, invalid};
 use brickmap::{EditOp, MaterialTable, Mode, Shape, VoxelSet, WorldView};
 use glam::{DVec3, IVec3};
@@ -65,11 +64,12 @@ impl PaintMode {
         matches!(self, PaintMode::Darken | PaintMode::Brighten)
     }
 
-    /// Checks the mode against the brush mode and the material table.
-    pub fn check(&self, mode: BrushMode, table: &MaterialTable) -> Result<()> {
+    /// Checks the mode against the brush's (erasing, attaching, else painting) and the
+    /// material table.
+    pub fn check(&self, erase: bool, attach: bool, table: &MaterialTable) -> Result<()> {
         match self {
             PaintMode::Solid => Ok(()),
-            _ if mode == BrushMode::Erase => Err(invalid("erasing has no colour mode")),
+            _ if erase => Err(invalid("erasing has no colour mode")),
             PaintMode::Gradient { to } => Ok(table.check(*to as u32)?),
             PaintMode::Random { among, .. } => {
                 if among.is_empty() {
@@ -80,7 +80,7 @@ impl PaintMode {
                 }
                 Ok(())
             }
-            PaintMode::Darken | PaintMode::Brighten if mode == BrushMode::Attach => Err(invalid(
+            PaintMode::Darken | PaintMode::Brighten if attach => Err(invalid(
                 "darken and brighten repaint solid voxels: use the paint mode",
             )),
             PaintMode::Darken | PaintMode::Brighten => Ok(()),
@@ -98,29 +98,25 @@ pub(super) struct Image {
 }
 
 /// The edits that colour the images' voxels by `paint` (not `Solid`): one `Set` edit per
-/// material, adding (`Attach`) or painting. `done` voxels are left out (a live stroke's
+/// material, adding (`attach`) or painting. `done` voxels are left out (a live stroke's
 /// earlier segments, for the modes that read materials).
 pub(super) fn coloured_edits(
     paint: &PaintMode,
-    mode: BrushMode,
+    attach: bool,
     from: u8,
     images: Vec<Image>,
     view: &WorldView<'_>,
     done: Option<&VoxelSet>,
 ) -> Result<Vec<EditOp>> {
     let table = view.materials();
-    paint.check(mode, table)?;
+    paint.check(false, attach, table)?;
     let mut by_material: BTreeMap<u8, VoxelSet> = BTreeMap::new();
     let mut edits = Vec::new();
     let mut flush = |by: &mut BTreeMap<u8, VoxelSet>| {
         for (m, set) in std::mem::take(by) {
             edits.push(EditOp::Shape {
                 shape: Shape::Set(Arc::new(set)),
-                mode: if mode == BrushMode::Attach {
-                    Mode::Add(m)
-                } else {
-                    Mode::Paint(m)
-                },
+                mode: if attach { Mode::Add(m) } else { Mode::Paint(m) },
             });
         }
     };

@@ -73,6 +73,9 @@ impl Editor {
             Action::SelectTool => self.settings.brush.tool = Tool::Select,
             Action::MeasureTool => self.settings.brush.tool = Tool::Measure,
             Action::ExtrudeTool => self.settings.brush.tool = Tool::Extrude,
+            Action::StampTool => self.settings.brush.tool = Tool::Stamp,
+            Action::StampTurn => self.stamp_turn(1),
+            Action::StampTurnBack => self.stamp_turn(-1),
             Action::ToggleGrid => self.settings.grid = !self.settings.grid,
             Action::ArrangeTool => {
                 self.settings.brush.tool = if self.settings.brush.tool == Tool::Arrange {

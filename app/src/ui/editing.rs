@@ -205,6 +205,7 @@ fn tools(
         ui.selectable_value(&mut brush.tool, Tool::Arrange, "Arrange  Tab");
         ui.selectable_value(&mut brush.tool, Tool::Measure, "Measure  K");
         ui.selectable_value(&mut brush.tool, Tool::Extrude, "Extrude  U");
+        ui.selectable_value(&mut brush.tool, Tool::Stamp, "Stamp  J");
     });
     ui.horizontal_wrapped(|ui| {
         for (s, name) in [
@@ -237,6 +238,17 @@ fn tools(
                 "on: each point of a stroke attaches to the face under the cursor;
  off: the stroke keeps to the first face's layer (shown while drawing)",
             );
+    }
+    if brush.tool == Tool::Stamp {
+        ui.horizontal_wrapped(|ui| {
+            ui.label(format!("stamp turned {}°", brush.stamp_quarters * 90));
+            if ui.button("turn  H").clicked() {
+                brush.stamp_quarters = (brush.stamp_quarters + 1).rem_euclid(4);
+            }
+        });
+        if doc.scene.clipboard.is_none() {
+            ui.label("the stamp is the clipboard: select, then Ctrl + C");
+        }
     }
     if brush.tool == Tool::Extrude {
         ui.checkbox(
@@ -274,9 +286,9 @@ fn tools(
         });
     }
     ui.separator();
-    super::selection_panel::selection(ui, brush, doc, out);
-    ui.separator();
     super::paint_panel::material(ui, brush, table);
+    ui.separator();
+    super::selection_panel::selection(ui, brush, doc, out);
 }
 
 fn palette(

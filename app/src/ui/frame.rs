@@ -274,11 +274,34 @@ impl Editor {
                     .update(&self.doc, stroke.as_ref(), doc.revision);
             }
             let paste = self.paste_target(&doc);
+            // The Stamp tool's stamps: the drag's, or the one a press would put down.
+            let stamping =
+                self.settings.brush.tool == super::tools::Tool::Stamp && !self.pointer.pasting;
+            let stamps: Vec<(glam::IVec3, glam::IVec3)> = match &self.pointer.stamping {
+                Some(d) => {
+                    let size = doc.scene.clipboard.as_ref().map_or(glam::IVec3::ONE, |c| {
+                        crate::editor::stamp::turned_size(
+                            c.size,
+                            self.settings.brush.stamp_quarters,
+                        )
+                    });
+                    d.at.iter().map(|a| (*a, size)).collect()
+                }
+                None if stamping && !self.on_ui(self.pointer.cursor) => {
+                    self.stamp_target(&doc, None).into_iter().collect()
+                }
+                None => Vec::new(),
+            };
             self.preview.set_paste(
                 doc.scene
                     .clipboard
                     .as_ref()
-                    .filter(|_| self.pointer.pasting),
+                    .filter(|_| self.pointer.pasting || stamping),
+                if stamping {
+                    self.settings.brush.stamp_quarters
+                } else {
+                    0
+                },
             );
             let view_area = self.viewing.area();
             let brush = &self.settings.brush;
@@ -386,6 +409,19 @@ impl Editor {
                 if let Some((at, _)) = paste {
                     self.preview
                         .paint_paste(&painter, &self.viewing.camera, rect, at);
+                }
+                for (at, size) in &stamps {
+                    self.preview
+                        .paint_paste(&painter, &self.viewing.camera, rect, *at);
+                    let stroke = egui::Stroke::new(1.0, egui::Color32::from_rgb(255, 210, 60));
+                    preview::paint_box(
+                        &painter,
+                        &self.viewing.camera,
+                        rect,
+                        at.as_dvec3(),
+                        (*at + *size).as_dvec3(),
+                        stroke,
+                    );
                 }
                 preview::paint_mirror(
                     &painter,

@@ -189,6 +189,7 @@ impl Editor {
             (false, MouseButton::Left) if self.pointer.extruding.is_some() => {
                 self.extrude_release()
             }
+            (false, MouseButton::Left) if self.pointer.stamping.is_some() => self.stamp_release(),
             (false, MouseButton::Left)
                 if self.pointer.moving.is_some() || self.pointer.boxing.is_some() =>
             {
@@ -227,6 +228,7 @@ impl Editor {
         self.select_to_cursor();
         self.arrange_to_cursor();
         self.extrude_to_cursor();
+        self.stamp_to_cursor();
     }
 
     /// Left button down: a paste being placed goes down, the eyedropper (Alt), the selection
@@ -246,6 +248,10 @@ impl Editor {
         }
         if self.settings.brush.tool == Tool::Measure {
             self.measure_press();
+            return;
+        }
+        if self.settings.brush.tool == Tool::Stamp && !self.pointer.mods.alt {
+            self.stamp_press();
             return;
         }
         if self.settings.brush.tool == Tool::Extrude && !self.pointer.mods.alt {

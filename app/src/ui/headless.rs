@@ -205,13 +205,10 @@ impl Editor {
         })
     }
 
-    /// How many voxel faces the paste being placed shows (0: no paste, or too large a clip).
+    /// How many voxel faces the paste being placed, or the Stamp tool, shows (0: neither, or
+    /// too large a clip).
     pub fn paste_preview_faces(&self) -> usize {
-        if self.pointer.pasting {
-            self.preview.paste_faces()
-        } else {
-            0
-        }
+        self.preview.paste_faces()
     }
 
     /// Whether the in-app file browser is open.

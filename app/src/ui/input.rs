@@ -61,6 +61,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "U, then drag a face",
         "extrude: the face's connected region grows (or, dragged inward, sinks) by the distance dragged",
     ),
+    (
+        "J, then drag (H / Shift + H turn)",
+        "stamp the clipboard along the drag, a stamp every stamp's width",
+    ),
     ("Esc (while drawing)", "cancel the stroke"),
     (
         "M",

@@ -66,6 +66,12 @@ pub enum Action {
     MeasureTool,
     /// The Extrude tool.
     ExtrudeTool,
+    /// The Stamp tool (the clipboard as a brush).
+    StampTool,
+    /// Turn the stamp a quarter turn about the vertical.
+    StampTurn,
+    /// Turn it back.
+    StampTurnBack,
     /// Arrange mode (pick and move objects), or back to the brush.
     ArrangeTool,
     /// Select the whole grid.

@@ -51,8 +51,9 @@ pub mod report;
 mod saves;
 mod selecting;
 mod selection_panel;
+mod stamping;
 mod status;
-mod swatch;
+pub mod swatch;
 pub mod tools;
 mod viewing;
 

@@ -47,6 +47,8 @@ pub(super) struct Pointer {
     pub(super) ruler: super::measure::Ruler,
     /// A face being extruded (the Extrude tool).
     pub(super) extruding: Option<super::extruding::ExtrudeDrag>,
+    /// A stamp drag (the Stamp tool).
+    pub(super) stamping: Option<super::stamping::StampDrag>,
 }
 
 impl Pointer {
@@ -57,13 +59,15 @@ impl Pointer {
             || self.moving.is_some()
             || self.boxing.is_some()
             || self.ruler.a.is_some()
-            || self.extruding.is_some();
+            || self.extruding.is_some()
+            || self.stamping.is_some();
         self.pasting = false;
         self.selecting = None;
         self.moving = None;
         self.boxing = None;
         self.ruler = Default::default();
         self.extruding = None;
+        self.stamping = None;
         was
     }
 

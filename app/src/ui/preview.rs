@@ -51,9 +51,10 @@ const PASTE_PREVIEW_VOXELS: u64 = 200_000;
 
 /// The kept preview and its thread.
 pub struct Preview {
-    /// The clipboard's outer faces where it was copied, for the paste being placed (the
-    /// clip they are of, by address; computed once per clip).
-    paste: Option<(usize, Faces, IVec3)>,
+    /// The clipboard's outer faces turned and with its minimum corner at the origin, for the
+    /// paste or stamps being placed (the clip they are of, by address, and the turn;
+    /// computed once per clip and turn).
+    paste: Option<((usize, i32), Faces)>,
     requests: Option<Sender<(SharedDocument, Key)>>,
     results: Receiver<(Key, Shown)>,
     /// The latest stroke asked for (None: nothing to show).
@@ -116,25 +117,35 @@ impl Preview {
         }
     }
 
-    /// Keeps the clipboard's faces for the paste preview (recomputed only for another clip;
-    /// none for a clip over [`PASTE_PREVIEW_VOXELS`]).
-    pub fn set_paste(&mut self, clip: Option<&Arc<crate::selection::Clip>>) {
+    /// Keeps the clipboard's faces, turned `quarters` times about the vertical, for the
+    /// paste or stamp preview (recomputed only for another clip or turn; none for a clip over
+    /// [`PASTE_PREVIEW_VOXELS`]).
+    pub fn set_paste(&mut self, clip: Option<&Arc<crate::selection::Clip>>, quarters: i32) {
         let Some(clip) = clip.filter(|c| c.voxels <= PASTE_PREVIEW_VOXELS) else {
             self.paste = None;
             return;
         };
-        let id = Arc::as_ptr(clip) as usize;
-        if self.paste.as_ref().is_none_or(|(k, _, _)| *k != id) {
-            self.paste = Some((id, outer_faces(&clip.source_bricks()), clip.origin));
+        let key = (Arc::as_ptr(clip) as usize, quarters);
+        if self.paste.as_ref().is_none_or(|(k, _)| *k != key) {
+            let rot =
+                brickmap::objects::Orientation::quarter_turn(brickmap::objects::Axis::Y, quarters);
+            let size = crate::editor::stamp::turned_size(clip.size, quarters);
+            let mut set = brickmap::VoxelSet::new();
+            for (p, _) in clip.solid_voxels() {
+                set.insert(crate::editor::stamp::turned(&rot, p, clip.size, size));
+            }
+            let bricks: Vec<(IVec3, Mask)> = set.iter().map(|(b, m)| (b.as_ivec3(), *m)).collect();
+            self.paste = Some((key, outer_faces(&bricks)));
         }
     }
 
     /// How many faces the paste preview has (0: none kept).
     pub fn paste_faces(&self) -> usize {
-        self.paste.as_ref().map_or(0, |(_, f, _)| f.len())
+        self.paste.as_ref().map_or(0, |(_, f)| f.len())
     }
 
-    /// Paints the kept clipboard's voxels where a paste at `at` puts them, translucent.
+    /// Paints the kept clipboard's voxels where a paste (or a stamp) at `at` puts them,
+    /// translucent.
     pub fn paint_paste(
         &self,
         painter: &egui::Painter,
@@ -142,16 +153,9 @@ impl Preview {
         rect: egui::Rect,
         at: IVec3,
     ) {
-        if let Some((_, faces, origin)) = &self.paste {
+        if let Some((_, faces)) = &self.paste {
             let colour = egui::Color32::from_rgba_unmultiplied(255, 210, 60, 70);
-            paint_faces(
-                painter,
-                view,
-                rect,
-                faces,
-                (at - *origin).as_dvec3(),
-                colour,
-            );
+            paint_faces(painter, view, rect, faces, at.as_dvec3(), colour);
         }
     }
 

@@ -45,6 +45,8 @@ pub struct Brush {
     /// How attach and paint strokes colour the voxels (solid, gradient, random, darken,
     /// brighten).
     pub paint: PaintMode,
+    /// The Stamp tool's quarter turns about the vertical (0..4).
+    pub stamp_quarters: i32,
 }
 
 /// How the selection tool selects.
@@ -73,6 +75,8 @@ pub enum Tool {
     Measure,
     /// Drag a face along its normal (extrude, push-pull).
     Extrude,
+    /// Stamp the clipboard along a drag.
+    Stamp,
 }
 
 impl Default for Brush {
@@ -93,6 +97,7 @@ impl Default for Brush {
             wand_diagonal: false,
             extrude_same_material: false,
             paint: PaintMode::Solid,
+            stamp_quarters: 0,
         }
     }
 }
