@@ -78,9 +78,8 @@ impl LiveStroke {
                 }
             }
         }
-        if self.at_the_end() && self.stroke.points.len() > 2 {
-            // A box is its first and latest corners; a gradient runs from the first point to
-            // the latest.
+        if self.stroke.shape == BrushShape::Box && self.stroke.points.len() > 2 {
+            // A box is its first and latest corners.
             let last = self.stroke.points[self.stroke.points.len() - 1];
             self.stroke.points.truncate(1);
             self.stroke.points.push(last);
@@ -98,7 +97,7 @@ impl LiveStroke {
     }
 
     /// Whether the stroke is applied only at its end: a box (its first and last corners), a
-    /// gradient (from the first point to the last).
+    /// gradient (its colours run from the first point to the last).
     fn at_the_end(&self) -> bool {
         self.stroke.shape == BrushShape::Box || self.stroke.paint.needs_whole_stroke()
     }

@@ -2,10 +2,12 @@
 //! simply the brush's material.
 //!
 //! - **Gradient** from the brush's material at the stroke's first point to `to` at its last:
-//!   a voxel's centre is projected on that segment (t clamped to 0..=1) and takes the table
-//!   entry `from + round(t · (to − from))` — the entries between the two in table order, as
-//!   indexed palettes are laid out (a row of shades). Each mirror image uses its own mirrored
-//!   segment.
+//!   the brush covers the whole drag as any stroke does (following the surface), and a
+//!   covered voxel's centre is projected on the segment from the first point to the last
+//!   (t clamped to 0..=1) and takes the table entry `from + round(t · (to − from))` — the
+//!   entries between the two in table order, as indexed palettes are laid out (a row of
+//!   shades). Each mirror image uses its own mirrored segment. The colours depend on the last
+//!   point, so a live gradient stroke is applied at the release (previewed meanwhile).
 //! - **Random** among chosen entries: entry `among[h mod n]`, `h` a hash of the voxel's
 //!   position and the stroke's seed; the same voxel gets the same entry within a stroke, so a
 //!   live stroke and its replay agree, and a new seed per stroke varies the next one.

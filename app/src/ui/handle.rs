@@ -314,6 +314,7 @@ impl Editor {
             layer,
             first: v,
             last: v,
+            points: vec![v],
         });
         self.edits.submit(&self.doc, Edit::StrokeBegin(stroke));
     }
@@ -334,6 +335,7 @@ impl Editor {
         {
             if let Some(d) = &mut self.pointer.drawing {
                 d.last = v;
+                d.points.push(v);
             }
             self.report.line(format_args!(
                 "stroke point {} {} voxel {} {} {}",
@@ -355,11 +357,12 @@ impl Editor {
             return None;
         }
         match &self.pointer.drawing {
-            Some(d)
-                if brush.shape == crate::editor::command::BrushShape::Box
-                    || brush.paint.needs_whole_stroke() =>
-            {
+            Some(d) if brush.shape == crate::editor::command::BrushShape::Box => {
                 Some(brush.stroke(vec![tools::centre(d.first), tools::centre(d.last)], dims))
+            }
+            // A gradient is applied at the release: the whole drag is previewed.
+            Some(d) if brush.stroke(Vec::new(), dims).paint.needs_whole_stroke() => {
+                Some(brush.stroke(d.points.iter().map(|v| tools::centre(*v)).collect(), dims))
             }
             Some(_) => None,
             None => {

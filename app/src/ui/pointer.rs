@@ -8,11 +8,13 @@ use super::input::{Drag, Mods};
 use super::selecting::SelectDrag;
 use super::tools;
 
-/// A stroke being drawn: the layer it keeps to, its first and its last voxel sent.
+/// A stroke being drawn: the layer it keeps to, its first and its last voxel sent, and every
+/// voxel sent (a gradient's preview shows the whole drag).
 pub(super) struct Drawing {
     pub(super) layer: tools::Layer,
     pub(super) first: glam::IVec3,
     pub(super) last: glam::IVec3,
+    pub(super) points: Vec<glam::IVec3>,
 }
 
 /// Picked objects being dragged (arrange mode) over the horizontal plane at height `y`
