@@ -85,7 +85,7 @@ impl Region {
 }
 
 /// How a box drag changes the selection.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum SelectOp {
     /// The box becomes the selection.
     Replace {
@@ -108,6 +108,13 @@ pub enum SelectOp {
         /// The opposite corner.
         max: IVec3,
     },
+    /// Only the selected voxels inside the box stay (Shift + Ctrl).
+    Intersect {
+        /// A corner.
+        min: IVec3,
+        /// The opposite corner.
+        max: IVec3,
+    },
     /// The whole grid.
     All,
     /// Nothing.
@@ -120,6 +127,27 @@ pub enum SelectOp {
         by_material: bool,
         /// Connected through edges and corners too (26), not only faces (6).
         diagonal: bool,
+        /// How it combines with the selection.
+        how: Combine,
+    },
+    /// The face wand from the face of `start` facing `normal` ([`crate::wand::face_region`]).
+    Face {
+        /// The clicked voxel.
+        start: IVec3,
+        /// The clicked face's normal (one axis, ±1).
+        normal: IVec3,
+        /// Only voxels of its material.
+        by_material: bool,
+        /// Joined through corners in the plane too, not only edges.
+        diagonal: bool,
+        /// How it combines with the selection.
+        how: Combine,
+    },
+    /// A rectangle on the screen, through all depth or visible voxels only
+    /// ([`crate::rect_select`]).
+    Rect {
+        /// The rectangle and the view it was dragged in.
+        rect: Box<crate::rect_select::ScreenRect>,
         /// How it combines with the selection.
         how: Combine,
     },
@@ -201,6 +229,24 @@ pub fn select(
                     diagonal,
                     how,
                 } => how.apply(now, crate::wand::wand(view, start, by_material, diagonal)),
+                SelectOp::Face {
+                    start,
+                    normal,
+                    by_material,
+                    diagonal,
+                    how,
+                } => how.apply(
+                    now,
+                    crate::wand::face_region(view, start, normal, by_material, diagonal),
+                ),
+                SelectOp::Rect { rect, how } => {
+                    how.apply(now, crate::rect_select::rect_set(view, &rect))
+                }
+                SelectOp::Intersect { min, max } => {
+                    let mut b = VoxelSet::new();
+                    b.apply_box(min.min(max), min.max(max), voxels, false);
+                    now?.intersection(&b)
+                }
                 SelectOp::Material { material, how } => {
                     how.apply(now, crate::wand::of_material(view, material))
                 }

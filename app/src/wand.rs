@@ -1,12 +1,14 @@
 //! Selections made as voxel sets: the magic wand (the voxels connected to a clicked one that
 //! have its material, or that are solid; connected by faces, or also by edges and corners),
+//! the face wand (the connected coplanar region of a clicked face: the voxels of its layer
+//! whose face on that side is exposed, joined in the plane through edges, or also corners),
 //! every voxel of a material, and how a new set combines with the selection (replace; Shift
 //! adds, Ctrl takes away, Shift + Ctrl keeps what both hold).
 
 use brickmap::{BrickMaterials, Mask, VoxelSet, WorldView};
 use glam::{IVec3, UVec3};
 use serde::{Deserialize, Serialize};
-use std::collections::{HashMap, VecDeque};
+use std::collections::{HashMap, HashSet, VecDeque};
 
 /// How a new set of voxels changes the selection.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -170,4 +172,77 @@ pub fn of_material(view: &WorldView<'_>, material: u8) -> VoxelSet {
         out.set_brick(b, m);
     });
     out
+}
+
+/// The voxels of the plane through `start` across `normal` (one axis, ±1), joined through
+/// edges in the plane (with `diagonal` also through corners), that `takes` accepts and that
+/// lie in `lo..hi` (hi exclusive); sorted by x, then y, then z. Extrude, plane fill and the
+/// face wand flood this way.
+pub fn plane_flood(
+    start: IVec3,
+    normal: IVec3,
+    (lo, hi): (IVec3, IVec3),
+    diagonal: bool,
+    takes: impl Fn(IVec3) -> bool,
+) -> Vec<IVec3> {
+    let inside = |v: IVec3| v.cmpge(lo).all() && v.cmplt(hi).all();
+    if !inside(start) || !takes(start) {
+        return Vec::new();
+    }
+    // The in-plane steps: 4 through edges, 8 with the corners.
+    let axes: Vec<IVec3> = [IVec3::X, IVec3::Y, IVec3::Z]
+        .into_iter()
+        .filter(|a| a.dot(normal) == 0)
+        .collect();
+    let mut steps: Vec<IVec3> = axes.iter().flat_map(|a| [*a, -*a]).collect();
+    if diagonal {
+        for i in [-1, 1] {
+            for j in [-1, 1] {
+                steps.push(axes[0] * i + axes[1] * j);
+            }
+        }
+    }
+    let mut seen = HashSet::from([start]);
+    let mut stack = vec![start];
+    let mut out = Vec::new();
+    while let Some(v) = stack.pop() {
+        out.push(v);
+        for s in &steps {
+            let n = v + *s;
+            if inside(n) && !seen.contains(&n) && takes(n) {
+                seen.insert(n);
+                stack.push(n);
+            }
+        }
+    }
+    out.sort_by_key(|v| (v.x, v.y, v.z));
+    out
+}
+
+/// The face wand from the face of `start` facing `normal`: the solid voxels of its layer
+/// whose neighbour along `normal` is empty (or outside the grid), joined in the plane
+/// ([`plane_flood`]); with `by_material` only those of `start`'s material. Empty when that
+/// face is not exposed or `normal` is not a face's.
+pub fn face_region(
+    view: &WorldView<'_>,
+    start: IVec3,
+    normal: IVec3,
+    by_material: bool,
+    diagonal: bool,
+) -> VoxelSet {
+    let mut set = VoxelSet::new();
+    if normal.abs().element_sum() != 1 {
+        return set;
+    }
+    let at = |v: IVec3| view.voxel(v).ok().flatten();
+    let Some(material) = at(start) else {
+        return set;
+    };
+    let exposed =
+        |v: IVec3| at(v).is_some_and(|m| !by_material || m == material) && at(v + normal).is_none();
+    let grid = (IVec3::ZERO, view.dims().voxels());
+    for v in plane_flood(start, normal, grid, diagonal, exposed) {
+        set.insert(v);
+    }
+    set
 }

@@ -35,6 +35,7 @@ fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     extrude_drags_a_face_and_shift_click_fills_a_plane(&mut s);
     the_stamp_puts_the_clipboard_down_along_a_drag(&mut s);
     the_colour_modes_are_chosen_in_the_tools_panel(&mut s);
+    the_face_wand_and_screen_rectangles_select(&mut s);
     the_docks_leave_the_viewport_framing_fits_it_and_the_palette_paints(&mut s);
     without_a_dialog_save_as_and_open_ask_in_the_browser(&mut s, &dir);
     the_first_click_on_an_empty_scene_attaches_on_the_floor(&mut s, &dir);

@@ -121,6 +121,22 @@ impl Camera {
         }
     }
 
+    /// Where a world point appears, as the (u, v) of [`Camera::ray`] (None behind the eye, or
+    /// behind the image plane of an orthographic view): the ray through it passes through
+    /// the point.
+    pub fn project(&self, p: DVec3, aspect: f64) -> Option<(f64, f64)> {
+        let (f, r, up) = self.basis(aspect);
+        let d = p - self.position;
+        let z = d.dot(f);
+        let depth = if self.is_orthographic() { 1.0 } else { z };
+        (z > 1e-9).then(|| {
+            (
+                d.dot(r) / r.length_squared() / depth,
+                d.dot(up) / up.length_squared() / depth,
+            )
+        })
+    }
+
     /// The view height at `distance` ahead: what a perspective view shows there, and an
     /// orthographic one everywhere.
     pub fn view_height_at(&self, distance: f64) -> f64 {

@@ -417,7 +417,7 @@ fn a_selection_splits_into_a_new_object_that_edits_apart() {
 fn selection_moves_read_the_active_object_alone() {
     let (mut doc, corner) = small_default();
     let terrain = doc.scene.active().unwrap();
-    doc.execute(Command::Select(corner)).unwrap();
+    doc.execute(Command::Select(corner.clone())).unwrap();
     doc.execute(Command::Object(ObjectCommand::SplitSelection))
         .unwrap();
     let part = *objects_in_order(&doc)

@@ -196,6 +196,18 @@ impl Command {
                 SelectOp::Replace { .. } => "Select box".into(),
                 SelectOp::Add { .. } => "Add box to selection".into(),
                 SelectOp::Subtract { .. } => "Subtract box from selection".into(),
+                SelectOp::Intersect { .. } => "Intersect selection with box".into(),
+                SelectOp::Face { start, normal, .. } => {
+                    format!("Select the face region at {start} ({normal})")
+                }
+                SelectOp::Rect { rect, how } => format!(
+                    "Select a screen rectangle ({}, {how:?})",
+                    if rect.visible_only {
+                        "visible voxels"
+                    } else {
+                        "all depth"
+                    }
+                ),
                 SelectOp::All => "Select all".into(),
                 SelectOp::None => "Select none".into(),
                 SelectOp::Wand { start, how, .. } => format!("Magic wand at {start} ({how:?})"),
@@ -275,7 +287,7 @@ impl Command {
             Command::Select(op) => {
                 let alone = scene.active_world()?;
                 let source = alone.as_ref().unwrap_or(world);
-                let next = select(scene.selection.as_ref(), *op, &source.read());
+                let next = select(scene.selection.as_ref(), op.clone(), &source.read());
                 unchanged(Inverse::Selection(std::mem::replace(
                     &mut scene.selection,
                     next,

@@ -15,7 +15,6 @@ use super::error::{EditError, Result};
 use crate::scene::Scene;
 use brickmap::{VoxelEdit, VoxelOp, WorldView};
 use glam::IVec3;
-use std::collections::HashSet;
 
 /// A unit axis vector, or an error naming it.
 fn axis_normal(normal: IVec3) -> Result<IVec3> {
@@ -36,41 +35,6 @@ fn bounds(scene: &Scene) -> (IVec3, IVec3) {
         Some((lo, hi)) => (lo.max(IVec3::ZERO), hi.min(grid)),
         None => (IVec3::ZERO, grid),
     }
-}
-
-/// The voxels of the plane through `start` across `normal`, joined through edges in the
-/// plane, that `takes` accepts and that lie in `lo..hi`.
-fn plane_flood(
-    start: IVec3,
-    normal: IVec3,
-    (lo, hi): (IVec3, IVec3),
-    takes: impl Fn(IVec3) -> bool,
-) -> Vec<IVec3> {
-    let inside = |v: IVec3| v.cmpge(lo).all() && v.cmplt(hi).all();
-    if !inside(start) || !takes(start) {
-        return Vec::new();
-    }
-    // The four in-plane steps.
-    let steps: Vec<IVec3> = [IVec3::X, IVec3::Y, IVec3::Z]
-        .into_iter()
-        .filter(|a| a.dot(normal) == 0)
-        .flat_map(|a| [a, -a])
-        .collect();
-    let mut seen = HashSet::from([start]);
-    let mut stack = vec![start];
-    let mut out = Vec::new();
-    while let Some(v) = stack.pop() {
-        out.push(v);
-        for s in &steps {
-            let n = v + *s;
-            if inside(n) && !seen.contains(&n) && takes(n) {
-                seen.insert(n);
-                stack.push(n);
-            }
-        }
-    }
-    out.sort_by_key(|v| (v.x, v.y, v.z));
-    out
 }
 
 /// The edits of an extrude from the face of `voxel` facing `normal` by `distance`.
@@ -97,7 +61,7 @@ pub(super) fn extrude_edits(
             && at(v + normal).is_none()
             && selection.as_ref().is_none_or(|s| s.contains(v))
     };
-    let region = plane_flood(voxel, normal, (lo, hi), exposed);
+    let region = crate::wand::plane_flood(voxel, normal, (lo, hi), false, exposed);
     if region.is_empty() {
         return Err(EditError::NothingToDo("that face is not exposed"));
     }
@@ -142,7 +106,7 @@ pub(super) fn plane_fill_edits(
     let source = alone.as_ref().unwrap_or(&scene.world);
     let view: WorldView<'_> = source.read();
     let empty = |v: IVec3| view.voxel(v).is_ok_and(|m| m.is_none());
-    let region = plane_flood(voxel + normal, normal, bounds(scene), empty);
+    let region = crate::wand::plane_flood(voxel + normal, normal, bounds(scene), false, empty);
     if region.is_empty() {
         return Err(EditError::NothingToDo(
             "no empty voxel in front of that face",

@@ -163,20 +163,7 @@ impl ViewCamera {
     /// Where a world point appears, in normalized device coordinates (None behind the eye,
     /// or behind the image plane of an orthographic view).
     pub fn project(&self, p: DVec3, aspect: f64) -> Option<(f64, f64)> {
-        let (f, r, up) = self.camera.basis(aspect);
-        let d = p - self.camera.position;
-        let z = d.dot(f);
-        let depth = if self.camera.is_orthographic() {
-            1.0
-        } else {
-            z
-        };
-        (z > 1e-9).then(|| {
-            (
-                d.dot(r) / r.length_squared() / depth,
-                d.dot(up) / up.length_squared() / depth,
-            )
-        })
+        self.camera.project(p, aspect)
     }
 }
 

@@ -402,6 +402,10 @@ impl Editor {
                 if let Some(b) = drawn_box.or(dragged.map(|(lo, hi, _)| (lo, hi))) {
                     preview::paint_box_size(&painter, cursor, b);
                 }
+                if let Some(d) = &self.pointer.rect_selecting {
+                    let from = egui::pos2(d.from.0 as f32 / ppp, d.from.1 as f32 / ppp);
+                    super::rect_selecting::paint(&painter, from, cursor, d.adds());
+                }
                 if let Some(d) = &self.pointer.extruding {
                     super::extruding::paint_distance(&painter, cursor, d.distance);
                 }

@@ -190,6 +190,9 @@ impl Editor {
                 self.extrude_release()
             }
             (false, MouseButton::Left) if self.pointer.stamping.is_some() => self.stamp_release(),
+            (false, MouseButton::Left) if self.pointer.rect_selecting.is_some() => {
+                self.rect_select_release()
+            }
             (false, MouseButton::Left)
                 if self.pointer.moving.is_some() || self.pointer.boxing.is_some() =>
             {

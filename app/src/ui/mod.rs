@@ -47,6 +47,7 @@ mod pointer;
 mod preview;
 pub mod purpose;
 mod recording;
+mod rect_selecting;
 pub mod report;
 mod saves;
 mod selecting;

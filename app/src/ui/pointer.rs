@@ -51,6 +51,8 @@ pub(super) struct Pointer {
     pub(super) extruding: Option<super::extruding::ExtrudeDrag>,
     /// A stamp drag (the Stamp tool).
     pub(super) stamping: Option<super::stamping::StampDrag>,
+    /// A screen rectangle being dragged (the selection tool).
+    pub(super) rect_selecting: Option<super::rect_selecting::RectDrag>,
 }
 
 impl Pointer {
@@ -62,7 +64,8 @@ impl Pointer {
             || self.boxing.is_some()
             || self.ruler.a.is_some()
             || self.extruding.is_some()
-            || self.stamping.is_some();
+            || self.stamping.is_some()
+            || self.rect_selecting.is_some();
         self.pasting = false;
         self.selecting = None;
         self.moving = None;
@@ -70,6 +73,7 @@ impl Pointer {
         self.ruler = Default::default();
         self.extruding = None;
         self.stamping = None;
+        self.rect_selecting = None;
         was
     }
 

@@ -1,6 +1,7 @@
 //! The selection tool and the operations on a selection in the window. A drag with the tool
 //! spans a rectangle on the plane of the face first clicked, `depth` voxels deep into the
-//! surface (Shift adds the box, Ctrl subtracts it; a click on nothing selects nothing); the
+//! surface (Shift adds the box, Ctrl subtracts it, both intersect; a click on nothing selects
+//! nothing; the wands select with a click, the screen rectangles in `rect_selecting.rs`); the
 //! arrow keys move the selection (the horizontal axes as the camera sees them; Page Up /
 //! Down vertically; Shift: a brick at a time); a paste follows the cursor, sitting on the
 //! face under it, until a click puts it down (Esc cancels). Every operation is a command.
@@ -25,12 +26,16 @@ pub enum DragKind {
     Add,
     /// Ctrl: taken away.
     Subtract,
+    /// Shift + Ctrl: only what both hold stays.
+    Intersect,
 }
 
 impl DragKind {
     /// The kind for the modifiers held.
     pub fn of(mods: Mods) -> Self {
-        if mods.shift {
+        if mods.shift && mods.ctrl {
+            DragKind::Intersect
+        } else if mods.shift {
             DragKind::Add
         } else if mods.ctrl {
             DragKind::Subtract
@@ -44,6 +49,7 @@ impl DragKind {
             DragKind::Replace => SelectOp::Replace { min, max },
             DragKind::Add => SelectOp::Add { min, max },
             DragKind::Subtract => SelectOp::Subtract { min, max },
+            DragKind::Intersect => SelectOp::Intersect { min, max },
         }
     }
 }
@@ -117,6 +123,34 @@ impl Editor {
     pub(super) fn select_press(&mut self) {
         let (origin, dir) = self.cursor_ray();
         let brush = &self.settings.brush;
+        if matches!(
+            brush.select_mode,
+            super::tools::SelectMode::Rect | super::tools::SelectMode::RectVisible
+        ) {
+            self.rect_select_press();
+            return;
+        }
+        if brush.select_mode == super::tools::SelectMode::WandFace {
+            let how = crate::wand::Combine::of(self.pointer.mods.shift, self.pointer.mods.ctrl);
+            let diagonal = brush.wand_diagonal;
+            let hit = {
+                let doc = self.read();
+                let view = doc.scene.world.read();
+                tools::pick(&view, origin, dir).map(|(h, _)| h)
+            };
+            match hit {
+                Some(h) => self.select(SelectOp::Face {
+                    start: h.voxel,
+                    normal: h.normal,
+                    by_material: false,
+                    diagonal,
+                    how,
+                }),
+                None if how == crate::wand::Combine::Replace => self.select(SelectOp::None),
+                None => {}
+            }
+            return;
+        }
         if brush.select_mode != super::tools::SelectMode::Box {
             // The magic wand: a click on a voxel (on nothing: a plain click selects nothing).
             let (by_material, diagonal) = (

@@ -39,6 +39,21 @@ pub(super) fn selection(
                     "wand: solid",
                     "click: the connected solid voxels",
                 ),
+                (
+                    SelectMode::WandFace,
+                    "wand: face",
+                    "click a face: its connected coplanar region (the voxels of that layer whose face on that side shows)",
+                ),
+                (
+                    SelectMode::Rect,
+                    "rectangle",
+                    "drag a rectangle on the screen: every solid voxel inside it, through all depth",
+                ),
+                (
+                    SelectMode::RectVisible,
+                    "rectangle: visible",
+                    "drag a rectangle on the screen: the voxels it shows",
+                ),
             ] {
                 ui.selectable_value(&mut brush.select_mode, m, name)
                     .on_hover_text(format!(
@@ -46,10 +61,17 @@ pub(super) fn selection(
                     ));
             }
         });
-        if brush.select_mode == SelectMode::Box {
-            ui.add(egui::Slider::new(&mut brush.select_depth, 1..=256).text("box depth"));
-        } else {
-            ui.checkbox(&mut brush.wand_diagonal, "through edges and corners too");
+        match brush.select_mode {
+            SelectMode::Box => {
+                ui.add(egui::Slider::new(&mut brush.select_depth, 1..=256).text("box depth"));
+            }
+            SelectMode::Rect | SelectMode::RectVisible => {}
+            SelectMode::WandFace => {
+                ui.checkbox(&mut brush.wand_diagonal, "through corners too");
+            }
+            SelectMode::WandColour | SelectMode::WandSolid => {
+                ui.checkbox(&mut brush.wand_diagonal, "through edges and corners too");
+            }
         }
     }
     ui.checkbox(&mut brush.in_selection, "brush only inside the selection");

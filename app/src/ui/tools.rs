@@ -59,6 +59,12 @@ pub enum SelectMode {
     WandColour,
     /// A click: the connected solid voxels.
     WandSolid,
+    /// A click on a face: its connected coplanar exposed region.
+    WandFace,
+    /// A rectangle dragged on the screen: every solid voxel inside, through all depth.
+    Rect,
+    /// A rectangle dragged on the screen: the voxels it shows.
+    RectVisible,
 }
 
 /// What the left button does in the viewport.

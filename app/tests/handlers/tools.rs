@@ -138,3 +138,63 @@ pub fn the_colour_modes_are_chosen_in_the_tools_panel(s: &mut Session) {
     assert_eq!(s.state().0, before.0, "undone");
     tap(s, KeyCode::KeyT);
 }
+
+fn selected(s: &Session) -> u64 {
+    let doc = s.ed.document();
+    let d = doc.read().unwrap();
+    d.scene.selection.as_ref().map_or(0, |x| x.voxels.count())
+}
+
+/// The selection tool's new modes from the Tools panel: "wand: face" takes the clicked face's
+/// region; "rectangle" a screen rectangle through all depth; "rectangle: visible" fewer
+/// voxels, only those it shows; Shift + Ctrl on a box drag keeps what both hold.
+pub fn the_face_wand_and_screen_rectangles_select(s: &mut Session) {
+    s.quiet();
+    tap(s, KeyCode::KeyM);
+    s.click_on("wand: face", MouseButton::Left);
+    let at = s.on_the_terrain();
+    s.to(at);
+    s.frame();
+    s.left(true);
+    s.left(false);
+    s.quiet();
+    let (label, _) = last_command(s).expect("a step");
+    assert!(label.starts_with("Select the face region at"), "{label}");
+    let face = selected(s);
+    assert!(face > 0);
+    let (x0, y0, w, h) = s.ed.view_area();
+    let centre = (
+        f64::from(x0) + f64::from(w) * 0.5,
+        f64::from(y0) + f64::from(h) * 0.5,
+    );
+    let (p1, p2) = (
+        (centre.0 - f64::from(w) / 5.0, centre.1 - f64::from(h) / 6.0),
+        (centre.0 + f64::from(w) / 5.0, centre.1 + f64::from(h) / 6.0),
+    );
+    assert!(!s.ed.on_ui_at(p1.0, p1.1) && !s.ed.on_ui_at(p2.0, p2.1));
+    let drag = |s: &mut Session| {
+        s.to(p1);
+        s.frame();
+        s.left(true);
+        s.to(((p1.0 + p2.0) * 0.5, (p1.1 + p2.1) * 0.5));
+        s.frame();
+        s.to(p2);
+        s.frame();
+        s.left(false);
+        s.quiet();
+        selected(s)
+    };
+    s.click_on("rectangle", MouseButton::Left);
+    let all = drag(s);
+    s.click_on("rectangle: visible", MouseButton::Left);
+    let visible = drag(s);
+    assert!(
+        0 < visible && visible < all,
+        "visible {visible}, all depth {all}"
+    );
+    let (label, _) = last_command(s).expect("a step");
+    assert!(label.contains("visible voxels"), "{label}");
+    s.ctrl(KeyCode::KeyD);
+    s.click_on("box", MouseButton::Left);
+    tap(s, KeyCode::KeyT);
+}
