@@ -25,6 +25,25 @@ pub enum ScaleStep {
     Halve,
 }
 
+/// The × ½ rule for one 2 × 2 × 2 block (its voxels' materials, None where empty): solid
+/// when at least 4 of the 8 are, with the material most of them have, the lowest index
+/// where two are as many.
+pub fn majority(block: impl IntoIterator<Item = Option<u8>>) -> Option<u8> {
+    let mut counts: Vec<(u8, u32)> = Vec::new();
+    let mut n = 0;
+    for m in block.into_iter().flatten() {
+        n += 1;
+        match counts.iter_mut().find(|(c, _)| *c == m) {
+            Some((_, c)) => *c += 1,
+            None => counts.push((m, 1)),
+        }
+    }
+    (n >= 4).then(|| {
+        counts.sort_by_key(|(m, c)| (std::cmp::Reverse(*c), *m));
+        counts[0].0
+    })
+}
+
 /// The new box's low corner and how a source voxel's offset from the old one maps.
 fn placement(step: ScaleStep, lo: IVec3, size: IVec3) -> IVec3 {
     match step {
@@ -81,22 +100,10 @@ pub fn scale_edit(
                 for y in 0..half.y {
                     for z in 0..half.z {
                         let u = IVec3::new(x, y, z);
-                        let mut counts: Vec<(u8, u32)> = Vec::new();
-                        let mut n = 0;
-                        for k in 0..8 {
-                            let v = lo + 2 * u + IVec3::new(k & 1, k >> 1 & 1, k >> 2);
-                            if let Some(m) = solid(v) {
-                                n += 1;
-                                match counts.iter_mut().find(|(c, _)| *c == m) {
-                                    Some((_, c)) => *c += 1,
-                                    None => counts.push((m, 1)),
-                                }
-                            }
-                        }
-                        if n >= 4 {
-                            // Most voxels; the lowest index among equals.
-                            counts.sort_by_key(|(m, c)| (std::cmp::Reverse(*c), *m));
-                            out.push((to + u, counts[0].0));
+                        let block = (0..8)
+                            .map(|k| solid(lo + 2 * u + IVec3::new(k & 1, k >> 1 & 1, k >> 2)));
+                        if let Some(m) = majority(block) {
+                            out.push((to + u, m));
                         }
                     }
                 }

@@ -104,6 +104,79 @@ pub(super) fn canvas_op(
         t: n.placement.t + n.placement.rot.apply(off + half(new_size) - half(size)),
         ..n.placement
     };
+    Ok(replace_model(objects, node, model, voxels, placement))
+}
+
+/// The model of `node` (now `model`) scaled × 2 (each voxel a 2³ block) or × ½ (each 2³
+/// block's majority, `selection_scale::majority`) about its centre: the object keeps its
+/// placement, so its pivot stays where it is; × 2 then × ½ is the identity.
+pub(super) fn scale_op(
+    objects: &Objects,
+    node: NodeId,
+    step: crate::selection_scale::ScaleStep,
+    table: &MaterialTable,
+) -> super::error::Result<ObjectOp> {
+    use crate::selection_scale::{ScaleStep, majority};
+    let tree = objects.tree();
+    let n = tree.node(node)?;
+    let NodeKind::Object { model, .. } = n.kind else {
+        return Err(ObjectError::NotAnObject(node).into());
+    };
+    let old = objects.model(model).ok_or(ObjectError::NoModel(model))?;
+    let size = old.size();
+    let voxels = || {
+        old.bricks().flat_map(|(b, brick)| {
+            let min = b.as_ivec3() * 8;
+            brick.mask.ones().map(move |bit| {
+                let v = min + IVec3::new(bit as i32 & 7, (bit as i32 >> 3) & 7, bit as i32 >> 6);
+                (v, brick.material(bit))
+            })
+        })
+    };
+    let new = match step {
+        ScaleStep::Double => Model::from_voxels(
+            size * 2,
+            voxels().flat_map(|(v, m)| {
+                (0..8).map(move |k| (2 * v + IVec3::new(k & 1, k >> 1 & 1, k >> 2), m))
+            }),
+            table,
+        )?,
+        ScaleStep::Halve => {
+            if size.cmple(IVec3::ONE).all() {
+                return Err(super::error::EditError::NothingToDo(
+                    "a one-voxel object cannot be halved",
+                ));
+            }
+            let by: std::collections::HashMap<IVec3, u8> = voxels().collect();
+            let mut blocks: std::collections::BTreeSet<(i32, i32, i32)> = Default::default();
+            for v in by.keys() {
+                let u = v.div_euclid(IVec3::splat(2));
+                blocks.insert((u.x, u.y, u.z));
+            }
+            let kept = blocks.into_iter().filter_map(|(x, y, z)| {
+                let u = IVec3::new(x, y, z);
+                let block = (0..8).map(|k| {
+                    by.get(&(2 * u + IVec3::new(k & 1, k >> 1 & 1, k >> 2)))
+                        .copied()
+                });
+                majority(block).map(|m| (u, m))
+            });
+            Model::from_voxels((size + 1) / 2, kept.collect::<Vec<_>>(), table)?
+        }
+    };
+    Ok(replace_model(objects, node, model, new, n.placement))
+}
+
+/// The ops that make `node` place `voxels` (a new model) at `placement` instead of `model`,
+/// dropping `model` when no other object places it.
+fn replace_model(
+    objects: &Objects,
+    node: NodeId,
+    model: ModelId,
+    voxels: Model,
+    placement: Placement,
+) -> ObjectOp {
+    let tree = objects.tree();
     let fresh: ModelId = objects.free_model_id();
     let mut ops = vec![
         ObjectOp::AddModel {
@@ -116,7 +189,7 @@ pub(super) fn canvas_op(
     if tree.instances(model).len() == 1 {
         ops.push(ObjectOp::RemoveModel { model });
     }
-    Ok(ObjectOp::Batch(ops))
+    ObjectOp::Batch(ops)
 }
 
 /// The box of a model's voxels (inclusive), if it has any.

@@ -136,6 +136,13 @@ pub enum ObjectCommand {
         /// Where its lowest corner goes.
         at: IVec3,
     },
+    /// Scale an object's model × 2 or × ½ about its centre (its pivot stays).
+    Scale {
+        /// The object.
+        node: NodeId,
+        /// × 2 or × ½.
+        step: crate::selection_scale::ScaleStep,
+    },
     /// Changes an object's model's canvas ([`super::canvas`]): fit, crop or resize.
     Canvas {
         /// The object.
@@ -189,6 +196,7 @@ impl ObjectCommand {
                 format!("New object {name:?} {}×{}×{}", size.x, size.y, size.z)
             }
             Self::Canvas { node, how } => format!("Canvas of #{}: {how:?}", node.0),
+            Self::Scale { node, step } => format!("Scale #{}: {step:?}", node.0),
             Self::ShowLayer { layer, visible } => format!(
                 "{} layer {}",
                 if *visible { "Show" } else { "Hide" },
@@ -296,6 +304,7 @@ impl ObjectCommand {
             Self::Instance { node, offset } => arrange::instance(&objects, *node, *offset)?,
             Self::MakeUnique(node) => arrange::make_unique(&objects, *node)?,
             Self::Canvas { node, how } => super::canvas::canvas_op(&objects, *node, *how, &table)?,
+            Self::Scale { node, step } => super::canvas::scale_op(&objects, *node, *step, &table)?,
             Self::Delete(nodes) => arrange::delete(&objects, nodes)?,
             Self::Group { nodes, name } => arrange::group(&objects, nodes, name)?,
             Self::Ungroup(node) => arrange::ungroup(&objects, *node)?,

@@ -88,12 +88,8 @@ impl Editor {
             Action::SelectAll => self.select(SelectOp::All),
             Action::SelectNone => self.select(SelectOp::None),
             Action::InvertSelection => self.select(SelectOp::Invert),
-            Action::DoubleSelection => self.execute(Command::ScaleSelection(
-                crate::selection_scale::ScaleStep::Double,
-            )),
-            Action::HalveSelection => self.execute(Command::ScaleSelection(
-                crate::selection_scale::ScaleStep::Halve,
-            )),
+            Action::DoubleSelection => self.scale(crate::selection_scale::ScaleStep::Double),
+            Action::HalveSelection => self.scale(crate::selection_scale::ScaleStep::Halve),
             Action::GrowSelection => self.select(SelectOp::Grow),
             Action::ShrinkSelection => self.select(SelectOp::Shrink),
             Action::SelectMaterial => self.select(SelectOp::Material {
@@ -136,6 +132,19 @@ impl Editor {
 
     /// A turn or a flip of the picked nodes in arrange mode; else of the selection's voxels
     /// when there is a selection, of the object brushes edit when not.
+    /// × 2 / × ½: the selection's voxels, or without one the edited object's model.
+    fn scale(&mut self, step: crate::selection_scale::ScaleStep) {
+        let (selected, node) = {
+            let doc = self.read();
+            (doc.scene.selection.is_some(), doc.scene.active())
+        };
+        if selected && self.settings.brush.tool != Tool::Arrange {
+            self.execute(Command::ScaleSelection(step));
+        } else if let Some(node) = node {
+            self.execute(Command::Object(ObjectCommand::Scale { node, step }));
+        }
+    }
+
     fn turn_or_flip(&mut self, t: SelectionTransform) {
         if self.settings.brush.tool != Tool::Arrange && self.read().scene.selection.is_some() {
             self.execute(Command::TransformSelection(t));

@@ -135,6 +135,24 @@ fn canvas(ui: &mut egui::Ui, doc: &Document, form: &mut CanvasForm, out: &mut Ve
     let send = |out: &mut Vec<UiEvent>, how| {
         out.push(UiEvent::Objects(ObjectCommand::Canvas { node, how }));
     };
+    for (name, step) in [
+        (
+            "Scale the object × 2",
+            crate::selection_scale::ScaleStep::Double,
+        ),
+        (
+            "Scale the object × ½",
+            crate::selection_scale::ScaleStep::Halve,
+        ),
+    ] {
+        if ui
+            .button(name)
+            .on_hover_text("its model, about its pivot (× ½: the majority of each 2 × 2 × 2)")
+            .clicked()
+        {
+            out.push(UiEvent::Objects(ObjectCommand::Scale { node, step }));
+        }
+    }
     if ui.button("Fit canvas to content").clicked() {
         send(out, Canvas::Fit);
     }

@@ -15,6 +15,8 @@ use glam::{DVec3, IVec3};
 use std::collections::HashMap;
 use std::path::PathBuf;
 
+mod canvas;
+
 fn asset(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../assets/vox")
@@ -602,72 +604,4 @@ fn damaged_files_imported_as_objects_change_nothing_or_undo_exactly() {
     assert!(refused >= 6, "the seeds are refused ({refused})");
     assert!(imported > 0, "some damage is harmless ({imported})");
     std::fs::remove_dir_all(&dir).ok();
-}
-
-/// The canvas of every object of a MagicaVoxel scene (many turned): fit to content, crop
-/// to a box, resize with each anchor; the world keeps its voxels (a crop drops exactly what
-/// lies outside), the composite stays exact, and undo gives the tree and the world back.
-#[test]
-fn canvas_fit_crop_and_resize_keep_the_world_and_undo_exactly() {
-    use app::editor::canvas::Canvas;
-    let scene = app::formats::load(&asset("ogt_test_multiple_model_scene.vox"), 2).unwrap();
-    let mut doc = Document::new(scene, History::default());
-    let objects = objects_in_order(&doc);
-    let start = (outline(&doc), doc.scene.world.read().content_hash());
-    let world = |doc: &Document| reference(&doc.scene.objects());
-    let mut done = 0;
-    for (k, node) in objects.iter().enumerate().take(12) {
-        let (lo, hi) = {
-            let o = doc.scene.objects();
-            let tree = o.tree();
-            let m = match tree.node(*node).unwrap().kind {
-                NodeKind::Object { model, .. } => o.model(model).unwrap().size(),
-                NodeKind::Group { .. } => unreachable!(),
-            };
-            tree.world_placement(*node).unwrap().bounds(m)
-        };
-        let before = (outline(&doc), world(&doc));
-        let hows = [
-            Canvas::Resize {
-                size: hi - lo + IVec3::new(3, 2, 5),
-                anchor: IVec3::new(-1, 0, 1),
-            },
-            Canvas::Resize {
-                size: (hi - lo - 1).max(IVec3::ONE),
-                anchor: IVec3::new(1, -1, 0),
-            },
-            Canvas::Fit,
-            Canvas::Crop {
-                min: lo + 1,
-                max: hi - 2,
-            },
-        ];
-        let how = hows[k % hows.len()];
-        match doc.execute(Command::Object(ObjectCommand::Canvas { node: *node, how })) {
-            Ok(_) => done += 1,
-            // An object already tight refuses Fit, a crop inside nothing refuses.
-            Err(e) => {
-                assert_eq!((outline(&doc), world(&doc)), before, "{how:?}: {e}");
-                continue;
-            }
-        }
-        assert_composite(&doc, &format!("{how:?} of #{}", node.0));
-        let after = world(&doc);
-        // Every voxel left is where and what it was (a crop or a shrink only drops some).
-        for (v, m) in &after {
-            assert_eq!(before.1.get(v), Some(m), "{how:?}: a voxel appeared at {v}");
-        }
-        let grows = matches!(how, Canvas::Resize { anchor, .. } if anchor == IVec3::new(-1, 0, 1));
-        if matches!(how, Canvas::Fit) || grows {
-            assert_eq!(after.len(), before.1.len(), "{how:?} keeps every voxel");
-        }
-        doc.undo().unwrap();
-        assert_eq!((outline(&doc), world(&doc)), before, "undo of {how:?}");
-        assert_composite(&doc, "undone");
-    }
-    assert!(done >= 8, "only {done} of 12 canvas changes applied");
-    assert_eq!(
-        (outline(&doc), doc.scene.world.read().content_hash()),
-        start
-    );
 }
