@@ -258,7 +258,9 @@ impl Editor {
                 l.as_secs_f64() * 1e3
             )),
         );
-        self.panels.status = self.status_line(&figures);
+        // One pick ray a frame: the status line and the ruler share it.
+        let hovered = self.hovered();
+        self.panels.status = self.status_line(&figures, hovered);
         gfx.set_title(files::title(&self.read()));
         let raw = gfx.host.take_egui_input();
         let egui_ctx = self.egui.clone();
@@ -332,10 +334,7 @@ impl Editor {
             let band = super::arranging::boxing_band(self);
             // The ruler (Measure tool): its ends, the second following the cursor.
             let ruler = (self.settings.brush.tool == super::tools::Tool::Measure)
-                .then(|| {
-                    let hovered = self.hovered().map(|(v, _)| v);
-                    self.pointer.ruler.ends(hovered)
-                })
+                .then(|| self.pointer.ruler.ends(hovered.map(|(v, _)| v)))
                 .flatten();
             // Outside arrange mode, the box of the object brushes edit (when it is not the
             // scene's only object).
@@ -355,6 +354,9 @@ impl Editor {
                 self.preview.paint(&painter, &self.viewing.camera, rect);
                 let brush = &self.settings.brush;
                 let dims = doc.scene.world.dims().voxels();
+                self.preview.set_selection(doc.scene.selection.as_ref());
+                self.preview
+                    .paint_selection(&painter, &self.viewing.camera, rect);
                 selecting::paint(
                     &painter,
                     &self.viewing.camera,

@@ -205,6 +205,11 @@ impl Editor {
         })
     }
 
+    /// How many voxel faces tint a selection made as a set (0: none, or a box selection).
+    pub fn selection_tint_faces(&self) -> usize {
+        self.preview.selection_faces()
+    }
+
     /// How many voxel faces the paste being placed, or the Stamp tool, shows (0: neither, or
     /// too large a clip).
     pub fn paste_preview_faces(&self) -> usize {

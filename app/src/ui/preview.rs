@@ -55,6 +55,8 @@ pub struct Preview {
     /// paste or stamps being placed (the clip they are of, by address, and the turn;
     /// computed once per clip and turn).
     paste: Option<((usize, i32), Faces)>,
+    /// A set selection's outer faces (the set they are of, by address).
+    selection: Option<(usize, Faces)>,
     requests: Option<Sender<(SharedDocument, Key)>>,
     results: Receiver<(Key, Shown)>,
     /// The latest stroke asked for (None: nothing to show).
@@ -91,6 +93,7 @@ impl Preview {
             .expect("spawning the preview thread");
         Self {
             paste: None,
+            selection: None,
             requests: Some(requests),
             results,
             wanted: None,
@@ -136,6 +139,37 @@ impl Preview {
             }
             let bricks: Vec<(IVec3, Mask)> = set.iter().map(|(b, m)| (b.as_ivec3(), *m)).collect();
             self.paste = Some((key, outer_faces(&bricks)));
+        }
+    }
+
+    /// Keeps the outer faces of a selection made as a set (a wand, a rectangle: its boxes do
+    /// not say what it holds), recomputed only for another set; none over
+    /// [`PASTE_PREVIEW_VOXELS`] voxels (its bounds are outlined instead).
+    pub fn set_selection(&mut self, selection: Option<&Selection>) {
+        let Some(s) = selection
+            .filter(|s| s.region.base.is_some() && s.voxels.count() <= PASTE_PREVIEW_VOXELS)
+        else {
+            self.selection = None;
+            return;
+        };
+        let id = Arc::as_ptr(&s.voxels) as usize;
+        if self.selection.as_ref().is_none_or(|(k, _)| *k != id) {
+            let bricks: Vec<(IVec3, Mask)> =
+                s.voxels.iter().map(|(b, m)| (b.as_ivec3(), *m)).collect();
+            self.selection = Some((id, outer_faces(&bricks)));
+        }
+    }
+
+    /// How many faces the selection's tint has (0: none kept).
+    pub fn selection_faces(&self) -> usize {
+        self.selection.as_ref().map_or(0, |(_, f)| f.len())
+    }
+
+    /// Paints the kept selection's voxels, translucent.
+    pub fn paint_selection(&self, painter: &egui::Painter, view: &ViewCamera, rect: egui::Rect) {
+        if let Some((_, faces)) = &self.selection {
+            let colour = egui::Color32::from_rgba_unmultiplied(255, 210, 60, 45);
+            paint_faces(painter, view, rect, faces, DVec3::ZERO, colour);
         }
     }
 

@@ -6,8 +6,13 @@ use super::Editor;
 use super::tools::Tool;
 
 impl Editor {
-    /// The status line, ending with `figures` (samples, GPU time, device…).
-    pub(super) fn status_line(&self, figures: &str) -> String {
+    /// The status line, ending with `figures` (samples, GPU time, device…); `hovered` is
+    /// the voxel and face under the cursor ([`Editor::hovered`], cast once per frame).
+    pub(super) fn status_line(
+        &self,
+        figures: &str,
+        hovered: Option<(glam::IVec3, glam::IVec3)>,
+    ) -> String {
         let tool = self.settings.brush.tool;
         let mut parts = Vec::new();
         let doc = self.read();
@@ -27,7 +32,6 @@ impl Editor {
                 )
         });
         drop(doc);
-        let hovered = self.hovered();
         if let Some((voxel, normal)) = hovered {
             parts.push(super::measure::hover_text(voxel, normal));
         }

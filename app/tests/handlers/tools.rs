@@ -162,6 +162,10 @@ pub fn the_face_wand_and_screen_rectangles_select(s: &mut Session) {
     assert!(label.starts_with("Select the face region at"), "{label}");
     let face = selected(s);
     assert!(face > 0);
+    assert!(
+        s.ed.selection_tint_faces() >= face as usize,
+        "the face region's voxels are tinted"
+    );
     let (x0, y0, w, h) = s.ed.view_area();
     let centre = (
         f64::from(x0) + f64::from(w) * 0.5,
