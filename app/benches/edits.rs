@@ -1,8 +1,9 @@
 //! CPU time of the editor's edits on the default scene (512 × 256 × 512 terrain): sphere
 //! strokes of radius 16 and 64 (attach and erase), and a 256 × 64 × 256 selection through the
 //! surface: select, copy, paste, move by a voxel and by a brick, turn, mirror, delete, fill;
-//! the magic wand; and the brush
-//! preview (the voxels a click would change) for both spheres. Each timed run
+//! the magic wand; extrude; an object's scale × 2 / × ½ (128³); four stamps of the copy; a
+//! paint stroke in each colour mode; and the brush preview (the voxels a click would change)
+//! for both spheres. Each timed run
 //! is one command as the editor executes it (world edit on the workers, inverse, history);
 //! the undo that puts the scene back between runs is not timed.
 //!
@@ -225,4 +226,73 @@ fn preview_sphere(bencher: Bencher, radius: f64) {
             .unwrap()
             .map(|v| v.len())
     });
+}
+
+/// Scale × 2 of a 128³ object holding a ball of radius 63 (1.05 M voxels → 8.4 M), in a
+/// 256³ grid, and × ½ of the doubled one back.
+#[divan::bench(args = ["double", "halve"], sample_count = 10, sample_size = 1)]
+fn scale_object(bencher: Bencher, how: &str) {
+    use app::selection_scale::ScaleStep;
+    let scene = app::scene::Scene::empty(brickmap::GridDims::new(32, 32, 32).unwrap(), 0).unwrap();
+    let mut doc = Document::new(scene, History::default());
+    doc.execute(Command::Object(ObjectCommand::NewObject {
+        name: "ball".into(),
+        size: IVec3::splat(128),
+        at: IVec3::splat(64),
+    }))
+    .unwrap();
+    let mut ball = sphere(BrushMode::Attach, 63.0);
+    if let Command::Stroke(s) = &mut ball {
+        s.points = vec![DVec3::splat(128.0)];
+        s.material = 0;
+    }
+    doc.execute(ball).unwrap();
+    let node = doc.scene.active().unwrap();
+    if how == "halve" {
+        doc.execute(Command::Object(ObjectCommand::Scale {
+            node,
+            step: ScaleStep::Double,
+        }))
+        .unwrap();
+    }
+    let step = if how == "double" {
+        ScaleStep::Double
+    } else {
+        ScaleStep::Halve
+    };
+    run(
+        bencher,
+        doc,
+        Command::Object(ObjectCommand::Scale { node, step }),
+    );
+}
+
+/// The 256 × 64 × 256 selection's copy stamped at 4 places along a row, turned a quarter.
+#[divan::bench(sample_count = 10, sample_size = 1)]
+fn stamp_four(bencher: Bencher) {
+    let doc = selected();
+    let at = (0..4).map(|k| IVec3::new(20 + 70 * k, 120, 100)).collect();
+    run(bencher, doc, Command::Stamp { at, quarters: 1 });
+}
+
+/// A paint stroke of radius 16 across the terrain (12 points) in each colour mode.
+#[divan::bench(args = ["solid", "gradient", "random", "darken"], sample_count = 20, sample_size = 1)]
+fn paint_stroke(bencher: Bencher, how: &str) {
+    use app::editor::command::PaintMode;
+    let mut stroke = sphere(BrushMode::Paint, 16.0);
+    if let Command::Stroke(s) = &mut stroke {
+        s.points = (0..12)
+            .map(|k| DVec3::new(150.0 + 16.0 * k as f64, 77.0, 256.0))
+            .collect();
+        s.paint = match how {
+            "gradient" => PaintMode::Gradient { to: 3 },
+            "random" => PaintMode::Random {
+                among: vec![0, 1, 2, 3],
+                seed: 5,
+            },
+            "darken" => PaintMode::Darken,
+            _ => PaintMode::Solid,
+        };
+    }
+    run(bencher, document(), stroke);
 }

@@ -147,21 +147,36 @@ pub(super) fn scale_op(
                     "a one-voxel object cannot be halved",
                 ));
             }
-            let by: std::collections::HashMap<IVec3, u8> = voxels().collect();
-            let mut blocks: std::collections::BTreeSet<(i32, i32, i32)> = Default::default();
-            for v in by.keys() {
-                let u = v.div_euclid(IVec3::splat(2));
-                blocks.insert((u.x, u.y, u.z));
+            // Brick by brick of the new model: the 2 × 2 × 2 old bricks it covers, looked up
+            // once, each new voxel the majority of its 8.
+            let mut new_bricks: std::collections::BTreeSet<(u32, u32, u32)> = Default::default();
+            for (b, _) in old.bricks() {
+                let n = b / 2;
+                new_bricks.insert((n.x, n.y, n.z));
             }
-            let kept = blocks.into_iter().filter_map(|(x, y, z)| {
-                let u = IVec3::new(x, y, z);
-                let block = (0..8).map(|k| {
-                    by.get(&(2 * u + IVec3::new(k & 1, k >> 1 & 1, k >> 2)))
-                        .copied()
+            let mut kept = Vec::new();
+            for (x, y, z) in new_bricks {
+                let nb = glam::UVec3::new(x, y, z);
+                let olds: [Option<&brickmap::objects::ModelBrick>; 8] = std::array::from_fn(|k| {
+                    let k = k as u32;
+                    old.brick(nb * 2 + glam::UVec3::new(k & 1, k >> 1 & 1, k >> 2))
                 });
-                majority(block).map(|m| (u, m))
-            });
-            Model::from_voxels((size + 1) / 2, kept.collect::<Vec<_>>(), table)?
+                for bit in 0..512usize {
+                    let u = IVec3::new(bit as i32 & 7, (bit as i32 >> 3) & 7, bit as i32 >> 6);
+                    let block = (0..8).map(|k| {
+                        // The old voxel 2u + k of the 16³ the new brick covers.
+                        let o = 2 * u + IVec3::new(k & 1, k >> 1 & 1, k >> 2);
+                        let which = (o.x / 8 + 2 * (o.y / 8) + 4 * (o.z / 8)) as usize;
+                        let b = olds[which]?;
+                        let obit = brickmap::brick::voxel_bit(o.x & 7, o.y & 7, o.z & 7);
+                        b.mask.get(obit).then(|| b.material(obit))
+                    });
+                    if let Some(m) = majority(block) {
+                        kept.push((nb.as_ivec3() * 8 + u, m));
+                    }
+                }
+            }
+            Model::from_voxels((size + 1) / 2, kept, table)?
         }
     };
     Ok(replace_model(objects, node, model, new, n.placement))

@@ -48,9 +48,17 @@ pub(super) fn stamp_edit(
     }
     let rot = Orientation::quarter_turn(Axis::Y, quarters);
     let size = turned_size(clip.size, quarters);
-    let voxels_turned: Vec<(IVec3, u8)> = clip
+    // The turned voxels with the source brick they came from: `Writes::set_all` takes the
+    // voxels of one source brick at a time (they land in a few target bricks).
+    let voxels_turned: Vec<(IVec3, IVec3, u8)> = clip
         .solid_voxels()
-        .map(|(p, m)| (turned(&rot, p, clip.size, size), m))
+        .map(|(p, m)| {
+            (
+                p.div_euclid(IVec3::splat(8)),
+                turned(&rot, p, clip.size, size),
+                m,
+            )
+        })
         .collect();
     let mut writes = Writes::default();
     for a in at {
@@ -58,7 +66,9 @@ pub(super) fn stamp_edit(
         if (*a + size).cmple(IVec3::ZERO).any() || a.cmpge(voxels).any() {
             continue;
         }
-        writes.set_all(voxels, voxels_turned.iter().map(|(p, m)| (*a + *p, *m)));
+        for brick in voxels_turned.chunk_by(|x, y| x.0 == y.0) {
+            writes.set_all(voxels, brick.iter().map(|(_, p, m)| (*a + *p, *m)));
+        }
     }
     Ok(writes.into_edit())
 }
