@@ -5,6 +5,7 @@
 //! frame, and camera move → first frame showing it (frames and ms, submit to completion).
 
 mod objects;
+mod selection;
 
 use super::{args, emit, with_progress};
 use anyhow::{Result, bail};
@@ -495,7 +496,7 @@ fn edits(
         }
     }
     text += &first_clicks(&mut vp, &mut doc, size, &params, radii)?;
-    text += &selection_edits(&mut vp, &mut doc, size, &params)?;
+    text += &selection::selection_edits(&mut vp, &mut doc, size, &params)?;
     text += &objects::object_edits(&mut vp, &mut doc, size, &params)?;
     Ok(text)
 }
@@ -596,67 +597,4 @@ fn frames_until_shown(
     }
     vp.wait_idle()?;
     Ok((n, bytes))
-}
-
-/// A 256 × 64 × 256 selection of the default scene (through its surface): select, copy,
-/// paste, move by a voxel and by a brick, delete; each applied (timed), shown (timed, to
-/// the first frame with all of it uploaded), undone (not timed), several times.
-fn selection_edits(
-    vp: &mut Viewport,
-    doc: &mut app::editor::Document,
-    size: (u32, u32),
-    params: &render::SceneParams,
-) -> Result<String> {
-    use app::editor::command::Command;
-    use app::selection::SelectOp;
-    use glam::IVec3;
-    let req = edit_request(params, size, 0.5);
-    let (min, max) = (IVec3::new(64, 48, 64), IVec3::new(319, 111, 319));
-    // `undo`: the operation changes voxels, is shown, then undone for the next run.
-    let select = Command::Select(SelectOp::Replace { min, max });
-    let mut text = format!(
-        "\nselection {min} … {max} (256 x 64 x 256), internal scale 0.5, {} runs each\noperation                 voxels changed   apply ms median (max)   edit → frame ms median (max), frames   uploaded MB\n",
-        objects::REPEATS
-    );
-    let cases = [
-        ("select", select.clone(), false),
-        ("copy", Command::Copy, false),
-        (
-            "paste at (200,100,200)",
-            Command::Paste {
-                at: IVec3::new(200, 100, 200),
-            },
-            true,
-        ),
-        (
-            "move by (1,0,1)",
-            Command::MoveSelection(IVec3::new(1, 0, 1)),
-            true,
-        ),
-        (
-            "move by (8,0,8)",
-            Command::MoveSelection(IVec3::new(8, 0, 8)),
-            true,
-        ),
-        ("delete", Command::DeleteSelection, true),
-    ];
-    doc.execute(select)?;
-    doc.execute(Command::Copy)?;
-    frames_until_shown(vp, &doc.scene.world, &req)?;
-    for (name, command, undo) in cases {
-        let t = objects::timed(vp, doc, &req, &command, undo)?;
-        let shown_text = if undo {
-            format!(
-                "{:.1} ({:.1}), {:.0}                 {:.2}",
-                t.shown.0, t.shown.1, t.frames, t.mb
-            )
-        } else {
-            "- (no voxel changes)".into()
-        };
-        text += &format!(
-            "{name:<25} {:<16} {:.1} ({:.1})            {shown_text}\n",
-            t.changed, t.apply.0, t.apply.1
-        );
-    }
-    Ok(text)
 }
