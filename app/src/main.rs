@@ -69,7 +69,8 @@ struct EditorArgs {
 enum Command {
     /// Build the built-in default scene and print its statistics.
     Stats(cli::stats::StatsArgs),
-    /// Convert between project (.ron) and MagicaVoxel (.vox) files.
+    /// Convert between project (.ron) and MagicaVoxel (.vox) files, or to a mesh (.obj, .glb,
+    /// .gltf, .ply).
     Convert(cli::scene_file::ConvertArgs),
     /// Create a new scene file.
     New(cli::scene_file::NewArgs),

@@ -98,13 +98,26 @@ fn save(scene: &Scene, path: &std::path::Path) -> Result<()> {
     })
 }
 
-/// `voxbrick convert`: between project (.ron) and MagicaVoxel (.vox) files.
+/// `voxbrick convert`: between project (.ron) and MagicaVoxel (.vox) files, or to a mesh
+/// (.obj, .glb, .gltf, .ply).
 #[derive(clap::Args)]
 pub(crate) struct ConvertArgs {
     /// Input file (.ron or .vox).
     input: PathBuf,
-    /// Output file (.ron or .vox); replaced atomically.
+    /// Output file (.ron, .vox, or a mesh: .obj with .mtl and a palette PNG beside it, .glb,
+    /// .gltf, .ply); replaced atomically.
     output: PathBuf,
+    /// Mesh: one quad per voxel face (watertight) instead of merged rectangles (which meet
+    /// at T-junctions).
+    #[arg(long)]
+    faces: bool,
+    /// Mesh: one part per object (named; glTF nodes under their groups), transforms applied;
+    /// else the scene as shown, one mesh.
+    #[arg(long)]
+    per_object: bool,
+    /// Mesh: units per voxel (glTF reads metres).
+    #[arg(long, default_value_t = 1.0)]
+    voxel_size: f64,
     /// Offset added to imported .vox voxels, as X,Y,Z (the file is then flattened into one
     /// object; without it and --include-hidden, its objects are kept).
     #[arg(long, value_parser = args::ivec3, default_value = "0,0,0")]
@@ -152,7 +165,22 @@ pub(crate) fn convert(a: ConvertArgs, workers: usize) -> Result<()> {
             }
         },
     )?;
-    save(&scene, &a.output)?;
+    if app::formats::mesh::MeshFormat::of(&a.output).is_some() {
+        let options = app::formats::mesh::MeshOptions {
+            greedy: !a.faces,
+            per_object: a.per_object,
+            voxel_size: a.voxel_size,
+        };
+        let stats = with_progress(format!("writing {}", a.output.display()), || {
+            Ok(app::formats::mesh::export(&scene, &a.output, &options)?)
+        })?;
+        eprintln!(
+            "{} parts, {} quads, {} triangles",
+            stats.parts, stats.quads, stats.triangles
+        );
+    } else {
+        save(&scene, &a.output)?;
+    }
     eprintln!(
         "wrote {} in {:.2} s",
         a.output.display(),

@@ -18,9 +18,9 @@ pub(super) fn selection_edits(
 ) -> Result<String> {
     use app::editor::command::Command;
     use app::selection::SelectOp;
-    use glam::IVec3;
     use app::selection_transform::SelectionTransform;
     use brickmap::objects::Axis;
+    use glam::IVec3;
     let req = edit_request(params, size, 0.5);
     let (min, max) = (IVec3::new(64, 48, 64), IVec3::new(319, 111, 319));
     // The terrain's top voxel at (192, 192): the wand's and the extrude's start.

@@ -1,7 +1,9 @@
 //! File formats end to end: project round trips and hostile files, atomic saves, .vox
 //! import of every sample, import → export → import, scenes beyond 256³, rotations.
 
+#[path = "../common/mod.rs"]
 mod common;
+mod mesh;
 
 use app::Scene;
 use app::builtin::{SceneSize, default_scene};
