@@ -389,6 +389,22 @@ impl Writes {
         }
     }
 
+    /// Adds the writes of `other`, which only puts voxels (no clears) and none where this
+    /// puts one: its voxels become solid with their materials.
+    pub(crate) fn merge_puts(&mut self, other: Writes) {
+        for (key, t) in other.targets {
+            let mine = self.targets.entry(key).or_default();
+            mine.touched = mine.touched.or(&t.touched);
+            mine.solid = mine.solid.or(&t.solid);
+            if let Some(d) = t.dense {
+                let dense = mine.dense.get_or_insert_with(|| Box::new([0; 512]));
+                for bit in t.solid.ones() {
+                    dense[bit] = d[bit];
+                }
+            }
+        }
+    }
+
     fn target(&mut self, b: UVec3) -> &mut Target {
         self.targets.entry((b.x, b.y, b.z)).or_default()
     }

@@ -109,16 +109,42 @@ pub fn transform_edit(
         w.clear(b, sel);
     }
     let [ax, ay, az, k] = map.affine();
-    for (b, sel) in selection.voxels.iter() {
-        let (solid, dense) = view.brick_voxels(b);
-        let min = b.as_ivec3() * 8;
-        let base = ax * min.x + ay * min.y + az * min.z + k;
-        let keep = solid.and(sel);
-        let moved = keep.ones().map(|bit| {
-            let (x, y, z) = (bit as i32 & 7, (bit as i32 >> 3) & 7, bit as i32 >> 6);
-            (base + ax * x + ay * y + az * z, dense[bit])
-        });
-        w.set_all(voxels, moved);
+    // The voxels gathered on every core, a share of the source bricks each, then merged:
+    // the map is one to one, so no two shares put the same voxel.
+    let bricks: Vec<_> = selection.voxels.iter().collect();
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(16);
+    let share = bricks.len().div_ceil(threads).max(64);
+    let parts: Vec<Writes> = std::thread::scope(|s| {
+        let handles: Vec<_> = bricks
+            .chunks(share)
+            .map(|chunk| {
+                s.spawn(move || {
+                    let mut w = Writes::default();
+                    for (b, sel) in chunk {
+                        let (solid, dense) = view.brick_voxels(*b);
+                        let min = b.as_ivec3() * 8;
+                        let base = ax * min.x + ay * min.y + az * min.z + k;
+                        let keep = solid.and(sel);
+                        let moved = keep.ones().map(|bit| {
+                            let (x, y, z) =
+                                (bit as i32 & 7, (bit as i32 >> 3) & 7, bit as i32 >> 6);
+                            (base + ax * x + ay * y + az * z, dense[bit])
+                        });
+                        w.set_all(voxels, moved);
+                    }
+                    w
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("a gather thread"))
+            .collect()
+    });
+    for part in parts {
+        w.merge_puts(part);
     }
     let region = Region {
         base: selection.region.base.as_ref().map(|set| {
