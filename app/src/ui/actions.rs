@@ -29,6 +29,10 @@ impl Editor {
                 self.files
                     .pick(Purpose::Export, self.folder(), Some("scene.vox".into()))
             }
+            Action::ExportMesh => {
+                self.files
+                    .pick(Purpose::ExportMesh, self.folder(), Some("scene.glb".into()))
+            }
             Action::Frame => {
                 // In arrange mode with nodes picked: their boxes; else the scene's content.
                 let picked = (self.settings.brush.tool == Tool::Arrange)

@@ -237,6 +237,14 @@ impl Editor {
                 };
                 self.save_to(path, false)
             }
+            Purpose::ExportMesh => {
+                let path = if path.extension().is_none() {
+                    path.with_extension("glb")
+                } else {
+                    path
+                };
+                self.files.export_mesh(&self.doc, path)
+            }
             // Asks for the offset first (the import dialog), then `ImportVox`.
             Purpose::Import => self.panels.import = Some((path, [0, 0, 0])),
             Purpose::LoadPalette => self.files.load_palette(path),
@@ -263,6 +271,17 @@ impl Editor {
             Done::Palette(Ok(colours)) => self.execute(Command::SetPalette(colours)),
             Done::Palette(Err(e)) => self.panels.errors.push(format!("{e:#}")),
             Done::PaletteSaved(_, Ok(())) => {}
+            Done::MeshExported(path, Ok(stats)) => {
+                self.report
+                    .line(format_args!("exported mesh {}", path.display()));
+                self.panels.notify(format!(
+                    "Exported {} triangles ({} parts) to {}",
+                    stats.triangles,
+                    stats.parts,
+                    path.display()
+                ));
+            }
+            Done::MeshExported(_, Err(e)) => self.panels.errors.push(format!("{e:#}")),
             Done::PaletteSaved(path, Err(e)) => self
                 .panels
                 .errors

@@ -163,6 +163,8 @@ pub enum Done {
     Palette(Result<Vec<[u8; 3]>>),
     /// The palette was written (or failed to).
     PaletteSaved(PathBuf, Result<()>),
+    /// A mesh was exported (or failed to).
+    MeshExported(PathBuf, Result<crate::formats::mesh::MeshStats>),
     /// A save finished; `autosave` saves go to the recovery file and don't clean the document.
     Saved {
         /// Where.
@@ -271,6 +273,24 @@ impl FileWorker {
         self.spawn(format!("writing {}", path.display()), move || {
             let result = crate::formats::palette::save_png(&colours, &path).map_err(Into::into);
             Done::PaletteSaved(path, result)
+        });
+    }
+
+    /// Writes the document's scene as a mesh (merged rectangles, the format by the
+    /// extension) on a worker thread, reading it under a read lock.
+    pub fn export_mesh(&mut self, doc: &SharedDocument, path: PathBuf) {
+        let doc = doc.clone();
+        self.spawn(format!("exporting {}", path.display()), move || {
+            let result = match doc.read() {
+                Ok(d) => crate::formats::mesh::export(
+                    &d.scene,
+                    &path,
+                    &crate::formats::mesh::MeshOptions::default(),
+                )
+                .map_err(|e| anyhow::anyhow!("Could not export {e}")),
+                Err(_) => Err(anyhow::anyhow!("the document is unavailable")),
+            };
+            Done::MeshExported(path, result)
         });
     }
 

@@ -128,6 +128,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Ctrl + S / Ctrl + Shift + S", "save / save as"),
     ("Ctrl + I", "import .vox into the scene"),
     ("Ctrl + E", "export .vox"),
+    (
+        "Ctrl + Shift + E",
+        "export a mesh (.glb, .gltf, .obj, .ply)",
+    ),
     ("F1", "this list"),
     ("Ctrl + Q", "quit"),
 ];

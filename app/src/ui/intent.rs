@@ -40,6 +40,8 @@ pub enum Action {
     Import,
     /// Export as .vox.
     Export,
+    /// Export a mesh (.glb, .gltf, .obj, .ply).
+    ExportMesh,
     /// Frame the scene's content.
     Frame,
     /// Switch between perspective and orthographic.

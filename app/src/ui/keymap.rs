@@ -211,6 +211,7 @@ pub fn default_bindings() -> Vec<Binding> {
         ("Ctrl+Shift+S", Action::SaveAs),
         ("Ctrl+I", Action::Import),
         ("Ctrl+E", Action::Export),
+        ("Ctrl+Shift+E", Action::ExportMesh),
         ("Ctrl+Q", Action::Quit),
         ("F", Action::Frame),
         ("O", Action::ToggleProjection),

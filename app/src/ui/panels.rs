@@ -151,6 +151,7 @@ pub fn draw(
                     ("Save As…  Ctrl+Shift+S", Action::SaveAs),
                     ("Import .vox…  Ctrl+I", Action::Import),
                     ("Export .vox…  Ctrl+E", Action::Export),
+                    ("Export mesh…  Ctrl+Shift+E", Action::ExportMesh),
                 ] {
                     if ui.button(label).clicked() {
                         out.push(UiEvent::Action(action));

@@ -12,6 +12,8 @@ pub enum Purpose {
     Import,
     /// Write a .vox.
     Export,
+    /// Write a mesh (.glb, .gltf, .obj, .ply).
+    ExportMesh,
     /// Read a palette (.png strip or .vox).
     LoadPalette,
     /// Write the palette as a PNG strip.
@@ -25,6 +27,7 @@ impl Purpose {
             Purpose::Open => ("Scenes", &["ron", "vox"]),
             Purpose::SaveAs => ("voxbrick project", &["ron"]),
             Purpose::Import | Purpose::Export => ("MagicaVoxel", &["vox"]),
+            Purpose::ExportMesh => ("Mesh", &["glb", "gltf", "obj", "ply"]),
             Purpose::LoadPalette => ("Palette", &["png", "vox"]),
             Purpose::SavePalette => ("PNG palette strip", &["png"]),
         }
@@ -34,7 +37,7 @@ impl Purpose {
     pub fn saves(self) -> bool {
         matches!(
             self,
-            Purpose::SaveAs | Purpose::Export | Purpose::SavePalette
+            Purpose::SaveAs | Purpose::Export | Purpose::ExportMesh | Purpose::SavePalette
         )
     }
 
@@ -45,6 +48,7 @@ impl Purpose {
             Purpose::SaveAs => "Save the scene as",
             Purpose::Import => "Import a .vox",
             Purpose::Export => "Export as .vox",
+            Purpose::ExportMesh => "Export a mesh",
             Purpose::LoadPalette => "Load a palette",
             Purpose::SavePalette => "Save the palette as",
         }

@@ -202,3 +202,30 @@ pub fn the_face_wand_and_screen_rectangles_select(s: &mut Session) {
     s.click_on("box", MouseButton::Left);
     tap(s, KeyCode::KeyT);
 }
+
+/// File → Export mesh (Ctrl + Shift + E) without a native dialog: the in-app browser asks,
+/// a typed name without an extension becomes a .glb, written on the file thread (a valid
+/// GLB header, the length it says), and the status line says how many triangles.
+pub fn the_scene_exports_as_a_mesh_from_the_browser(s: &mut Session, dir: &std::path::Path) {
+    s.chord(true, true, false, KeyCode::KeyE);
+    s.quiet();
+    assert!(s.ed.browser_open(), "Export mesh asks in the browser");
+    s.ctrl(KeyCode::KeyA);
+    s.ed.input(app::ui::Input::Text("exported".into()));
+    s.key(KeyCode::Enter, true);
+    s.key(KeyCode::Enter, false);
+    s.quiet();
+    s.quiet();
+    let file = dir.join("exported.glb");
+    let bytes = std::fs::read(&file).expect("the mesh was written");
+    assert_eq!(&bytes[..4], b"glTF");
+    assert_eq!(
+        u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize,
+        bytes.len()
+    );
+    let notice = s.ed.notice().unwrap_or_default().to_string();
+    assert!(
+        notice.starts_with("Exported ") && notice.contains("triangles"),
+        "{notice}"
+    );
+}
