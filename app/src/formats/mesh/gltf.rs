@@ -240,6 +240,14 @@ pub fn write(mesh: &Mesh, path: &Path, binary: bool) -> Result<(), FormatError> 
         text.push(b' ');
     }
     let total = 12 + 8 + text.len() + 8 + bin.len();
+    if total > u32::MAX as usize {
+        return Err(FormatError::invalid(
+            path,
+            format!(
+                "{total} bytes: a .glb holds at most 4 GiB (merge faces, or write .obj or .ply)"
+            ),
+        ));
+    }
     let mut out = Vec::with_capacity(total);
     out.extend_from_slice(b"glTF");
     out.extend_from_slice(&2u32.to_le_bytes());

@@ -106,17 +106,43 @@ pub fn quads(src: &dyn Bricks, see_through: &[bool; 256], greedy: bool) -> Vec<Q
     let mut planes: HashMap<Plane, Vec<(i32, i32, u8)>> = HashMap::new();
     let mut bricks = src.non_empty();
     bricks.sort_by_key(|b| (b.x, b.y, b.z));
+    let any_clear = see_through.iter().any(|c| *c);
+    let has_clear = |mask: &Mask, mats: &[u8; 512]| {
+        any_clear && mask.ones().any(|bit| see_through[mats[bit] as usize])
+    };
     for b in bricks {
         let Some((mask, mats)) = src.brick(b) else {
             continue;
         };
         let min = b * 8;
+        let clear_here = has_clear(&mask, &mats);
         for k in 0..6 {
             let axis = k / 2;
             let sign = if k % 2 == 0 { -1 } else { 1 };
             let mut d = IVec3::ZERO;
             d[axis] = sign;
             let next = src.brick(b + d);
+            let clear_next = next.as_ref().is_some_and(|(m, x)| has_clear(m, x));
+            if !clear_here && !clear_next {
+                // Opaque both sides: the faces are the solid voxels whose neighbour along d
+                // (inside the brick, or the next brick's facing layer) is empty — whole-mask
+                // shifts, then only those voxels visited.
+                let mut occupied = mask.shifted(-d);
+                if let Some((m, _)) = &next {
+                    occupied = occupied.or(&m.shifted(d * 7));
+                }
+                for bit in mask.and_not(&occupied).ones() {
+                    let l = IVec3::new(bit as i32 & 7, (bit as i32 >> 3) & 7, bit as i32 >> 6);
+                    let v = min + l;
+                    let plane = v[axis] + i32::from(sign > 0);
+                    let (u, w) = (v[(axis + 1) % 3], v[(axis + 2) % 3]);
+                    planes
+                        .entry((axis, sign, plane))
+                        .or_default()
+                        .push((u, w, mats[bit]));
+                }
+                continue;
+            }
             for bit in mask.ones() {
                 let l = IVec3::new(bit as i32 & 7, (bit as i32 >> 3) & 7, bit as i32 >> 6);
                 let n = l + d;
