@@ -80,6 +80,11 @@ impl Editor {
             Action::StampTool => self.settings.brush.tool = Tool::Stamp,
             Action::StampTurn => self.stamp_turn(1),
             Action::StampTurnBack => self.stamp_turn(-1),
+            Action::NextColourMode => self.settings.brush.next_colour_mode(),
+            Action::NextSelectMode => {
+                self.settings.brush.tool = Tool::Select;
+                self.settings.brush.select_mode = self.settings.brush.select_mode.next();
+            }
             Action::ToggleGrid => self.settings.grid = !self.settings.grid,
             Action::ArrangeTool => {
                 self.settings.brush.tool = if self.settings.brush.tool == Tool::Arrange {

@@ -62,6 +62,14 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "extrude: the face's connected region grows (or, dragged inward, sinks) by the distance dragged",
     ),
     (
+        "N",
+        "the brush's next colour mode: solid, gradient, random (paint: darken, brighten)",
+    ),
+    (
+        "Shift + M",
+        "the selection tool's next mode: box, wand by colour, solid, face, rectangle, visible",
+    ),
+    (
         "J, then drag (H / Shift + H turn)",
         "stamp the clipboard along the drag, a stamp every stamp's width",
     ),

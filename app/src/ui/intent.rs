@@ -74,6 +74,11 @@ pub enum Action {
     StampTurn,
     /// Turn it back.
     StampTurnBack,
+    /// The brush's next colour mode (solid, gradient, random; in paint mode darken and
+    /// brighten too).
+    NextColourMode,
+    /// The selection tool's next mode (box, the wands, the screen rectangles).
+    NextSelectMode,
     /// Arrange mode (pick and move objects), or back to the brush.
     ArrangeTool,
     /// Select the whole grid.

@@ -234,6 +234,8 @@ pub fn default_bindings() -> Vec<Binding> {
         ("J", Action::StampTool),
         ("H", Action::StampTurn),
         ("Shift+H", Action::StampTurnBack),
+        ("N", Action::NextColourMode),
+        ("Shift+M", Action::NextSelectMode),
         ("G", Action::ToggleGrid),
         ("Ctrl+A", Action::SelectAll),
         ("Ctrl+D", Action::SelectNone),

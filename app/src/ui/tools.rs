@@ -67,6 +67,20 @@ pub enum SelectMode {
     RectVisible,
 }
 
+impl SelectMode {
+    /// Shift + M: the next mode.
+    pub fn next(self) -> Self {
+        match self {
+            SelectMode::Box => SelectMode::WandColour,
+            SelectMode::WandColour => SelectMode::WandSolid,
+            SelectMode::WandSolid => SelectMode::WandFace,
+            SelectMode::WandFace => SelectMode::Rect,
+            SelectMode::Rect => SelectMode::RectVisible,
+            SelectMode::RectVisible => SelectMode::Box,
+        }
+    }
+}
+
 /// What the left button does in the viewport.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Tool {
@@ -139,6 +153,22 @@ impl Brush {
     /// The mirror planes' point.
     pub fn centre(&self, dims: IVec3) -> DVec3 {
         self.mirror_centre.unwrap_or(dims.as_dvec3() * 0.5)
+    }
+
+    /// N: the next colour mode (darken and brighten only while painting); a gradient starts
+    /// and ends at the current material, random picks among it alone, until chosen.
+    pub fn next_colour_mode(&mut self) {
+        let paint = self.mode == BrushMode::Paint;
+        self.paint = match self.paint {
+            PaintMode::Solid => PaintMode::Gradient { to: self.material },
+            PaintMode::Gradient { .. } => PaintMode::Random {
+                among: vec![self.material],
+                seed: 1,
+            },
+            PaintMode::Random { .. } if paint => PaintMode::Darken,
+            PaintMode::Darken => PaintMode::Brighten,
+            _ => PaintMode::Solid,
+        };
     }
 
     /// `[` / `]`: one smaller or larger, within 1..=[`MAX_SIZE`].
@@ -410,6 +440,33 @@ mod tests {
             None,
             "outside the grid"
         );
+    }
+
+    #[test]
+    fn the_colour_and_select_modes_cycle_back_to_the_start() {
+        let mut b = Brush {
+            mode: BrushMode::Paint,
+            material: 3,
+            ..Brush::default()
+        };
+        let mut seen = Vec::new();
+        for _ in 0..5 {
+            b.next_colour_mode();
+            seen.push(std::mem::discriminant(&b.paint));
+        }
+        assert_eq!(b.paint, PaintMode::Solid, "five steps while painting");
+        seen.dedup();
+        assert_eq!(seen.len(), 5);
+        b.mode = BrushMode::Attach;
+        for _ in 0..3 {
+            b.next_colour_mode();
+        }
+        assert_eq!(b.paint, PaintMode::Solid, "three while attaching");
+        let mut m = SelectMode::Box;
+        for _ in 0..6 {
+            m = m.next();
+        }
+        assert_eq!(m, SelectMode::Box);
     }
 
     #[test]
