@@ -601,30 +601,35 @@ fn extrude_and_plane_fill_change_exactly_their_region() {
 /// nothing.
 #[test]
 fn stamps_put_the_turned_clipboard_down_at_each_place() {
-    let mut doc = document();
-    let dims = doc.scene.world.dims().voxels();
     let (lo, hi) = (IVec3::new(40, 20, 50), IVec3::new(47, 34, 53));
-    // Something of several materials in the copied box.
-    doc.execute(stroke(
-        BrushMode::Attach,
-        BrushShape::Sphere,
-        3.0,
-        &[[43.0, 30.0, 51.0]],
-    ))
-    .unwrap();
-    let empty_clipboard = doc
-        .execute(Command::Stamp {
-            at: vec![IVec3::new(5, 40, 5)],
-            quarters: 0,
-        })
-        .unwrap_err();
-    assert!(empty_clipboard.is_no_op(), "{empty_clipboard}");
-    doc.execute(Command::Select(app::selection::SelectOp::Replace {
-        min: lo,
-        max: hi,
-    }))
-    .unwrap();
-    doc.execute(Command::Copy).unwrap();
+    // A scene with something of several materials in the box, the box copied (after a
+    // stamp with nothing copied is refused).
+    let copied = || {
+        let mut doc = document();
+        doc.execute(stroke(
+            BrushMode::Attach,
+            BrushShape::Sphere,
+            3.0,
+            &[[43.0, 30.0, 51.0]],
+        ))
+        .unwrap();
+        let empty_clipboard = doc
+            .execute(Command::Stamp {
+                at: vec![IVec3::new(5, 40, 5)],
+                quarters: 0,
+            })
+            .unwrap_err();
+        assert!(empty_clipboard.is_no_op(), "{empty_clipboard}");
+        doc.execute(Command::Select(app::selection::SelectOp::Replace {
+            min: lo,
+            max: hi,
+        }))
+        .unwrap();
+        doc.execute(Command::Copy).unwrap();
+        doc
+    };
+    let doc = copied();
+    let dims = doc.scene.world.dims().voxels();
     let clip: Vec<(IVec3, u8)> = {
         let view = doc.scene.world.read();
         every(lo, hi)
@@ -634,20 +639,7 @@ fn stamps_put_the_turned_clipboard_down_at_each_place() {
     assert!(clip.len() > 50, "the copy holds {} voxels", clip.len());
     let size = hi - lo + 1;
     for quarters in [0, 1, 3] {
-        let mut doc = document();
-        doc.execute(stroke(
-            BrushMode::Attach,
-            BrushShape::Sphere,
-            3.0,
-            &[[43.0, 30.0, 51.0]],
-        ))
-        .unwrap();
-        doc.execute(Command::Select(app::selection::SelectOp::Replace {
-            min: lo,
-            max: hi,
-        }))
-        .unwrap();
-        doc.execute(Command::Copy).unwrap();
+        let mut doc = copied();
         let before = state(&doc);
         let old = {
             let view = doc.scene.world.read();

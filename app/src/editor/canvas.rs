@@ -47,11 +47,7 @@ pub(super) fn canvas_op(
     table: &MaterialTable,
 ) -> super::error::Result<ObjectOp> {
     let tree = objects.tree();
-    let n = tree.node(node)?;
-    let NodeKind::Object { model, .. } = n.kind else {
-        return Err(ObjectError::NotAnObject(node).into());
-    };
-    let old = objects.model(model).ok_or(ObjectError::NoModel(model))?;
+    let (n, model, old) = object_model(objects, node)?;
     let size = old.size();
     // The new model's origin in the old model's voxels, and its size.
     let (off, new_size) = match how {
@@ -117,12 +113,7 @@ pub(super) fn scale_op(
     table: &MaterialTable,
 ) -> super::error::Result<ObjectOp> {
     use crate::selection_scale::{ScaleStep, majority};
-    let tree = objects.tree();
-    let n = tree.node(node)?;
-    let NodeKind::Object { model, .. } = n.kind else {
-        return Err(ObjectError::NotAnObject(node).into());
-    };
-    let old = objects.model(model).ok_or(ObjectError::NoModel(model))?;
+    let (n, model, old) = object_model(objects, node)?;
     let size = old.size();
     let voxels = || {
         old.bricks().flat_map(|(b, brick)| {
@@ -180,6 +171,19 @@ pub(super) fn scale_op(
         }
     };
     Ok(replace_model(objects, node, model, new, n.placement))
+}
+
+/// The node `node`, its model's id and its model (an error for a group or a missing model).
+fn object_model(
+    objects: &Objects,
+    node: NodeId,
+) -> super::error::Result<(&brickmap::objects::Node, ModelId, &Model)> {
+    let n = objects.tree().node(node)?;
+    let NodeKind::Object { model, .. } = n.kind else {
+        return Err(ObjectError::NotAnObject(node).into());
+    };
+    let old = objects.model(model).ok_or(ObjectError::NoModel(model))?;
+    Ok((n, model, old))
 }
 
 /// The ops that make `node` place `voxels` (a new model) at `placement` instead of `model`,

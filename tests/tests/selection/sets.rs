@@ -12,6 +12,18 @@ fn selected_set(doc: &Document) -> std::collections::HashSet<IVec3> {
         .unwrap_or_default()
 }
 
+/// The small default scene, its voxels and the top voxel of its column at (40, 50).
+fn terrain_top() -> (Document, Vec<Option<u8>>, IVec3) {
+    let doc = document();
+    let old = snapshot(&doc);
+    let top = (0..DIMS.y)
+        .rev()
+        .map(|y| IVec3::new(40, y, 50))
+        .find(|v| old[index(*v)].is_some())
+        .unwrap();
+    (doc, old, top)
+}
+
 /// The magic wand (by material and solid, through faces and corners), select by material,
 /// invert, grow and shrink, each combined as the modifiers say, against voxel-by-voxel
 /// references on the terrain; each is one undoable step.
@@ -19,15 +31,8 @@ fn selected_set(doc: &Document) -> std::collections::HashSet<IVec3> {
 fn set_selections_match_voxel_by_voxel_references() {
     use app::wand::Combine;
     use std::collections::HashSet;
-    let mut doc = document();
-    let old = snapshot(&doc);
+    let (mut doc, old, top) = terrain_top();
     let at = |v: IVec3| inside(v).then(|| old[index(v)]).flatten();
-    // The top voxel of the column at (40, 50).
-    let top = (0..DIMS.y)
-        .rev()
-        .map(|y| IVec3::new(40, y, 50))
-        .find(|v| at(*v).is_some())
-        .unwrap();
     let reference = |by_material: bool, diagonal: bool| {
         let m = at(top).unwrap();
         let mut seen = HashSet::from([top]);
@@ -141,14 +146,8 @@ fn set_selections_match_voxel_by_voxel_references() {
 fn the_face_wand_and_box_intersections_match_references() {
     use app::wand::Combine;
     use std::collections::HashSet;
-    let mut doc = document();
-    let old = snapshot(&doc);
+    let (mut doc, old, top) = terrain_top();
     let at = |v: IVec3| inside(v).then(|| old[index(v)]).flatten();
-    let top = (0..DIMS.y)
-        .rev()
-        .map(|y| IVec3::new(40, y, 50))
-        .find(|v| at(*v).is_some())
-        .unwrap();
     let m = at(top).unwrap();
     for (by_material, diagonal) in [(false, false), (true, false), (false, true)] {
         let takes = |v: IVec3| {

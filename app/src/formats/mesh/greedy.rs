@@ -132,19 +132,12 @@ pub fn quads(src: &dyn Bricks, see_through: &[bool; 256], greedy: bool) -> Vec<Q
                     occupied = occupied.or(&m.shifted(d * 7));
                 }
                 for bit in mask.and_not(&occupied).ones() {
-                    let l = IVec3::new(bit as i32 & 7, (bit as i32 >> 3) & 7, bit as i32 >> 6);
-                    let v = min + l;
-                    let plane = v[axis] + i32::from(sign > 0);
-                    let (u, w) = (v[(axis + 1) % 3], v[(axis + 2) % 3]);
-                    planes
-                        .entry((axis, sign, plane))
-                        .or_default()
-                        .push((u, w, mats[bit]));
+                    add_face(&mut planes, min + local(bit), axis, sign, mats[bit]);
                 }
                 continue;
             }
             for bit in mask.ones() {
-                let l = IVec3::new(bit as i32 & 7, (bit as i32 >> 3) & 7, bit as i32 >> 6);
+                let l = local(bit);
                 let n = l + d;
                 let other = if n.cmpge(IVec3::ZERO).all() && n.cmplt(IVec3::splat(8)).all() {
                     let nb = voxel_bit(n.x, n.y, n.z);
@@ -154,15 +147,8 @@ pub fn quads(src: &dyn Bricks, see_through: &[bool; 256], greedy: bool) -> Vec<Q
                     let nb = voxel_bit(w.x, w.y, w.z);
                     next.as_ref().and_then(|(m, x)| m.get(nb).then(|| x[nb]))
                 };
-                let m = mats[bit];
-                if shows(m, other, see_through) {
-                    let v = min + l;
-                    let plane = v[axis] + i32::from(sign > 0);
-                    let (u, w) = (v[(axis + 1) % 3], v[(axis + 2) % 3]);
-                    planes
-                        .entry((axis, sign, plane))
-                        .or_default()
-                        .push((u, w, m));
+                if shows(mats[bit], other, see_through) {
+                    add_face(&mut planes, min + l, axis, sign, mats[bit]);
                 }
             }
         }
@@ -183,6 +169,27 @@ pub fn quads(src: &dyn Bricks, see_through: &[bool; 256], greedy: bool) -> Vec<Q
         }
     }
     out
+}
+
+/// A voxel's position in its brick from its bit.
+fn local(bit: usize) -> IVec3 {
+    IVec3::new(bit as i32 & 7, (bit as i32 >> 3) & 7, bit as i32 >> 6)
+}
+
+/// Keeps the face of voxel `v` on the `sign` side of `axis` with its plane's others.
+fn add_face(
+    planes: &mut HashMap<Plane, Vec<(i32, i32, u8)>>,
+    v: IVec3,
+    axis: usize,
+    sign: i32,
+    m: u8,
+) {
+    let plane = v[axis] + i32::from(sign > 0);
+    let (u, w) = (v[(axis + 1) % 3], v[(axis + 2) % 3]);
+    planes
+        .entry((axis, sign, plane))
+        .or_default()
+        .push((u, w, m));
 }
 
 /// The quad of the rectangle `[u0, u1) × [w0, w1)` of a plane.
