@@ -97,14 +97,7 @@ pub fn write(mesh: &Mesh, path: &Path) -> Result<(), FormatError> {
     for c in 0..256 {
         let _ = writeln!(obj, "vt {} 0.5", (c as f64 + 0.5) / 256.0);
     }
-    let normals = [
-        IVec3::NEG_X,
-        IVec3::X,
-        IVec3::NEG_Y,
-        IVec3::Y,
-        IVec3::NEG_Z,
-        IVec3::Z,
-    ];
+    let normals = brickmap::FACES;
     for n in normals {
         let _ = writeln!(obj, "vn {} {} {}", n.x, n.y, n.z);
     }
