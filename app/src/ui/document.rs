@@ -243,7 +243,8 @@ impl Editor {
                 } else {
                     path
                 };
-                self.files.export_mesh(&self.doc, path)
+                let options = self.settings.mesh_export.clone();
+                self.files.export_mesh(&self.doc, path, options)
             }
             // Asks for the offset first (the import dialog), then `ImportVox`.
             Purpose::Import => self.panels.import = Some((path, [0, 0, 0])),

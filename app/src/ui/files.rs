@@ -276,18 +276,19 @@ impl FileWorker {
         });
     }
 
-    /// Writes the document's scene as a mesh (merged rectangles, the format by the
-    /// extension) on a worker thread, reading it under a read lock.
-    pub fn export_mesh(&mut self, doc: &SharedDocument, path: PathBuf) {
+    /// Writes the document's scene as a mesh (the format by the extension) on a worker
+    /// thread, reading it under a read lock.
+    pub fn export_mesh(
+        &mut self,
+        doc: &SharedDocument,
+        path: PathBuf,
+        options: crate::formats::mesh::MeshOptions,
+    ) {
         let doc = doc.clone();
         self.spawn(format!("exporting {}", path.display()), move || {
             let result = match doc.read() {
-                Ok(d) => crate::formats::mesh::export(
-                    &d.scene,
-                    &path,
-                    &crate::formats::mesh::MeshOptions::default(),
-                )
-                .map_err(|e| anyhow::anyhow!("Could not export {e}")),
+                Ok(d) => crate::formats::mesh::export(&d.scene, &path, &options)
+                    .map_err(|e| anyhow::anyhow!("Could not export {e}")),
                 Err(_) => Err(anyhow::anyhow!("the document is unavailable")),
             };
             Done::MeshExported(path, result)

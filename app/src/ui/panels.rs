@@ -46,6 +46,8 @@ pub struct ViewSettings {
     pub autosave_secs: u64,
     /// The brush.
     pub brush: super::tools::Brush,
+    /// How File → Export mesh makes the mesh.
+    pub mesh_export: crate::formats::mesh::MeshOptions,
 }
 
 impl Default for ViewSettings {
@@ -62,6 +64,7 @@ impl Default for ViewSettings {
             key_preset: Default::default(),
             autosave_secs: 180,
             brush: Default::default(),
+            mesh_export: Default::default(),
         }
     }
 }
@@ -157,6 +160,30 @@ pub fn draw(
                         out.push(UiEvent::Action(action));
                     }
                 }
+                ui.separator();
+                ui.label("mesh export options");
+                {
+                    let m = &mut view.mesh_export;
+                    ui.checkbox(&mut m.per_object, "one part per object")
+                        .on_hover_text("named; glTF nodes under their groups; else the scene as shown");
+                    let mut faces = !m.greedy;
+                    if ui
+                        .checkbox(&mut faces, "one quad per voxel face (watertight)")
+                        .on_hover_text("else coplanar faces of one material merged into rectangles, which meet at T-junctions")
+                        .changed()
+                    {
+                        m.greedy = !faces;
+                    }
+                    ui.horizontal(|ui| {
+                        ui.add(
+                            egui::DragValue::new(&mut m.voxel_size)
+                                .speed(0.01)
+                                .range(0.001..=1000.0),
+                        );
+                        ui.label("units per voxel (glTF: metres)");
+                    });
+                }
+                ui.separator();
                 ui.menu_button("Recent", |ui| {
                     if state.recent.is_empty() {
                         ui.label("(none)");

@@ -205,7 +205,8 @@ pub fn the_face_wand_and_screen_rectangles_select(s: &mut Session) {
 
 /// File → Export mesh (Ctrl + Shift + E) without a native dialog: the in-app browser asks,
 /// a typed name without an extension becomes a .glb, written on the file thread (a valid
-/// GLB header, the length it says), and the status line says how many triangles.
+/// GLB header, the length it says), and the status line says how many triangles; File →
+/// "one quad per voxel face" makes the next export larger.
 pub fn the_scene_exports_as_a_mesh_from_the_browser(s: &mut Session, dir: &std::path::Path) {
     s.chord(true, true, false, KeyCode::KeyE);
     s.quiet();
@@ -223,9 +224,36 @@ pub fn the_scene_exports_as_a_mesh_from_the_browser(s: &mut Session, dir: &std::
         u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize,
         bytes.len()
     );
-    let notice = s.ed.notice().unwrap_or_default().to_string();
-    assert!(
-        notice.starts_with("Exported ") && notice.contains("triangles"),
-        "{notice}"
-    );
+    let triangles = |s: &Session| {
+        let notice = s.ed.notice().unwrap_or_default().to_string();
+        assert!(
+            notice.starts_with("Exported ") && notice.contains("triangles"),
+            "{notice}"
+        );
+        notice["Exported ".len()..]
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse::<u64>()
+            .unwrap()
+    };
+    let merged = triangles(s);
+    // File → one quad per voxel face: the next export has more triangles.
+    s.click_on("File", MouseButton::Left);
+    s.click_on("one quad per voxel face (watertight)", MouseButton::Left);
+    assert!(!s.ed.settings().mesh_export.greedy);
+    s.key(KeyCode::Escape, true);
+    s.key(KeyCode::Escape, false);
+    s.quiet();
+    s.chord(true, true, false, KeyCode::KeyE);
+    s.quiet();
+    s.ctrl(KeyCode::KeyA);
+    s.ed.input(app::ui::Input::Text("faces".into()));
+    s.key(KeyCode::Enter, true);
+    s.key(KeyCode::Enter, false);
+    s.quiet();
+    s.quiet();
+    assert!(dir.join("faces.glb").exists());
+    let faces = triangles(s);
+    assert!(faces > merged, "{faces} per face, {merged} merged");
 }

@@ -23,8 +23,9 @@ use glam::IVec3;
 pub use greedy::Quad;
 use std::path::Path;
 
-/// How a mesh is made.
-#[derive(Clone, Debug, PartialEq)]
+/// How a mesh is made (also the editor's File → Mesh options, kept in its settings).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct MeshOptions {
     /// Merge coplanar faces of one material into rectangles (T-junctions where a long edge
     /// meets short ones); off: one quad per voxel face (watertight).
