@@ -115,6 +115,10 @@ pub(crate) struct ConvertArgs {
     /// else the scene as shown, one mesh.
     #[arg(long)]
     per_object: bool,
+    /// Mesh, glTF, with --per-object: each object's placement kept as its node's matrix
+    /// (its mesh in its own frame) instead of applied.
+    #[arg(long)]
+    keep_transforms: bool,
     /// Mesh: units per voxel (glTF reads metres).
     #[arg(long, default_value_t = 1.0)]
     voxel_size: f64,
@@ -170,6 +174,7 @@ pub(crate) fn convert(a: ConvertArgs, workers: usize) -> Result<()> {
             greedy: !a.faces,
             per_object: a.per_object,
             voxel_size: a.voxel_size,
+            keep_transforms: a.keep_transforms,
         };
         let stats = with_progress(format!("writing {}", a.output.display()), || {
             Ok(app::formats::mesh::export(&scene, &a.output, &options)?)

@@ -166,6 +166,11 @@ pub fn draw(
                     let m = &mut view.mesh_export;
                     ui.checkbox(&mut m.per_object, "one part per object")
                         .on_hover_text("named; glTF nodes under their groups; else the scene as shown");
+                    ui.add_enabled(
+                        m.per_object,
+                        egui::Checkbox::new(&mut m.keep_transforms, "keep placements (glTF)"),
+                    )
+                    .on_hover_text("each object's turn and position as its node's matrix, its mesh in its own frame; else applied");
                     let mut faces = !m.greedy;
                     if ui
                         .checkbox(&mut faces, "one quad per voxel face (watertight)")

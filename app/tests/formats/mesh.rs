@@ -177,6 +177,7 @@ fn meshes_pass_the_gltf_validator_and_trimesh_finds_the_scenes_faces_bounds_and_
             greedy,
             per_object: false,
             voxel_size: size,
+            keep_transforms: false,
         };
         let built = mesh::build(&scene, &options);
         let quads = &built.parts[0].quads;
@@ -273,6 +274,28 @@ fn meshes_pass_the_gltf_validator_and_trimesh_finds_the_scenes_faces_bounds_and_
             "{ext}: area"
         );
     }
+    // The placements kept as node matrices (the meshes in their own frames): valid, and
+    // trimesh, applying the matrices, finds the same area and bounds as with them applied.
+    let applied = trimesh(&tools, &dir.join("objects.glb"));
+    let kept = MeshOptions {
+        keep_transforms: true,
+        ..per_object.clone()
+    };
+    let file = dir.join("kept.glb");
+    mesh::export(&vox, &file, &kept).unwrap();
+    assert_eq!(validator_errors(&tools, &file), 0);
+    let found = trimesh(&tools, &file);
+    assert!((found.area - applied.area).abs() < 1e-6 * found.area);
+    assert_eq!(found.bounds, applied.bounds, "the same place in the world");
+    let identity = [[1, 0, 0], [0, 1, 0], [0, 0, 1]];
+    let local = mesh::build(&vox, &kept);
+    assert!(
+        local
+            .parts
+            .iter()
+            .any(|p| p.transform.is_some_and(|(r, _)| r != identity)),
+        "some object of the sample is turned"
+    );
     // Nothing to mesh, a bad size, an unknown extension: refused, nothing written.
     let empty = app::scene::Scene::empty(GridDims::new(2, 2, 2).unwrap(), 1).unwrap();
     assert!(mesh::export(&empty, &dir.join("e.glb"), &MeshOptions::default()).is_err());

@@ -171,6 +171,20 @@ pub fn document(mesh: &Mesh) -> (Value, Vec<u8>) {
             }));
         }
         let mut node = json!({ "name": part.name });
+        if let Some((r, t)) = part.transform {
+            // Column-major; the translation in the file's units.
+            let mut m = [0.0f64; 16];
+            for (row, cols) in r.iter().enumerate() {
+                for (col, v) in cols.iter().enumerate() {
+                    m[col * 4 + row] = f64::from(*v);
+                }
+            }
+            m[12] = f64::from(t.x) * s;
+            m[13] = f64::from(t.y) * s;
+            m[14] = f64::from(t.z) * s;
+            m[15] = 1.0;
+            node["matrix"] = json!(m);
+        }
         if !primitives.is_empty() {
             meshes.push(json!({ "name": part.name, "primitives": primitives }));
             node["mesh"] = json!(meshes.len() - 1);

@@ -34,6 +34,9 @@ pub struct MeshOptions {
     pub per_object: bool,
     /// Units per voxel.
     pub voxel_size: f64,
+    /// Per object in glTF: each object's mesh in its model's frame (the pivot at the origin)
+    /// and its placement as the node's matrix, instead of applied (OBJ and PLY apply it).
+    pub keep_transforms: bool,
 }
 
 impl Default for MeshOptions {
@@ -42,6 +45,7 @@ impl Default for MeshOptions {
             greedy: true,
             per_object: false,
             voxel_size: 1.0,
+            keep_transforms: false,
         }
     }
 }
@@ -54,8 +58,11 @@ pub struct Part {
     pub name: String,
     /// The groups above it, outermost first (empty when merged or at the root).
     pub groups: Vec<String>,
-    /// Its quads, in world voxel coordinates.
+    /// Its quads, in world voxel coordinates — or, with `transform`, in its own frame.
     pub quads: Vec<Quad>,
+    /// Its placement kept: the rotation (a signed permutation, rows) and the translation in
+    /// voxels that carry its quads into the world.
+    pub transform: Option<([[i32; 3]; 3], IVec3)>,
 }
 
 /// A scene as quads, with the table its materials index.
@@ -122,7 +129,23 @@ pub fn build(scene: &Scene, options: &MeshOptions) -> Mesh {
                 let half = size.div_euclid(IVec3::splat(2));
                 // A corner p of the model lands at R·(p − ⌊s/2⌋) + t (the pivot rule).
                 let place = |p: IVec3| rot.apply(p - half) + d.placement.t;
-                let quads = greedy::quads(model, &clear, options.greedy)
+                let node = tree.node(d.node).ok()?;
+                let local = greedy::quads(model, &clear, options.greedy);
+                if options.keep_transforms {
+                    return Some(Part {
+                        name: node.name.clone(),
+                        groups: groups_above(tree, d.node),
+                        quads: local
+                            .into_iter()
+                            .map(|q| Quad {
+                                corners: q.corners.map(|p| p - half),
+                                ..q
+                            })
+                            .collect(),
+                        transform: Some((rot.matrix(), d.placement.t)),
+                    });
+                }
+                let quads = local
                     .into_iter()
                     .map(|q| {
                         let mut corners = q.corners.map(place);
@@ -136,11 +159,11 @@ pub fn build(scene: &Scene, options: &MeshOptions) -> Mesh {
                         }
                     })
                     .collect();
-                let node = tree.node(d.node).ok()?;
                 Some(Part {
                     name: node.name.clone(),
                     groups: groups_above(tree, d.node),
                     quads,
+                    transform: None,
                 })
             })
             .collect()
@@ -150,6 +173,7 @@ pub fn build(scene: &Scene, options: &MeshOptions) -> Mesh {
             name: "scene".into(),
             groups: Vec::new(),
             quads: greedy::quads(&view, &clear, options.greedy),
+            transform: None,
         }]
     };
     Mesh {
@@ -221,6 +245,19 @@ pub fn export(scene: &Scene, path: &Path, options: &MeshOptions) -> Result<MeshS
             "the scene has no voxels to mesh",
         ));
     }
+    let mesh = if options.keep_transforms && format != MeshFormat::Glb && format != MeshFormat::Gltf
+    {
+        // Only glTF has node transforms: the others get them applied.
+        build(
+            scene,
+            &MeshOptions {
+                keep_transforms: false,
+                ..options.clone()
+            },
+        )
+    } else {
+        mesh
+    };
     match format {
         MeshFormat::Obj => obj::write(&mesh, path)?,
         MeshFormat::Glb => gltf::write(&mesh, path, true)?,
