@@ -22,6 +22,10 @@ pub(crate) struct NewArgs {
     /// The thesis benchmark scene: 512×256×512 terrain, water and a metal statue.
     #[arg(long)]
     thesis: bool,
+    /// Terrain from a heightmap image (PNG, 8 or 16 bits; a pixel a column, white
+    /// --height-max voxels tall, default 256).
+    #[arg(long, conflicts_with_all = ["thesis", "terrain"])]
+    heightmap: Option<PathBuf>,
     /// Grid size in voxels, as WxHxD (multiples of 8 are used as they are).
     #[arg(long, value_parser = args::grid_size, default_value = "512x256x512")]
     size: IVec3,
@@ -52,14 +56,20 @@ pub(crate) struct NewArgs {
 
 /// Generates the scene and writes it atomically.
 pub(crate) fn new(a: NewArgs, workers: usize) -> Result<()> {
-    if !a.terrain && !a.thesis {
-        bail!("say what to create: --terrain (with its parameters) or --thesis");
+    if !a.terrain && !a.thesis && a.heightmap.is_none() {
+        bail!(
+            "say what to create: --terrain (with its parameters), --heightmap FILE.png or --thesis"
+        );
     }
     Format::of(&a.output)?;
     let started = Instant::now();
     let scene = with_progress("generating".into(), || {
         if a.thesis {
             return thesis_scene(workers);
+        }
+        if let Some(image) = &a.heightmap {
+            let height = a.height_max.unwrap_or(256);
+            return Ok(app::formats::heightmap::scene(image, height, workers)?);
         }
         let dims = GridDims::from_voxels(a.size.as_uvec3()).context("grid size")?;
         let world = World::new(dims, WorldConfig::with_workers(workers))?;

@@ -1,6 +1,7 @@
 //! Scene file formats: RON projects (`project`, with the voxel payload in `payload`) and
 //! MagicaVoxel `.vox` (`vox`, its chunk structure checked first by `vox::check`).
 
+pub mod heightmap;
 pub mod mesh;
 pub mod palette;
 pub mod payload;

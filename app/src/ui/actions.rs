@@ -29,6 +29,7 @@ impl Editor {
                 self.files
                     .pick(Purpose::Export, self.folder(), Some("scene.vox".into()))
             }
+            Action::NewFromHeightmap => self.guard_unsaved(Pending::Heightmap),
             Action::ExportMesh => {
                 self.files
                     .pick(Purpose::ExportMesh, self.folder(), Some("scene.glb".into()))

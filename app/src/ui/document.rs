@@ -188,6 +188,7 @@ impl Editor {
             Pending::Open(Some(p)) => self.files.load(p, self.options.workers),
             Pending::Open(None) => self.files.pick(Purpose::Open, self.folder(), None),
             Pending::New { size, terrain } => self.new_scene(size, terrain),
+            Pending::Heightmap => self.files.pick(Purpose::Heightmap, self.folder(), None),
         }
     }
 
@@ -229,6 +230,11 @@ impl Editor {
     pub(super) fn picked(&mut self, purpose: Purpose, path: PathBuf) {
         match purpose {
             Purpose::Open => self.files.load(path, self.options.workers),
+            Purpose::Heightmap => {
+                // Built on a worker; it replaces the document like New.
+                self.waits.building();
+                self.files.load_heightmap(path, self.options.workers);
+            }
             Purpose::SaveAs | Purpose::Export => {
                 let path = if purpose == Purpose::SaveAs && path.extension().is_none() {
                     path.with_extension("ron")

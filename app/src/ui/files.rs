@@ -295,6 +295,15 @@ impl FileWorker {
         });
     }
 
+    /// Builds a new scene from a heightmap image (white 256 voxels tall) on a worker thread.
+    pub fn load_heightmap(&mut self, path: PathBuf, workers: usize) {
+        self.spawn(format!("reading {}", path.display()), move || {
+            let scene = crate::formats::heightmap::scene(&path, 256, workers)
+                .map_err(|e| anyhow::anyhow!("Could not read the heightmap {e}"));
+            Done::Loaded(None, Box::new(scene))
+        });
+    }
+
     /// Builds a new scene (`size` voxels, empty or with noise terrain) on a worker thread.
     pub fn build_new(&mut self, size: (u32, u32, u32), terrain: bool, workers: usize) {
         self.spawn(

@@ -42,6 +42,8 @@ pub enum Action {
     Export,
     /// Export a mesh (.glb, .gltf, .obj, .ply).
     ExportMesh,
+    /// A new document: terrain from a heightmap image.
+    NewFromHeightmap,
     /// Frame the scene's content.
     Frame,
     /// Switch between perspective and orthographic.

@@ -149,6 +149,7 @@ pub fn draw(
                     }
                 }
                 for (label, action) in [
+                    ("New from a heightmap…", Action::NewFromHeightmap),
                     ("Open…  Ctrl+O", Action::Open),
                     ("Save  Ctrl+S", Action::Save),
                     ("Save As…  Ctrl+Shift+S", Action::SaveAs),

@@ -11,6 +11,8 @@ use std::path::PathBuf;
 pub(super) enum Pending {
     Quit,
     Open(Option<PathBuf>),
+    /// A new document from a heightmap image (asked for next).
+    Heightmap,
     New {
         size: (u32, u32, u32),
         terrain: bool,

@@ -14,6 +14,8 @@ pub enum Purpose {
     Export,
     /// Write a mesh (.glb, .gltf, .obj, .ply).
     ExportMesh,
+    /// Read a heightmap image into a new terrain.
+    Heightmap,
     /// Read a palette (.png strip or .vox).
     LoadPalette,
     /// Write the palette as a PNG strip.
@@ -28,6 +30,7 @@ impl Purpose {
             Purpose::SaveAs => ("voxbrick project", &["ron"]),
             Purpose::Import | Purpose::Export => ("MagicaVoxel", &["vox"]),
             Purpose::ExportMesh => ("Mesh", &["glb", "gltf", "obj", "ply"]),
+            Purpose::Heightmap => ("Heightmap (PNG, 8 or 16 bit)", &["png"]),
             Purpose::LoadPalette => ("Palette", &["png", "vox"]),
             Purpose::SavePalette => ("PNG palette strip", &["png"]),
         }
@@ -49,6 +52,7 @@ impl Purpose {
             Purpose::Import => "Import a .vox",
             Purpose::Export => "Export as .vox",
             Purpose::ExportMesh => "Export a mesh",
+            Purpose::Heightmap => "A new terrain from a heightmap",
             Purpose::LoadPalette => "Load a palette",
             Purpose::SavePalette => "Save the palette as",
         }

@@ -3,6 +3,7 @@
 
 #[path = "../common/mod.rs"]
 mod common;
+mod heightmap;
 mod mesh;
 
 use app::Scene;

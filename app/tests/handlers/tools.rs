@@ -257,3 +257,46 @@ pub fn the_scene_exports_as_a_mesh_from_the_browser(s: &mut Session, dir: &std::
     let faces = triangles(s);
     assert!(faces > merged, "{faces} per face, {merged} merged");
 }
+
+/// File → New from a heightmap…: the browser asks, the typed PNG becomes a new untitled
+/// terrain (a column per pixel, white 256 voxels tall).
+pub fn a_heightmap_becomes_a_new_terrain(s: &mut Session, dir: &std::path::Path) {
+    let image = dir.join("hm.png");
+    {
+        let file = std::fs::File::create(&image).unwrap();
+        let mut e = png::Encoder::new(std::io::BufWriter::new(file), 9, 5);
+        e.set_color(png::ColorType::Grayscale);
+        e.set_depth(png::BitDepth::Eight);
+        let data: Vec<u8> = (0..45).map(|i| (i * 5) as u8).collect();
+        e.write_header().unwrap().write_image_data(&data).unwrap();
+    }
+    assert!(
+        !s.ed.document().read().unwrap().dirty,
+        "no question about changes"
+    );
+    let generation = s.ed.generation();
+    s.click_on("File", MouseButton::Left);
+    s.click_on("New from a heightmap…", MouseButton::Left);
+    assert!(s.ed.browser_open(), "the browser asks for the image");
+    s.ed.input(app::ui::Input::Text(image.display().to_string()));
+    s.key(KeyCode::Enter, true);
+    s.key(KeyCode::Enter, false);
+    s.quiet();
+    s.settle();
+    s.quiet();
+    assert!(
+        s.ed.generation() > generation,
+        "the terrain replaced the document"
+    );
+    let doc = s.ed.document();
+    let d = doc.read().unwrap();
+    assert_eq!(d.path, None, "untitled");
+    let view = d.scene.world.read();
+    assert_eq!(view.dims().voxels(), glam::IVec3::new(16, 256, 8));
+    // The brightest pixel (44 · 5 = 220) at (8, 4): round(220 / 255 · 256) voxels.
+    let top = (0..256)
+        .rev()
+        .find(|y| view.voxel(glam::IVec3::new(8, *y, 4)).unwrap().is_some())
+        .map(|y| y + 1);
+    assert_eq!(top, Some((220.0f64 / 255.0 * 256.0).round() as i32));
+}

@@ -1,0 +1,130 @@
+//! Heightmap images to terrain (as vengi and Avoyd offer): a PNG, 8 or 16 bits per sample,
+//! grey or colour (colour: Rec. 709 luminance of the stored values), each pixel a column —
+//! pixel (x, y) of the image is column (x, z = y), +x right and +z down the image — as tall
+//! as `round(value / max · height)` voxels (black: no ground). The columns are painted as the
+//! terrain generator paints (`builtin::terrain_materials`): the top voxel grass, rock above
+//! three quarters of the height and snow above nine tenths; three voxels of dirt under grass;
+//! rock below. The grid is the image's size (rounded up to whole bricks) by `height`.
+//! All or nothing: a file that is not a PNG, an image past the largest grid, or a height
+//! out of range is refused with an error that names the file and the reason.
+
+use super::FormatError;
+use crate::scene::Scene;
+use brickmap::{GridDims, World, WorldConfig, terrain};
+use glam::{IVec3, UVec3};
+use std::path::Path;
+
+/// An image's samples, one per pixel row by row, and the largest value a sample can take.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Heights {
+    /// Pixels across (the grid's x).
+    pub width: u32,
+    /// Pixels down (the grid's z).
+    pub depth: u32,
+    /// One sample per pixel.
+    pub values: Vec<u16>,
+    /// 255 or 65535.
+    pub max: u16,
+}
+
+/// Reads the PNG's samples.
+pub fn read(path: &Path) -> Result<Heights, FormatError> {
+    let bytes = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
+    decode(&bytes).map_err(|m| FormatError::invalid(path, m))
+}
+
+fn decode(bytes: &[u8]) -> Result<Heights, String> {
+    let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+    decoder.set_transformations(png::Transformations::EXPAND);
+    let mut reader = decoder.read_info().map_err(|e| format!("not a PNG: {e}"))?;
+    let (w, h) = (reader.info().width, reader.info().height);
+    let limit = brickmap::grid::MAX_BRICKS_X * 8;
+    if w > limit || h > brickmap::grid::MAX_BRICKS_Z * 8 {
+        return Err(format!(
+            "a heightmap is at most {limit} × {} pixels, this one is {w} × {h}",
+            brickmap::grid::MAX_BRICKS_Z * 8
+        ));
+    }
+    let mut buf = vec![
+        0;
+        reader
+            .output_buffer_size()
+            .ok_or("the image is too large")?
+    ];
+    let info = reader
+        .next_frame(&mut buf)
+        .map_err(|e| format!("reading the image: {e}"))?;
+    let sixteen = info.bit_depth == png::BitDepth::Sixteen;
+    let channels = info.color_type.samples();
+    let bytes_per = if sixteen { 2 } else { 1 };
+    let sample = |px: &[u8], c: usize| -> f64 {
+        if sixteen {
+            f64::from(u16::from_be_bytes([px[2 * c], px[2 * c + 1]]))
+        } else {
+            f64::from(px[c])
+        }
+    };
+    let mut values = Vec::with_capacity((w * h) as usize);
+    for row in buf[..info.buffer_size()].chunks(info.line_size) {
+        for px in row.chunks(channels * bytes_per).take(w as usize) {
+            let v = if channels >= 3 {
+                0.2126 * sample(px, 0) + 0.7152 * sample(px, 1) + 0.0722 * sample(px, 2)
+            } else {
+                sample(px, 0)
+            };
+            values.push(v.round() as u16);
+        }
+    }
+    Ok(Heights {
+        width: w,
+        depth: h,
+        values,
+        max: if sixteen { u16::MAX } else { 255 },
+    })
+}
+
+/// A column's height in voxels for a sample (0..=`height`).
+pub fn column_height(value: u16, max: u16, height: u32) -> i32 {
+    (f64::from(value) / f64::from(max) * f64::from(height)).round() as i32
+}
+
+/// A new scene of the heightmap's terrain, `height` voxels tall at white.
+pub fn scene(path: &Path, height: u32, workers: usize) -> Result<Scene, FormatError> {
+    let heights = read(path)?;
+    let tallest = brickmap::grid::MAX_BRICKS_Y * 8;
+    if !(1..=tallest).contains(&height) {
+        return Err(FormatError::invalid(
+            path,
+            format!("the terrain's height {height} must lie in 1..={tallest} voxels"),
+        ));
+    }
+    let dims = GridDims::from_voxels(UVec3::new(heights.width, height, heights.depth))
+        .map_err(|e| FormatError::world(path, e))?;
+    let world = World::new(dims, WorldConfig::with_workers(workers))
+        .map_err(|e| FormatError::world(path, e))?;
+    let m = crate::builtin::terrain_materials(&world).map_err(|e| FormatError::world(path, e))?;
+    let size = dims.voxels();
+    let mut columns = vec![0i32; (size.x * size.z) as usize];
+    for z in 0..heights.depth as usize {
+        for x in 0..heights.width as usize {
+            let v = heights.values[z * heights.width as usize + x];
+            columns[x + z * size.x as usize] = column_height(v, heights.max, height);
+        }
+    }
+    let h = height as f64;
+    let edit = terrain::heightfield(dims, &columns, |v: IVec3, top: i32| {
+        let depth = top - 1 - v.y;
+        let high = f64::from(top) > 0.75 * h;
+        match depth {
+            0 if f64::from(top) > 0.9 * h => m.snow[0],
+            0 if high => m.rock[0],
+            0 => m.grass[0],
+            1..=3 if !high => m.dirt[0],
+            _ => m.rock[0],
+        }
+    });
+    world.apply(edit).map_err(|e| FormatError::world(path, e))?;
+    world.take_dirty();
+    let params = render::SceneParams::framing(size.as_dvec3());
+    Ok(Scene::new(world, params))
+}
