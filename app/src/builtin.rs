@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use brickmap::{
     EditOp, GridDims, Material, MaterialKind, Mode, Shape, World, WorldConfig, terrain,
 };
-use glam::{DVec3, IVec3};
+use glam::{DVec3, IVec3, UVec3};
 
 /// Size presets for the default scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -181,6 +181,57 @@ pub fn terrain_materials(world: &World) -> brickmap::Result<terrain::TerrainMate
         snow,
         water,
     })
+}
+
+/// A new scene of a heightmap image's terrain (`formats::heightmap`), `height` voxels tall at
+/// white: the grid is the image's size (rounded up to whole bricks) by `height`; the columns
+/// are painted as the terrain generator paints — the top voxel grass, rock above three
+/// quarters of the height and snow above nine tenths, three voxels of dirt under grass, rock
+/// below.
+pub fn heightmap_scene(
+    path: &std::path::Path,
+    height: u32,
+    workers: usize,
+) -> Result<Scene, formats::FormatError> {
+    use formats::FormatError;
+    let heights = formats::heightmap::read(path)?;
+    let tallest = brickmap::grid::MAX_BRICKS_Y * 8;
+    if !(1..=tallest).contains(&height) {
+        return Err(FormatError::invalid(
+            path,
+            format!("the terrain's height {height} must lie in 1..={tallest} voxels"),
+        ));
+    }
+    let dims = GridDims::from_voxels(UVec3::new(heights.width, height, heights.depth))
+        .map_err(|e| FormatError::world(path, e))?;
+    let world = World::new(dims, WorldConfig::with_workers(workers))
+        .map_err(|e| FormatError::world(path, e))?;
+    let m = terrain_materials(&world).map_err(|e| FormatError::world(path, e))?;
+    let size = dims.voxels();
+    let mut columns = vec![0i32; (size.x * size.z) as usize];
+    for z in 0..heights.depth as usize {
+        for x in 0..heights.width as usize {
+            let v = heights.values[z * heights.width as usize + x];
+            columns[x + z * size.x as usize] =
+                formats::heightmap::column_height(v, heights.max, height);
+        }
+    }
+    let h = height as f64;
+    let edit = terrain::heightfield(dims, &columns, |v: IVec3, top: i32| {
+        let depth = top - 1 - v.y;
+        let high = f64::from(top) > 0.75 * h;
+        match depth {
+            0 if f64::from(top) > 0.9 * h => m.snow[0],
+            0 if high => m.rock[0],
+            0 => m.grass[0],
+            1..=3 if !high => m.dirt[0],
+            _ => m.rock[0],
+        }
+    });
+    world.apply(edit).map_err(|e| FormatError::world(path, e))?;
+    world.take_dirty();
+    let params = render::SceneParams::framing(size.as_dvec3());
+    Ok(Scene::new(world, params))
 }
 
 /// The thesis benchmark scene: 512 × 256 × 512 noise terrain with water, and a statue in

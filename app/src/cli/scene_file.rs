@@ -69,7 +69,7 @@ pub(crate) fn new(a: NewArgs, workers: usize) -> Result<()> {
         }
         if let Some(image) = &a.heightmap {
             let height = a.height_max.unwrap_or(256);
-            return Ok(app::formats::heightmap::scene(image, height, workers)?);
+            return Ok(app::builtin::heightmap_scene(image, height, workers)?);
         }
         let dims = GridDims::from_voxels(a.size.as_uvec3()).context("grid size")?;
         let world = World::new(dims, WorldConfig::with_workers(workers))?;

@@ -1,17 +1,12 @@
 //! Heightmap images to terrain (as vengi and Avoyd offer): a PNG, 8 or 16 bits per sample,
 //! grey or colour (colour: Rec. 709 luminance of the stored values), each pixel a column —
 //! pixel (x, y) of the image is column (x, z = y), +x right and +z down the image — as tall
-//! as `round(value / max · height)` voxels (black: no ground). The columns are painted as the
-//! terrain generator paints (`builtin::terrain_materials`): the top voxel grass, rock above
-//! three quarters of the height and snow above nine tenths; three voxels of dirt under grass;
-//! rock below. The grid is the image's size (rounded up to whole bricks) by `height`.
-//! All or nothing: a file that is not a PNG, an image past the largest grid, or a height
-//! out of range is refused with an error that names the file and the reason.
+//! as `round(value / max · height)` voxels (black: no ground). `builtin::heightmap_scene`
+//! builds the terrain from what this reads. All or nothing: a file that is not a PNG, an
+//! image past the largest grid, or a height out of range is refused with an error that
+//! names the file and the reason.
 
 use super::FormatError;
-use crate::scene::Scene;
-use brickmap::{GridDims, World, WorldConfig, terrain};
-use glam::{IVec3, UVec3};
 use std::path::Path;
 
 /// An image's samples, one per pixel row by row, and the largest value a sample can take.
@@ -86,45 +81,4 @@ fn decode(bytes: &[u8]) -> Result<Heights, String> {
 /// A column's height in voxels for a sample (0..=`height`).
 pub fn column_height(value: u16, max: u16, height: u32) -> i32 {
     (f64::from(value) / f64::from(max) * f64::from(height)).round() as i32
-}
-
-/// A new scene of the heightmap's terrain, `height` voxels tall at white.
-pub fn scene(path: &Path, height: u32, workers: usize) -> Result<Scene, FormatError> {
-    let heights = read(path)?;
-    let tallest = brickmap::grid::MAX_BRICKS_Y * 8;
-    if !(1..=tallest).contains(&height) {
-        return Err(FormatError::invalid(
-            path,
-            format!("the terrain's height {height} must lie in 1..={tallest} voxels"),
-        ));
-    }
-    let dims = GridDims::from_voxels(UVec3::new(heights.width, height, heights.depth))
-        .map_err(|e| FormatError::world(path, e))?;
-    let world = World::new(dims, WorldConfig::with_workers(workers))
-        .map_err(|e| FormatError::world(path, e))?;
-    let m = crate::builtin::terrain_materials(&world).map_err(|e| FormatError::world(path, e))?;
-    let size = dims.voxels();
-    let mut columns = vec![0i32; (size.x * size.z) as usize];
-    for z in 0..heights.depth as usize {
-        for x in 0..heights.width as usize {
-            let v = heights.values[z * heights.width as usize + x];
-            columns[x + z * size.x as usize] = column_height(v, heights.max, height);
-        }
-    }
-    let h = height as f64;
-    let edit = terrain::heightfield(dims, &columns, |v: IVec3, top: i32| {
-        let depth = top - 1 - v.y;
-        let high = f64::from(top) > 0.75 * h;
-        match depth {
-            0 if f64::from(top) > 0.9 * h => m.snow[0],
-            0 if high => m.rock[0],
-            0 => m.grass[0],
-            1..=3 if !high => m.dirt[0],
-            _ => m.rock[0],
-        }
-    });
-    world.apply(edit).map_err(|e| FormatError::world(path, e))?;
-    world.take_dirty();
-    let params = render::SceneParams::framing(size.as_dvec3());
-    Ok(Scene::new(world, params))
 }

@@ -298,7 +298,7 @@ impl FileWorker {
     /// Builds a new scene from a heightmap image (white 256 voxels tall) on a worker thread.
     pub fn load_heightmap(&mut self, path: PathBuf, workers: usize) {
         self.spawn(format!("reading {}", path.display()), move || {
-            let scene = crate::formats::heightmap::scene(&path, 256, workers)
+            let scene = crate::builtin::heightmap_scene(&path, 256, workers)
                 .map_err(|e| anyhow::anyhow!("Could not read the heightmap {e}"));
             Done::Loaded(None, Box::new(scene))
         });

@@ -2,7 +2,6 @@
 //! height and its top material against the rule written here; refusals name the file.
 
 use super::*;
-use app::formats::heightmap;
 
 /// Writes a PNG of `w` × `h` pixels.
 fn png(path: &Path, w: u32, h: u32, colour: png::ColorType, depth: png::BitDepth, data: &[u8]) {
@@ -58,7 +57,7 @@ fn heightmaps_become_terrain_column_by_column() {
             }
         }
         png(&path, w, d, colour, depth, &data);
-        let scene = heightmap::scene(&path, height, 2).unwrap();
+        let scene = app::builtin::heightmap_scene(&path, height, 2).unwrap();
         let view = scene.world.read();
         let dims = view.dims().voxels();
         assert_eq!(dims, IVec3::new(24, 40, 16), "{name}: whole bricks");
@@ -99,10 +98,12 @@ fn heightmaps_become_terrain_column_by_column() {
     // Refusals name the file: not a PNG, a height past the grid or 0.
     let junk = dir.join("junk.png");
     std::fs::write(&junk, b"not an image").unwrap();
-    let e = heightmap::scene(&junk, 40, 1).unwrap_err().to_string();
+    let e = app::builtin::heightmap_scene(&junk, 40, 1)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("junk.png") && e.contains("not a PNG"), "{e}");
     for h in [0, 5000] {
-        let e = heightmap::scene(&dir.join("grey8.png"), h, 1)
+        let e = app::builtin::heightmap_scene(&dir.join("grey8.png"), h, 1)
             .unwrap_err()
             .to_string();
         assert!(e.contains("grey8.png") && e.contains("height"), "{e}");
@@ -116,6 +117,8 @@ fn heightmaps_become_terrain_column_by_column() {
         png::BitDepth::Eight,
         &[7; 4097],
     );
-    let e = heightmap::scene(&wide, 40, 1).unwrap_err().to_string();
+    let e = app::builtin::heightmap_scene(&wide, 40, 1)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("at most 4096"), "{e}");
 }
