@@ -146,17 +146,22 @@ impl Preview {
     /// not say what it holds), recomputed only for another set; none over
     /// [`PASTE_PREVIEW_VOXELS`] voxels (its bounds are outlined instead).
     pub fn set_selection(&mut self, selection: Option<&Selection>) {
-        let Some(s) = selection
-            .filter(|s| s.region.base.is_some() && s.voxels.count() <= PASTE_PREVIEW_VOXELS)
-        else {
+        let Some(s) = selection.filter(|s| s.region.base.is_some()) else {
             self.selection = None;
             return;
         };
+        // Counted and faced once per set (a frame must not walk a large set's bricks); a set
+        // too large keeps no faces.
         let id = Arc::as_ptr(&s.voxels) as usize;
         if self.selection.as_ref().is_none_or(|(k, _)| *k != id) {
-            let bricks: Vec<(IVec3, Mask)> =
-                s.voxels.iter().map(|(b, m)| (b.as_ivec3(), *m)).collect();
-            self.selection = Some((id, outer_faces(&bricks)));
+            let faces = if s.voxels.count() <= PASTE_PREVIEW_VOXELS {
+                let bricks: Vec<(IVec3, Mask)> =
+                    s.voxels.iter().map(|(b, m)| (b.as_ivec3(), *m)).collect();
+                outer_faces(&bricks)
+            } else {
+                Vec::new()
+            };
+            self.selection = Some((id, faces));
         }
     }
 
