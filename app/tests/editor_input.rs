@@ -287,8 +287,7 @@ fn objects_are_arranged_in_the_viewport_and_the_objects_window_and_edited() {
     s.drag(&steps, Some("edited command Move #2 into #0: ok"));
     // A double-click on the original's row: edit its voxels with the brush.
     let original = s.widget("scene");
-    s.mouse_to(original);
-    s.xdotool(&["click", "--repeat", "2", "--delay", "60", "1"]);
+    s.double_click(original, "editing scene (Tab: arrange)");
     s.report.frame();
     s.drag(
         &[(640, 420), (650, 425), (660, 430)],

@@ -189,6 +189,25 @@ impl Session {
         self.release();
     }
 
+    /// A double-click at `p`, sent again until a report line starts with `answer`: egui
+    /// tells a double-click by the frames' times, and frames of a busy lavapipe machine can
+    /// be slower than its 0.3 s, so a pair can read as two clicks.
+    pub fn double_click(&mut self, p: (i32, i32), answer: &str) {
+        self.mouse_to(p);
+        for sent in 1.. {
+            self.xdotool(&["click", "--repeat", "2", "--delay", "60", "1"]);
+            if self
+                .report
+                .wait_for(Duration::from_secs(20), |l| l.contains(answer))
+                .is_some()
+            {
+                return;
+            }
+            assert!(sent < 4, "a double-click never gave {answer:?}");
+            eprintln!("the double-click read as clicks: sent again");
+        }
+    }
+
     /// Quits with Ctrl+Q (sent again if the key went missing) and returns the output.
     /// Quits and checks the editor ended well, without validation messages.
     pub fn quit_cleanly(self) {
