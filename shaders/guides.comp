@@ -27,7 +27,7 @@ void main() {
     uint index = px.y * p.image.x + px.x;
     vec3 o;
     vec3 d;
-    camera_ray(vec2(px) + 0.5, o, d);
+    camera_ray(vec2(picture_pixel(px)) + 0.5, o, d);
     // Through mirrors and smooth dielectrics to the first surface that is neither (the way
     // its light most likely goes: refraction unless Fresnel reflects more, or total internal
     // reflection), so a reflection or what lies behind glass is filtered on its own plane.
@@ -74,7 +74,7 @@ void main() {
         }
         // Voxels one pixel spans at the hit: the film's pixel height times the distance
         // (perspective; `cam_up` is scaled by tan(fov / 2)) or the view's (orthographic).
-        float pixel = 2.0 * length(p.cam_up.xyz) / float(p.image.y);
+        float pixel = 2.0 * length(p.cam_up.xyz) / float(p.window.w);
         float footprint = p.cam_pos.w > 0.5 ? pixel : pixel * travelled;
         int face = normal.x != 0 ? (normal.x > 0 ? 1 : 0) : (normal.y != 0 ? (normal.y > 0 ? 3 : 2) : (normal.z > 0 ? 5 : 4));
         guides[2u * index] = vec4(o + d * t, footprint);

@@ -24,6 +24,8 @@ struct Params {
     vec4 dim_hi;        // camera hits outside the box are weighted by; xyz: its high corner
     vec4 ground;        // GRID variants: line spacing (voxels), how far the grid reaches past the
                         // world's sides (voxels), the lines' width in pixels, their radiance
+    uvec4 window;       // this image's place in the whole picture (a tile of a tiled render):
+                        // its top left pixel x, y there, and the picture's width, height
 };
 
 layout(std430, set = 0, binding = 5) readonly buffer ParamBuffer { Params p; };
@@ -65,11 +67,22 @@ int camera_medium(vec3 o) {
     return (m >= 0 && material(m).kind == DIELECTRIC) ? m : AIR;
 }
 
-// The camera ray through film position `f` (pixels from the top left corner; a pixel's
-// samples jitter it within [x, x + 1) × [y, y + 1)).
+// A pixel's index in the whole picture (what its random numbers are made from, so a tile
+// renders exactly the pixels the untiled picture has there).
+uint picture_index(uvec2 px) {
+    return (px.y + p.window.y) * p.window.z + px.x + p.window.x;
+}
+
+// A pixel of this image as a pixel of the whole picture.
+uvec2 picture_pixel(uvec2 px) {
+    return px + p.window.xy;
+}
+
+// The camera ray through film position `f` (pixels from the picture's top left corner; a
+// pixel's samples jitter it within [x, x + 1) × [y, y + 1)).
 void camera_ray(vec2 f, out vec3 o, out vec3 d) {
-    float u = 2.0 * f.x / float(p.image.x) - 1.0;
-    float v = 1.0 - 2.0 * f.y / float(p.image.y);
+    float u = 2.0 * f.x / float(p.window.z) - 1.0;
+    float v = 1.0 - 2.0 * f.y / float(p.window.w);
     if (p.cam_pos.w > 0.5) {
         // Orthographic: parallel rays from the image plane through the camera's position.
         o = p.cam_pos.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v;

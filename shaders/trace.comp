@@ -50,6 +50,13 @@ layout(constant_id = 12) const bool DIM = false;
 // p.ground.y voxels of the world's x-z extent, and land within p.ground.z pixels of a line every
 // p.ground.x voxels see the line's radiance p.ground.w (a display aid like DIM).
 layout(constant_id = 13) const bool GRID = false;
+// Coverage (a finished render's alpha): a camera ray adds 1 when it hits a voxel and 0 when
+// it does not (the sun, the sky and the grid are not voxels), and the path ends there.
+layout(constant_id = 14) const bool COVERAGE = false;
+// A transparent background (a finished render with alpha): camera rays that reach the sky or
+// the sun disc add nothing (the picture's colour is premultiplied by its coverage); the sky
+// and the sun still light the voxels.
+layout(constant_id = 15) const bool TRANSPARENT = false;
 
 // Without dielectrics every ray travels in air: the traversal drops its medium branch.
 #define MEDIUM_POSSIBLE HAS_DIELECTRIC
@@ -324,14 +331,15 @@ float face_probability(int material, ivec3 voxel, ivec3 normal) {
     return light_weight(material) / light_total() * k;
 }
 
-void begin_path(uvec2 px, uint index, uint s) {
+void begin_path(uvec2 px, uint s) {
+    uint index = picture_index(px);
     rng = hash(p.seed.x ^ hash(index * 9781u + (p.seed.z + s) * 6271u + 1u));
     sob_index = p.seed.z + s;
     sob_seed = hash(p.seed.x ^ hash(index * 9781u + 0x2545f491u));
     sob_pair = 0xffffffffu;
     dims(0u);
     float jx = rand();
-    camera_ray(vec2(px) + vec2(jx, rand()), path_o, path_d);
+    camera_ray(vec2(picture_pixel(px)) + vec2(jx, rand()), path_o, path_d);
     path_beta = vec3(1.0);
     path_start = ivec3(0);
     path_medium = HAS_DIELECTRIC ? camera_medium(path_o) : AIR;
@@ -350,6 +358,10 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
     const uint bounces = MAX_BOUNCES;
     vec3 o = path_o;
     vec3 d = path_d;
+    if (COVERAGE) {
+        pixel_sum += vec3(hit ? 1.0 : 0.0);
+        return false;
+    }
     if (!hit) t_voxel = 1.0 / 0.0;
     if (GRID && path_camera && d.y != 0.0) {
         float tg = -o.y / d.y;
@@ -357,7 +369,7 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
         vec2 extent = vec2(p.grid.xz) * 8.0 + p.ground.y;
         if (tg > 0.0 && tg < t_voxel && all(greaterThanEqual(q, vec2(-p.ground.y))) && all(lessThanEqual(q, extent))) {
             // Voxels a pixel spans there (as shaders/guides.comp finds a footprint).
-            float pixel = 2.0 * length(p.cam_up.xyz) / float(p.image.y);
+            float pixel = 2.0 * length(p.cam_up.xyz) / float(p.window.w);
             float footprint = p.cam_pos.w > 0.5 ? pixel : pixel * tg;
             vec2 off = abs(fract(q / p.ground.x + 0.5) - 0.5) * p.ground.x;
             if (min(off.x, off.y) < 0.5 * p.ground.z * footprint) {
@@ -369,11 +381,13 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
     float cos_l;
     float t_sun = sun_hit(o, d, cos_l);
     if (t_sun > 0.0 && t_sun < t_voxel) {
+        if (TRANSPARENT && path_camera) return false;
         float w = path_pdf < 0.0 ? 1.0 : power_heuristic(path_pdf, t_sun * t_sun / (cos_l * sun_area()));
         pixel_sum += path_beta * p.sun_radiance.rgb * w;
         return false;
     }
     if (!hit) {
+        if (TRANSPARENT && path_camera) return false;
         pixel_sum += path_beta * sky(d);
         return false;
     }
@@ -525,7 +539,7 @@ void main() {
     uint next_sample = gl_WorkGroupID.z * p.image.z; // this slice's first sample
     uint end_sample = next_sample + p.image.z;
     bool more = p.image.z > 0u; // samples left (the current path's included)
-    if (more) begin_path(px, index, next_sample++);
+    if (more) begin_path(px, next_sample++);
     bool path_alive = true; // false: the path ended (its shadow ray may still be pending)
     while (more) {
         // Idle: this path ended and the subgroup has not (only with experiment bit 6).
@@ -587,7 +601,7 @@ void main() {
         if (ended && together) {
             more = next_sample < end_sample;
             if (more) {
-                begin_path(px, index, next_sample++);
+                begin_path(px, next_sample++);
                 path_alive = true;
             }
         }

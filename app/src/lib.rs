@@ -8,6 +8,7 @@ pub mod camera_path;
 pub mod editor;
 pub mod formats;
 pub mod gpu;
+pub mod picture;
 pub mod rect_select;
 pub mod scene;
 #[cfg(any(test, feature = "test-hooks"))]

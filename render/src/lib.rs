@@ -4,6 +4,7 @@
 
 pub mod convergence;
 pub mod cpu;
+pub mod finished;
 pub mod image;
 pub mod params;
 pub mod present;

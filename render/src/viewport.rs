@@ -21,7 +21,7 @@ use crate::vulkan::primary::{GpuHit, PrimaryTracer};
 use crate::vulkan::progressive::Progressive;
 pub use crate::vulkan::progressive::{RenderHow, Rendered};
 use crate::vulkan::tonemap::ToneMapper;
-use crate::vulkan::trace::{Dim, PathTracer, TraceParams, Variant};
+use crate::vulkan::trace::{Dim, PathTracer, TraceParams, Variant, Window};
 use crate::vulkan::world::{GpuWorld, UploadReport};
 use crate::vulkan::{GpuContext, GpuError};
 use ash::vk;
@@ -192,6 +192,12 @@ impl Viewport {
         &mut self.tracer
     }
 
+    /// The context, the tracer and the uploaded world, for one-shot renders elsewhere in
+    /// the crate (`finished.rs`).
+    pub(crate) fn parts(&mut self) -> (&Arc<GpuContext>, &mut PathTracer, &GpuWorld) {
+        (&self.ctx, &mut self.tracer, &self.world)
+    }
+
     /// Renders `job` as `how` says on this session's world and waits
     /// ([`PathTracer::render`]).
     pub fn render(
@@ -216,6 +222,21 @@ impl Viewport {
         variant: Variant,
         timed: u32,
     ) -> Result<DenoisedRender, GpuError> {
+        let whole = Window::whole((job.width, job.height));
+        self.render_denoised_in(view, params, job, variant, timed, whole)
+    }
+
+    /// [`Viewport::render_denoised`] of `job`'s image as the part `window` of a larger
+    /// picture (a tile: its pixels and guides are the picture's there).
+    pub fn render_denoised_in(
+        &mut self,
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        job: &RenderJob,
+        variant: Variant,
+        timed: u32,
+        window: Window,
+    ) -> Result<DenoisedRender, GpuError> {
         let ctx = self.ctx.clone();
         // The denoiser's buffers may be the live accumulation's.
         self.wait_idle()?;
@@ -224,6 +245,7 @@ impl Viewport {
         }
         let size = (job.width, job.height);
         let mut acc = Progressive::new(&ctx, size, size, job.seed)?;
+        acc.set_window(window);
         let mut guide_params = match HostBuffer::new(
             &ctx,
             "guide params",
@@ -236,7 +258,8 @@ impl Viewport {
                 return Err(e);
             }
         };
-        guide_params.write(bytemuck::bytes_of(&TraceParams::new(view, params, job)));
+        let guides = TraceParams::in_window(view, params, job, window);
+        guide_params.write(bytemuck::bytes_of(&guides));
         let mut sets = match SetCache::new(&ctx) {
             Ok(s) => s,
             Err(e) => {

@@ -1,12 +1,14 @@
 //! The GPU session's interactive frames (frames in flight, cached descriptor sets, no host
 //! waits) on a real device with the validation layer: they accumulate exactly the samples a
-//! one-shot render takes, restart on an edit and on a camera change, and stop at the target.
+//! one-shot render takes, restart on an edit and on a camera change, and stop at the target;
+//! finished pictures (`render::finished`): alpha, tiles, cancel and noise targets.
 
 mod common;
 
 use brickmap::{EditOp, Mode, Shape};
 use glam::{DVec3, IVec3};
 use render::cpu::RenderJob;
+use render::finished::{Finish, PictureError, Stop, relative_error};
 use render::viewport::{FrameRequest, RenderHow, Viewport};
 use render::vulkan::trace::Dim;
 use render::vulkan::{DeviceChoice, GpuContext};
@@ -391,5 +393,148 @@ fn dimming_weights_exactly_the_camera_hits_outside_the_box() {
         full > n / 10 && dark > n / 10,
         "{full} full, {dark} dimmed of {n}"
     );
+    assert_eq!(ctx.validation_errors(), 0);
+}
+
+/// A finished picture of `params` on `vp` (progress ignored).
+fn picture(
+    vp: &mut Viewport,
+    world: &brickmap::World,
+    params: &render::SceneParams,
+    finish: &Finish,
+) -> render::finished::Picture {
+    vp.render_picture(&world.read(), params, finish, &mut |_| true)
+        .unwrap()
+}
+
+fn finish(size: (u32, u32), stop: Stop, tile: u32) -> Finish {
+    Finish {
+        size,
+        stop,
+        denoise: false,
+        alpha: true,
+        seed: 7,
+        tile,
+    }
+}
+
+#[test]
+fn a_finished_pictures_alpha_is_exactly_its_coverage_and_its_background_transparent() {
+    let Some(ctx) = context() else { return };
+    // Orthographic along −z, a voxel per pixel: two walls cover known pixels wholly.
+    let (world, mut params, lit) = common::orthographic_walls();
+    params.sky = render::Sky::Uniform { colour: [1.0; 3] };
+    let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
+    for tile in [32, 12] {
+        let p = picture(
+            &mut vp,
+            &world,
+            &params,
+            &finish((32, 32), Stop::Samples(4), tile),
+        );
+        let alpha = p.alpha.as_ref().unwrap();
+        for (i, &l) in lit.iter().enumerate() {
+            assert_eq!(
+                alpha[i],
+                if l { 1.0 } else { 0.0 },
+                "pixel {i}, tiles of {tile}"
+            );
+            // Camera rays that miss add nothing, though the sky is white.
+            let c = p.image.pixels[i];
+            assert_eq!(c == [0.0; 3], !l, "pixel {i}: {c:?}");
+        }
+    }
+    // Without alpha the sky shows.
+    let mut opaque = finish((32, 32), Stop::Samples(2), 32);
+    opaque.alpha = false;
+    let p = picture(&mut vp, &world, &params, &opaque);
+    assert!(p.alpha.is_none());
+    let sky = lit.iter().position(|l| !l).unwrap();
+    assert_eq!(p.image.pixels[sky], [1.0; 3]);
+    drop(vp);
+    assert_eq!(ctx.validation_errors(), 0);
+}
+
+#[test]
+fn a_tiled_picture_equals_the_untiled_one_and_a_cancel_stops_it() {
+    let Some(ctx) = context() else { return };
+    let (world, params) = common::showcase();
+    let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
+    // The same batches in every tile (the automatic shape follows the pixel count), one
+    // invocation per pixel and shadow rays traced in place (sliced sums and the shadow
+    // queue's add in any order).
+    vp.tracer().set_samples_per_dispatch(Some(3));
+    vp.tracer().set_sample_slices(Some(1));
+    vp.tracer().set_deferred_shadows(&ctx, false);
+    let whole = picture(
+        &mut vp,
+        &world,
+        &params,
+        &finish((41, 27), Stop::Samples(7), 64),
+    );
+    assert_eq!(whole.tiles, 1);
+    let tiled = picture(
+        &mut vp,
+        &world,
+        &params,
+        &finish((41, 27), Stop::Samples(7), 16),
+    );
+    assert_eq!(tiled.tiles, 6);
+    assert!(whole.image.all_finite() && whole.image.mean()[0] > 0.0);
+    assert_eq!(tiled.image, whole.image);
+    assert_eq!(tiled.alpha, whole.alpha);
+    // Cancelled at the second progress report: an error, and the session still renders.
+    let mut calls = 0;
+    let r = vp.render_picture(
+        &world.read(),
+        &params,
+        &finish((41, 27), Stop::Samples(7), 16),
+        &mut |p| {
+            assert!((0.0..=1.0).contains(&p.done) && p.tile.1 == 6);
+            calls += 1;
+            calls < 2
+        },
+    );
+    assert!(matches!(r, Err(PictureError::Cancelled)), "{r:?}");
+    let again = picture(
+        &mut vp,
+        &world,
+        &params,
+        &finish((41, 27), Stop::Samples(7), 16),
+    );
+    assert_eq!(again.image, whole.image);
+    drop(vp);
+    assert_eq!(ctx.validation_errors(), 0);
+}
+
+#[test]
+fn a_noise_target_is_reached_as_a_converged_reference_measures_it() {
+    let Some(ctx) = context() else { return };
+    let (world, params) = common::showcase();
+    let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
+    let size = (48, 32);
+    let mut reference = finish(size, Stop::Samples(2048), 64);
+    reference.alpha = false;
+    reference.seed = 99;
+    let reference = picture(&mut vp, &world, &params, &reference).image;
+    let mut taken = Vec::new();
+    for target in [0.12, 0.06] {
+        let mut f = finish(size, Stop::Noise { target, max: 4096 }, 64);
+        f.alpha = false;
+        let p = picture(&mut vp, &world, &params, &f);
+        let estimate = p.noise.unwrap();
+        let error = relative_error(&p.image, &reference);
+        eprintln!(
+            "target {target}: {} spp, estimated {estimate:.4}, measured {error:.4}",
+            p.samples.1
+        );
+        assert!(estimate <= target, "{estimate} > {target}");
+        assert!(p.samples.1 < 4096, "the target never stopped it");
+        // The reference's own noise adds a little to what is measured.
+        assert!(error <= target * 1.25, "measured {error} for {target}");
+        taken.push(p.samples.1);
+    }
+    assert!(taken[1] >= 2 * taken[0], "{taken:?}");
+    drop(vp);
     assert_eq!(ctx.validation_errors(), 0);
 }

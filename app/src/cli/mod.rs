@@ -9,6 +9,7 @@
 
 pub mod args;
 pub mod harness;
+pub mod picture;
 pub mod render;
 pub mod replay;
 pub mod scene_file;

@@ -12,15 +12,48 @@ use std::time::Instant;
 pub(crate) struct RenderArgs {
     /// A .ron or .vox file (a .vox gets the default camera, sun and sky).
     pub(crate) scene: PathBuf,
-    /// Output image (.png).
+    /// Output image: .png, .exr or .pfm (a turntable or a path numbers it: NAME_0000.png…).
     #[arg(long)]
     pub(crate) out: PathBuf,
     /// Also write the linear image as PFM (for error measurement).
     #[arg(long)]
     pub(crate) hdr: Option<PathBuf>,
-    /// Samples per pixel.
+    /// Samples per pixel (with --noise: the most a tile takes).
     #[arg(long, default_value_t = 16)]
     pub(crate) spp: u32,
+    /// Stop each tile at this relative noise (e.g. 0.02), estimated from two halves of its
+    /// samples, or at --spp (GPU only).
+    #[arg(long, value_name = "NOISE")]
+    pub(crate) noise: Option<f64>,
+    /// Filter the noise with the viewport's denoiser (GPU only).
+    #[arg(long)]
+    pub(crate) denoise: bool,
+    /// A transparent background: alpha is the coverage of the camera rays by voxels (PNG,
+    /// EXR; GPU only).
+    #[arg(long)]
+    pub(crate) alpha: bool,
+    /// The view: scene (the scene's camera), or iso, front, side, top (orthographic,
+    /// framing the content).
+    #[arg(long, default_value = "scene", value_parser = app::picture::Preset::parse)]
+    pub(crate) view: app::picture::Preset,
+    /// 16 bits per channel for .png.
+    #[arg(long)]
+    pub(crate) png16: bool,
+    /// Half floats for .exr (default: 32-bit floats).
+    #[arg(long)]
+    pub(crate) half: bool,
+    /// A tile's side in pixels: larger pictures render tile by tile (GPU only).
+    #[arg(long, default_value_t = 2048)]
+    pub(crate) tile: u32,
+    /// A turntable of N frames about the content's centre, from the camera's place.
+    #[arg(long, value_name = "N", conflicts_with = "path")]
+    pub(crate) turntable: Option<usize>,
+    /// A camera path (the benchmark's RON format) rendered as a sequence at --fps.
+    #[arg(long, value_name = "P.ron")]
+    pub(crate) path: Option<PathBuf>,
+    /// Frames per second of path time for --path.
+    #[arg(long, default_value_t = 24.0)]
+    pub(crate) fps: f64,
     /// Max bounces (default: the scene's setting).
     #[arg(long)]
     pub(crate) bounces: Option<u32>,
@@ -66,42 +99,16 @@ pub(crate) fn render_command(a: RenderArgs, workers: usize) -> Result<()> {
     if a.spp == 0 || a.width == 0 || a.height == 0 || a.width > 16384 || a.height > 16384 {
         bail!("--spp, --width and --height must be positive (sizes at most 16384)");
     }
+    if a.finished() {
+        return super::picture::render_finished(a, workers);
+    }
     if !(a.scale > 0.0 && a.scale <= 1.0) {
         bail!("--scale {} is outside (0, 1]", a.scale);
     }
     let scene = with_progress(format!("reading {}", a.scene.display()), || {
         Ok(app::formats::load(&a.scene, workers)?)
     })?;
-    let mut params = scene.params.clone();
-    if let Some(spec) = &a.camera {
-        let (eye, target) = spec
-            .split_once(':')
-            .context("--camera wants EYE:TARGET, each X,Y,Z")?;
-        let eye = parse_ivec3_f(eye)?;
-        let target = parse_ivec3_f(target)?;
-        let aimed =
-            render::Camera::aimed(eye, target, params.camera.fov_y_deg).context("--camera")?;
-        params.camera = render::Camera {
-            projection: params.camera.projection,
-            ..aimed
-        };
-    }
-    if let Some(height) = a.orthographic {
-        params.camera.projection = render::Projection::Orthographic { height };
-    }
-    params
-        .camera
-        .validate()
-        .context("--camera / --orthographic")?;
-    if let Some(b) = a.bounces {
-        if !(1..=64).contains(&b) {
-            bail!("--bounces {b} is outside 1..=64");
-        }
-        params.settings.max_bounces = b;
-    }
-    if let Some(q) = a.sequence {
-        params.settings.sequence = q;
-    }
+    let params = a.params(&scene)?;
     let view = scene.world.read();
     let internal = (
         ((a.width as f64 * a.scale).ceil() as u32).max(1),
@@ -143,6 +150,59 @@ pub(crate) fn render_command(a: RenderArgs, workers: usize) -> Result<()> {
         a.height,
         a.out.display()
     ))
+}
+
+impl RenderArgs {
+    /// Whether this is a finished render (`render::finished`: tiles, noise targets, alpha,
+    /// denoising, presets, sequences, EXR and 16-bit PNG) rather than a plain one (which
+    /// also runs on the CPU reference and counts rays).
+    fn finished(&self) -> bool {
+        let ext = self.out.extension().and_then(|e| e.to_str()).unwrap_or("");
+        self.noise.is_some()
+            || self.denoise
+            || self.alpha
+            || self.view != app::picture::Preset::Scene
+            || self.png16
+            || self.turntable.is_some()
+            || self.path.is_some()
+            || !ext.eq_ignore_ascii_case("png")
+            || self.width.max(self.height) > self.tile
+    }
+
+    /// The scene's parameters with the camera, projection, bounces and sequence asked for.
+    pub(crate) fn params(&self, scene: &app::scene::Scene) -> Result<render::SceneParams> {
+        let mut params = scene.params.clone();
+        if let Some(spec) = &self.camera {
+            let (eye, target) = spec
+                .split_once(':')
+                .context("--camera wants EYE:TARGET, each X,Y,Z")?;
+            let eye = parse_ivec3_f(eye)?;
+            let target = parse_ivec3_f(target)?;
+            let aimed =
+                render::Camera::aimed(eye, target, params.camera.fov_y_deg).context("--camera")?;
+            params.camera = render::Camera {
+                projection: params.camera.projection,
+                ..aimed
+            };
+        }
+        if let Some(height) = self.orthographic {
+            params.camera.projection = render::Projection::Orthographic { height };
+        }
+        params
+            .camera
+            .validate()
+            .context("--camera / --orthographic")?;
+        if let Some(b) = self.bounces {
+            if !(1..=64).contains(&b) {
+                bail!("--bounces {b} is outside 1..=64");
+            }
+            params.settings.max_bounces = b;
+        }
+        if let Some(q) = self.sequence {
+            params.settings.sequence = q;
+        }
+        Ok(params)
+    }
 }
 
 pub(crate) fn parse_ivec3_f(s: &str) -> Result<DVec3> {

@@ -5,6 +5,7 @@ pub mod heightmap;
 pub mod mesh;
 pub mod palette;
 pub mod payload;
+pub mod picture;
 pub mod project;
 pub mod vox;
 

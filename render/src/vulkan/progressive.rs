@@ -16,7 +16,7 @@
 use super::buffer::{Binding, HostBuffer, read_device};
 use super::pass::SetCache;
 use super::tonemap::ToneMapper;
-use super::trace::{MAX_SAMPLES_PER_DISPATCH, PathTracer, RayCounts, TraceParams, Variant};
+use super::trace::{MAX_SAMPLES_PER_DISPATCH, PathTracer, RayCounts, TraceParams, Variant, Window};
 use super::world::GpuWorld;
 use super::{GpuContext, GpuError};
 use crate::cpu::RenderJob;
@@ -46,6 +46,8 @@ pub struct Progressive {
     key: Option<u64>,
     samples: u32,
     seed: u64,
+    /// Where the internal image lies in the picture (the whole picture but for tiles).
+    window: Window,
     /// Some batch was recorded into the buffer (it holds an image to display).
     traced: bool,
 }
@@ -83,8 +85,15 @@ impl Progressive {
             key: None,
             samples: 0,
             seed,
+            window: Window::whole(internal),
             traced: false,
         })
+    }
+
+    /// Makes the internal image the part `window` of a larger picture (a tile); restarts.
+    pub fn set_window(&mut self, window: Window) {
+        self.window = window;
+        self.restart();
     }
 
     /// Samples per pixel accumulated so far.
@@ -189,7 +198,7 @@ impl Progressive {
         spp: u32,
         mut after: impl FnMut(Binding, bool) -> Result<(), GpuError>,
     ) -> Result<(Option<f64>, bool), GpuError> {
-        let base = TraceParams::new(view, params, &self.job(spp));
+        let base = TraceParams::in_window(view, params, &self.job(spp), self.window);
         self.check_key(&base, variant);
         let restarted = self.samples == 0;
         let mut gpu = Some(0.0);

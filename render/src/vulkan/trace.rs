@@ -49,7 +49,7 @@ use std::collections::HashMap;
 
 mod params;
 mod variant;
-pub use params::{Dim, TraceParams};
+pub use params::{Dim, TraceParams, Window};
 pub use variant::Variant;
 
 const SPIRV: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/trace.comp.spv"));

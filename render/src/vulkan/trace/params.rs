@@ -20,7 +20,28 @@ pub struct Dim {
 const GRID_LINE_PIXELS: f32 = 1.5;
 const GRID_RADIANCE: f32 = 0.35;
 
-/// Keep in sync with `Params` in shaders/trace.comp (std430: eleven vec4, three uvec4, three vec4).
+/// Where an image lies in a larger picture: a tile of a tiled render. Its pixels are the
+/// picture's pixels there, random numbers included (shaders/scene.glsl `picture_index`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Window {
+    /// The image's top left pixel in the picture.
+    pub origin: (u32, u32),
+    /// The whole picture's width and height.
+    pub picture: (u32, u32),
+}
+
+impl Window {
+    /// The whole picture of `size`.
+    pub fn whole(size: (u32, u32)) -> Self {
+        Self {
+            origin: (0, 0),
+            picture: size,
+        }
+    }
+}
+
+/// Keep in sync with `Params` in shaders/scene.glsl (std430: eleven vec4, three uvec4, three
+/// vec4, one uvec4).
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable, Default)]
 pub struct TraceParams {
@@ -41,8 +62,9 @@ pub struct TraceParams {
     dim_lo: [f32; 4],
     dim_hi: [f32; 4],
     ground: [f32; 4],
+    window: [u32; 4],
 }
-const _: () = assert!(std::mem::size_of::<TraceParams>() == 272);
+const _: () = assert!(std::mem::size_of::<TraceParams>() == 288);
 
 fn v4(v: DVec3, w: f32) -> [f32; 4] {
     [v.x as f32, v.y as f32, v.z as f32, w]
@@ -51,8 +73,19 @@ fn v4(v: DVec3, w: f32) -> [f32; 4] {
 impl TraceParams {
     /// The parameters of a render, derived exactly as `CpuScene::new` derives them.
     pub fn new(view: &WorldView<'_>, params: &SceneParams, job: &RenderJob) -> Self {
+        Self::in_window(view, params, job, Window::whole((job.width, job.height)))
+    }
+
+    /// The parameters of `job`'s image as the part `window` of a larger picture (the
+    /// camera frames the picture; the image is `job.width` × `job.height` of it).
+    pub fn in_window(
+        view: &WorldView<'_>,
+        params: &SceneParams,
+        job: &RenderJob,
+        window: Window,
+    ) -> Self {
         let c = &params.camera;
-        let (forward, right, up) = c.basis(job.width as f64 / job.height as f64);
+        let (forward, right, up) = c.basis(window.picture.0 as f64 / window.picture.1 as f64);
         let dims = view.dims();
         let centre = dims.voxels().as_dvec3() * 0.5;
         let mut p = TraceParams {
@@ -69,6 +102,12 @@ impl TraceParams {
                 dims.coarse_words_per_column() as u32,
             ],
             image: [job.width, job.height, job.spp, params.settings.max_bounces],
+            window: [
+                window.origin.0,
+                window.origin.1,
+                window.picture.0,
+                window.picture.1,
+            ],
             ..Default::default()
         };
         if let Some(sun) = params.sun.disc(centre) {

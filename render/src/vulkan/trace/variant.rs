@@ -4,7 +4,7 @@
 
 use super::*;
 
-/// What a pipeline variant contains (`constant_id` 0..8, 10 and 11 of shaders/trace.comp; 9, the shadow
+/// What a pipeline variant contains (`constant_id` 0..8 and 10..15 of shaders/trace.comp; 9, the shadow
 /// queue, is the tracer's choice).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Variant {
@@ -36,6 +36,12 @@ pub struct Variant {
     pub dim: bool,
     /// The ground grid ([`TraceParams::with_grid`]).
     pub grid: bool,
+    /// Coverage only: camera rays add 1 where they hit a voxel, 0 elsewhere, and end (a
+    /// finished render's alpha; [`Variant::coverage`]).
+    pub coverage: bool,
+    /// A transparent background: camera rays that miss every voxel add nothing (the sky
+    /// and the sun still light the voxels; a finished render with alpha).
+    pub transparent: bool,
 }
 
 impl Variant {
@@ -64,6 +70,8 @@ impl Variant {
             sequence: params.settings.sequence,
             dim: false,
             grid: false,
+            coverage: false,
+            transparent: false,
         };
         for i in 0..materials.len() {
             if let Ok(m) = materials.get(i as u8) {
@@ -94,10 +102,33 @@ impl Variant {
             sequence: Sequence::Independent,
             dim: false,
             grid: false,
+            coverage: false,
+            transparent: false,
         }
     }
 
-    pub(super) fn constants(&self, shadow_queue: bool) -> [u32; 14] {
+    /// The coverage variant: the camera rays of `sequence`'s numbers, nothing else.
+    pub fn coverage(sequence: Sequence) -> Self {
+        Self {
+            lambertian: false,
+            metal: false,
+            dielectric: false,
+            emissive: false,
+            lights: false,
+            sun: false,
+            gradient_sky: false,
+            max_bounces: 1,
+            count_rays: false,
+            experiment: 0,
+            sequence,
+            dim: false,
+            grid: false,
+            coverage: true,
+            transparent: false,
+        }
+    }
+
+    pub(super) fn constants(&self, shadow_queue: bool) -> [u32; 16] {
         [
             self.lambertian as u32,
             self.metal as u32,
@@ -113,6 +144,8 @@ impl Variant {
             (self.sequence == Sequence::Sobol) as u32,
             self.dim as u32,
             self.grid as u32,
+            self.coverage as u32,
+            self.transparent as u32,
         ]
     }
 }
