@@ -1,11 +1,13 @@
 //! File formats end to end: project round trips and hostile files, atomic saves (here);
 //! .vox import of every sample, import → export → import, scenes beyond 256³, rotations
-//! (`vox_files.rs`); meshes out (`mesh.rs`); heightmaps in (`heightmap.rs`).
+//! (`vox_files.rs`); meshes out (`mesh.rs`); heightmaps in (`heightmap.rs`); finished
+//! pictures out (`pictures.rs`).
 
 #[path = "../common/mod.rs"]
 mod common;
 mod heightmap;
 mod mesh;
+mod pictures;
 mod vox_files;
 
 use app::Scene;

@@ -12,7 +12,7 @@ use std::collections::HashMap;
 use std::process::Command;
 
 /// The tools' folder, if the tools are there.
-fn tools() -> Option<PathBuf> {
+pub(super) fn tools() -> Option<PathBuf> {
     let dir = std::env::var_os("VOXBRICK_MESH_TOOLS")
         .filter(|d| !d.is_empty())
         .map(PathBuf::from)
@@ -37,7 +37,7 @@ fn tools() -> Option<PathBuf> {
     None
 }
 
-fn script(name: &str) -> PathBuf {
+pub(super) fn script(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../tests/tools")
         .join(name)
