@@ -162,6 +162,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Convert(a) => cli::scene_file::convert(a, workers),
         Command::New(a) => cli::scene_file::new(a, workers),
         Command::Info(a) => cli::scene_file::info(a, workers),
+        Command::Render(a) if a.finished() => cli::picture::render_finished(a, workers),
         Command::Render(a) => cli::render::render_command(a, workers),
         Command::Soak(a) => cli::soak::soak_command(a, workers),
         Command::Replay(a) => cli::replay::replay(a, workers),

@@ -39,6 +39,7 @@ fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
     the_docks_leave_the_viewport_framing_fits_it_and_the_palette_paints(&mut s);
     without_a_dialog_save_as_and_open_ask_in_the_browser(&mut s, &dir);
     the_scene_exports_as_a_mesh_from_the_browser(&mut s, &dir);
+    a_finished_render_is_written_while_the_editor_runs(&mut s, &dir);
     a_heightmap_becomes_a_new_terrain(&mut s, &dir);
     the_first_click_on_an_empty_scene_attaches_on_the_floor(&mut s, &dir);
     a_small_window_folds_the_docks_and_a_large_one_brings_them_back(&mut s);

@@ -99,9 +99,6 @@ pub(crate) fn render_command(a: RenderArgs, workers: usize) -> Result<()> {
     if a.spp == 0 || a.width == 0 || a.height == 0 || a.width > 16384 || a.height > 16384 {
         bail!("--spp, --width and --height must be positive (sizes at most 16384)");
     }
-    if a.finished() {
-        return super::picture::render_finished(a, workers);
-    }
     if !(a.scale > 0.0 && a.scale <= 1.0) {
         bail!("--scale {} is outside (0, 1]", a.scale);
     }
@@ -156,7 +153,7 @@ impl RenderArgs {
     /// Whether this is a finished render (`render::finished`: tiles, noise targets, alpha,
     /// denoising, presets, sequences, EXR and 16-bit PNG) rather than a plain one (which
     /// also runs on the CPU reference and counts rays).
-    fn finished(&self) -> bool {
+    pub(crate) fn finished(&self) -> bool {
         let ext = self.out.extension().and_then(|e| e.to_str()).unwrap_or("");
         self.noise.is_some()
             || self.denoise

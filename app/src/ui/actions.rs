@@ -225,6 +225,11 @@ impl Editor {
                     at,
                 }));
             }
+            UiEvent::RenderImage => {
+                let name = format!("render.{}", self.settings.render_image.format.extension());
+                self.files
+                    .pick(Purpose::RenderImage, self.folder(), Some(name))
+            }
             UiEvent::EditObject(n) => {
                 if self.read().scene.active() != Some(n) {
                     self.execute(Command::Object(ObjectCommand::Activate(Some(n))));

@@ -255,6 +255,7 @@ impl Editor {
             // Asks for the offset first (the import dialog), then `ImportVox`.
             Purpose::Import => self.panels.import = Some((path, [0, 0, 0])),
             Purpose::LoadPalette => self.files.load_palette(path),
+            Purpose::RenderImage => self.start_render(path),
             Purpose::SavePalette => {
                 let path = if path.extension().is_none() {
                     path.with_extension("png")
@@ -267,6 +268,55 @@ impl Editor {
                     (0..=255u8).map(|i| table.colour(i)).collect()
                 };
                 self.files.save_palette(colours, path);
+            }
+        }
+    }
+
+    /// Starts File → Render image…'s job writing `path` (its extension made the format's).
+    fn start_render(&mut self, path: PathBuf) {
+        let format = self.settings.render_image.format;
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        let path = if ext.eq_ignore_ascii_case(format.extension()) {
+            path
+        } else {
+            path.with_extension(format.extension())
+        };
+        let text = crate::formats::project::to_string(&self.read().scene);
+        let device = self
+            .gfx
+            .as_ref()
+            .map_or_else(|| "gpu".to_string(), |g| g.viewport.ctx().name.clone());
+        self.report
+            .line(format_args!("rendering image {}", path.display()));
+        self.render_task = Some(super::render_image::RenderTask::start(
+            text,
+            self.viewing.camera.camera.clone(),
+            &self.settings.render_image,
+            path,
+            device,
+        ));
+    }
+
+    /// Takes File → Render image…'s outcome once its job ended.
+    pub(super) fn render_finished(&mut self) {
+        let Some(outcome) = self.render_task.as_ref().and_then(|t| t.take_outcome()) else {
+            return;
+        };
+        let path = self.render_task.take().expect("a task").path;
+        match outcome {
+            Ok(done) => {
+                self.report
+                    .line(format_args!("rendered image {}", path.display()));
+                let spp = done.first().map_or(0, |r| r.samples.1);
+                self.panels
+                    .notify(format!("Rendered {} ({spp} spp)", path.display()));
+            }
+            Err(e) => {
+                self.report
+                    .line(format_args!("render failed {}: {e}", path.display()));
+                self.panels
+                    .errors
+                    .push(format!("Rendering {}: {e}", path.display()));
             }
         }
     }

@@ -180,6 +180,7 @@ impl Editor {
         while let Ok(edited) = self.edits.done.try_recv() {
             self.edited(edited);
         }
+        self.render_finished();
         if !self.edits.busy() {
             for (path, autosave) in self.saves.take_waiting() {
                 self.files.save(&self.doc, path, autosave);
@@ -438,6 +439,12 @@ impl Editor {
                     dims,
                 );
                 events = panels::draw(ui, &mut self.panels, &doc, &mut self.settings);
+                events.extend(super::render_image::window(
+                    ui.ctx(),
+                    &mut self.panels.render_image_open,
+                    &mut self.settings.render_image,
+                    self.render_task.as_ref(),
+                ));
             })
         };
         for e in events {

@@ -235,6 +235,8 @@ pub enum UiEvent {
     NewObject(glam::IVec3),
     /// Edit this object's voxels: it becomes the one brushes edit, arrange mode ends.
     EditObject(brickmap::objects::NodeId),
+    /// Ask where to write a finished render (File → Render image…), then render.
+    RenderImage,
     /// Replace the scene's voxels by generated terrain (undoable).
     Generate(crate::editor::command::TerrainSpec),
     /// Go back (undo) or forward (redo) this many steps in the history.

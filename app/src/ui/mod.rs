@@ -48,6 +48,7 @@ mod preview;
 pub mod purpose;
 mod recording;
 mod rect_selecting;
+pub mod render_image;
 pub mod report;
 mod saves;
 mod selecting;
@@ -187,6 +188,8 @@ pub struct Editor {
     saves: saves::Saves,
     /// The view camera, the stored views, the window's size and the viewport's area.
     viewing: viewing::Viewing,
+    /// File → Render image…'s job, while it runs.
+    render_task: Option<render_image::RenderTask>,
     settings: ViewSettings,
     panels: PanelState,
     /// When pointer or key input last went to the UI (a panel, a menu, a window): for
@@ -295,6 +298,7 @@ impl Editor {
             backlog: Vec::new(),
             saves: saves::Saves::new(),
             viewing: viewing::Viewing::new(view),
+            render_task: None,
             ui_touched: None,
             flight: flight::Flight::new(headless),
             motion: motion::Motion::new(),

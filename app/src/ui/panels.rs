@@ -48,6 +48,8 @@ pub struct ViewSettings {
     pub brush: super::tools::Brush,
     /// How File → Export mesh makes the mesh.
     pub mesh_export: crate::formats::mesh::MeshOptions,
+    /// File → Render image…'s options.
+    pub render_image: super::render_image::RenderImageOptions,
 }
 
 impl Default for ViewSettings {
@@ -65,6 +67,7 @@ impl Default for ViewSettings {
             autosave_secs: 180,
             brush: Default::default(),
             mesh_export: Default::default(),
+            render_image: Default::default(),
         }
     }
 }
@@ -74,6 +77,8 @@ impl Default for ViewSettings {
 pub struct PanelState {
     /// Render settings window open.
     pub render_open: bool,
+    /// File → Render image… open.
+    pub render_image_open: bool,
     /// Sun and sky window open.
     pub sun_open: bool,
     /// Statistics window open.
@@ -160,6 +165,9 @@ pub fn draw(
                     if ui.button(label).clicked() {
                         out.push(UiEvent::Action(action));
                     }
+                }
+                if ui.button("Render image…").clicked() {
+                    state.render_image_open = true;
                 }
                 ui.separator();
                 ui.label("mesh export options");

@@ -20,6 +20,8 @@ pub enum Purpose {
     LoadPalette,
     /// Write the palette as a PNG strip.
     SavePalette,
+    /// Write a finished render (File → Render image…).
+    RenderImage,
 }
 
 impl Purpose {
@@ -33,6 +35,7 @@ impl Purpose {
             Purpose::Heightmap => ("Heightmap (PNG, 8 or 16 bit)", &["png"]),
             Purpose::LoadPalette => ("Palette", &["png", "vox"]),
             Purpose::SavePalette => ("PNG palette strip", &["png"]),
+            Purpose::RenderImage => ("Picture", &["png", "exr", "pfm"]),
         }
     }
 
@@ -40,7 +43,11 @@ impl Purpose {
     pub fn saves(self) -> bool {
         matches!(
             self,
-            Purpose::SaveAs | Purpose::Export | Purpose::ExportMesh | Purpose::SavePalette
+            Purpose::SaveAs
+                | Purpose::Export
+                | Purpose::ExportMesh
+                | Purpose::SavePalette
+                | Purpose::RenderImage
         )
     }
 
@@ -55,6 +62,7 @@ impl Purpose {
             Purpose::Heightmap => "A new terrain from a heightmap",
             Purpose::LoadPalette => "Load a palette",
             Purpose::SavePalette => "Save the palette as",
+            Purpose::RenderImage => "Render the image to",
         }
     }
 }

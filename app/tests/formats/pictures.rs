@@ -19,7 +19,9 @@ fn render(out: &Path, extra: &[&str]) -> Option<String> {
         .arg(&robot)
         .arg("--out")
         .arg(out)
-        .args(["--width", "24", "--height", "18", "--spp", "4", "--seed", "3"])
+        .args([
+            "--width", "24", "--height", "18", "--spp", "4", "--seed", "3",
+        ])
         .args(extra)
         .output()
         .unwrap();
@@ -79,7 +81,11 @@ fn read_pfm(path: &Path) -> (usize, usize, Vec<[f32; 3]>) {
         .map(|d| d.parse().unwrap())
         .collect();
     assert_eq!(lines.next(), Some("-1.0"), "little-endian");
-    let header = text.splitn(4, '\n').take(3).map(|l| l.len() + 1).sum::<usize>();
+    let header = text
+        .splitn(4, '\n')
+        .take(3)
+        .map(|l| l.len() + 1)
+        .sum::<usize>();
     let (w, h) = (dims[0], dims[1]);
     let floats: Vec<f32> = bytes[header..]
         .chunks_exact(4)
@@ -120,7 +126,12 @@ fn pictures_are_read_back_by_independent_readers() {
     assert_eq!(ch.len(), 3, "{:?}", ch.keys());
     for (i, p) in linear.iter().enumerate() {
         for (c, name) in ["R", "G", "B"].iter().enumerate() {
-            assert!(close(ch[*name][i], p[c], 1e-5), "{name} {i}: {} vs {}", ch[*name][i], p[c]);
+            assert!(
+                close(ch[*name][i], p[c], 1e-5),
+                "{name} {i}: {} vs {}",
+                ch[*name][i],
+                p[c]
+            );
         }
     }
     // Half floats: rounded to 11 significant bits.
@@ -129,7 +140,12 @@ fn pictures_are_read_back_by_independent_readers() {
     let (_, _, ty, ch) = read_exr(&tools, &half);
     assert_eq!(ty, "float16");
     for (i, p) in linear.iter().enumerate() {
-        assert!(close(ch["R"][i], p[0], 1e-3), "R {i}: {} vs {}", ch["R"][i], p[0]);
+        assert!(
+            close(ch["R"][i], p[0], 1e-3),
+            "R {i}: {} vs {}",
+            ch["R"][i],
+            p[0]
+        );
     }
     // Alpha: premultiplied colour in the EXR; the 16-bit PNG's alpha is the EXR's.
     let (ea, pa) = (d.join("robot_alpha.exr"), d.join("robot_alpha.png"));
@@ -141,7 +157,7 @@ fn pictures_are_read_back_by_independent_readers() {
     .unwrap();
     let (_, _, _, ch) = read_exr(&tools, &ea);
     let alpha = &ch["A"];
-    assert!(alpha.iter().any(|&a| a == 0.0) && alpha.iter().any(|&a| a == 1.0));
+    assert!(alpha.contains(&0.0) && alpha.contains(&1.0));
     for (i, &a) in alpha.iter().enumerate() {
         assert!((0.0..=1.0).contains(&a));
         if a == 0.0 {
@@ -179,7 +195,10 @@ fn pictures_are_read_back_by_independent_readers() {
     // A PFM has no alpha: refused before anything is written.
     let no = d.join("no.pfm");
     let run = Command::new(env!("CARGO_BIN_EXE_voxbrick"))
-        .args(["render", assets().join("mmmm_chr_robot.vox").to_str().unwrap()])
+        .args([
+            "render",
+            assets().join("mmmm_chr_robot.vox").to_str().unwrap(),
+        ])
         .arg("--out")
         .arg(&no)
         .arg("--alpha")

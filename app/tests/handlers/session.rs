@@ -24,6 +24,12 @@ impl Session {
                 internal_scale: 0.25,
                 target_spp: 8,
                 autosave_secs: 0,
+                render_image: app::ui::render_image::RenderImageOptions {
+                    size: (40, 30),
+                    samples: 4,
+                    alpha: true,
+                    ..Default::default()
+                },
                 ..Default::default()
             })
             .unwrap();

@@ -300,3 +300,40 @@ pub fn a_heightmap_becomes_a_new_terrain(s: &mut Session, dir: &std::path::Path)
         .map(|y| y + 1);
     assert_eq!(top, Some((220.0f64 / 255.0 * 256.0).round() as i32));
 }
+
+/// File → Render image…: the window's Render… asks where (the browser), the job renders on
+/// its own session while the editor keeps drawing frames, and the picture is written with
+/// the window's options (40 × 30, a transparent background).
+pub fn a_finished_render_is_written_while_the_editor_runs(s: &mut Session, dir: &std::path::Path) {
+    let out = dir.join("shot.png");
+    s.click_on("File", MouseButton::Left);
+    s.click_on("Render image…", MouseButton::Left);
+    s.frame();
+    s.click_on("Render…", MouseButton::Left);
+    assert!(s.ed.browser_open(), "the browser asks where");
+    s.ctrl(KeyCode::KeyA);
+    s.ed.input(app::ui::Input::Text("shot.png".into()));
+    s.key(KeyCode::Enter, true);
+    s.key(KeyCode::Enter, false);
+    s.quiet();
+    let started = std::time::Instant::now();
+    let mut frames = 0;
+    while !out.exists() {
+        let errors = s.ed.take_errors();
+        assert!(errors.is_empty(), "{errors:?}");
+        assert!(started.elapsed().as_secs() < 120, "never rendered");
+        s.frame();
+        frames += 1;
+    }
+    s.quiet();
+    s.frame();
+    assert!(frames > 0, "the editor drew frames meanwhile");
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&out).unwrap()));
+    let reader = decoder.read_info().unwrap();
+    let info = reader.info();
+    assert_eq!(
+        (info.width, info.height, info.color_type),
+        (40, 30, png::ColorType::Rgba)
+    );
+    assert!(s.ed.take_errors().is_empty());
+}
