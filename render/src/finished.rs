@@ -159,41 +159,35 @@ impl Finish {
     }
 }
 
-/// The relative noise of the mean of halves `a` and `b` (the same pixels, independent
-/// samples): √(mean over pixels of ((La − Lb) / 2)² / (Lm² + 0.01)), L the luminance and Lm
-/// that of the mean.
-pub fn relative_noise(a: &Image, b: &Image) -> f64 {
+/// √(mean over pixel pairs of `term(L1, L2)`), L the luminance of each image's pixel.
+fn luminance_rms(a: &Image, b: &Image, term: impl Fn(f64, f64) -> f64) -> f64 {
     let lum = |p: &[f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
     let n = a.pixels.len().max(1) as f64;
     let sum: f64 = a
         .pixels
         .iter()
         .zip(&b.pixels)
-        .map(|(pa, pb)| {
-            let (la, lb) = (lum(pa), lum(pb));
-            let m = 0.5 * (la + lb);
-            let d = 0.5 * (la - lb);
-            d * d / (m * m + 0.01)
-        })
+        .map(|(p, q)| term(lum(p), lum(q)))
         .sum();
     (sum / n).sqrt()
+}
+
+/// The relative noise of the mean of halves `a` and `b` (the same pixels, independent
+/// samples): √(mean over pixels of ((La − Lb) / 2)² / (Lm² + 0.01)), L the luminance and Lm
+/// that of the mean.
+pub fn relative_noise(a: &Image, b: &Image) -> f64 {
+    luminance_rms(a, b, |la, lb| {
+        let (m, d) = (0.5 * (la + lb), 0.5 * (la - lb));
+        d * d / (m * m + 0.01)
+    })
 }
 
 /// The relative error of `image` against `reference`, the way [`relative_noise`] measures
 /// noise: √(mean over pixels of (L − Lr)² / (Lr² + 0.01)).
 pub fn relative_error(image: &Image, reference: &Image) -> f64 {
-    let lum = |p: &[f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
-    let n = image.pixels.len().max(1) as f64;
-    let sum: f64 = image
-        .pixels
-        .iter()
-        .zip(&reference.pixels)
-        .map(|(p, r)| {
-            let (l, lr) = (lum(p), lum(r));
-            (l - lr) * (l - lr) / (lr * lr + 0.01)
-        })
-        .sum();
-    (sum / n).sqrt()
+    luminance_rms(image, reference, |l, lr| {
+        (l - lr) * (l - lr) / (lr * lr + 0.01)
+    })
 }
 
 /// The second half's seed.

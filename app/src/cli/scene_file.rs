@@ -108,15 +108,18 @@ fn save(scene: &Scene, path: &std::path::Path) -> Result<()> {
     })
 }
 
-/// `voxbrick convert`: between project (.ron) and MagicaVoxel (.vox) files, or to a mesh
-/// (.obj, .glb, .gltf, .ply).
+/// `voxbrick convert`: between project (.ron), MagicaVoxel (.vox), Qubicle (.qb) and Sponge
+/// schematic (.schem) files, or to a mesh (.obj, .glb, .gltf, .ply).
 #[derive(clap::Args)]
 pub(crate) struct ConvertArgs {
-    /// Input file (.ron or .vox).
+    /// Input file (.ron, .vox, .qb or .schem).
     input: PathBuf,
-    /// Output file (.ron, .vox, or a mesh: .obj with .mtl and a palette PNG beside it, .glb,
-    /// .gltf, .ply); replaced atomically.
+    /// Output file (.ron, .vox, .qb, .schem, or a mesh: .obj with .mtl and a palette PNG
+    /// beside it, .glb, .gltf, .ply); replaced atomically.
     output: PathBuf,
+    /// .schem: the block table (RON, as assets/schem/blocks.ron) instead of the built-in one.
+    #[arg(long, value_name = "FILE.ron")]
+    blocks: Option<PathBuf>,
     /// Mesh: one quad per voxel face (watertight) instead of merged rectangles (which meet
     /// at T-junctions).
     #[arg(long)]
@@ -147,6 +150,10 @@ pub(crate) struct ConvertArgs {
 /// Reads the input (reporting what a .vox import dropped) and writes the output.
 pub(crate) fn convert(a: ConvertArgs, workers: usize) -> Result<()> {
     let started = Instant::now();
+    let blocks = match &a.blocks {
+        Some(p) => formats::schem::BlockTable::load(p)?,
+        None => formats::schem::BlockTable::builtin(),
+    };
     let scene = with_progress(
         format!("reading {}", a.input.display()),
         || match Format::of(&a.input)? {
@@ -177,6 +184,57 @@ pub(crate) fn convert(a: ConvertArgs, workers: usize) -> Result<()> {
                 }
                 Ok(scene)
             }
+            Format::Qb => {
+                let bytes = std::fs::read(&a.input)
+                    .with_context(|| format!("reading {}", a.input.display()))?;
+                let (scene, r) = formats::qb::import(&bytes, &a.input, workers)?;
+                eprintln!(
+                    "imported {} voxels from {} matrices, {} colours",
+                    r.voxels, r.matrices, r.colours
+                );
+                if r.merged_colours > 0 {
+                    eprintln!(
+                        "  merged: {} colours beyond 256 into their nearest",
+                        r.merged_colours
+                    );
+                }
+                Ok(if a.flatten { scene.flattened() } else { scene })
+            }
+            Format::Schem => {
+                let bytes = std::fs::read(&a.input)
+                    .with_context(|| format!("reading {}", a.input.display()))?;
+                let (scene, r) = formats::schem::import(&bytes, &a.input, &blocks, workers)?;
+                eprintln!(
+                    "imported {} voxels of a {}x{}x{} version {} schematic",
+                    r.voxels, r.size.x, r.size.y, r.size.z, r.version
+                );
+                if !r.derived.is_empty() {
+                    eprintln!(
+                        "  {} block ids shown as the listed block their name derives from (e.g. {})",
+                        r.derived.len(),
+                        r.derived
+                            .iter()
+                            .take(3)
+                            .map(|(a, b)| format!("{a} as {b}"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    );
+                }
+                for (name, n) in &r.unknown {
+                    eprintln!(
+                        "  not in the block table (shown as its unknown material): {name} ({n} blocks)"
+                    );
+                }
+                if r.block_entities + r.entities > 0 || r.biomes {
+                    eprintln!(
+                        "  dropped: {} block entities, {} entities{}",
+                        r.block_entities,
+                        r.entities,
+                        if r.biomes { ", biomes" } else { "" }
+                    );
+                }
+                Ok(scene)
+            }
         },
     )?;
     if app::formats::mesh::MeshFormat::of(&a.output).is_some() {
@@ -193,6 +251,26 @@ pub(crate) fn convert(a: ConvertArgs, workers: usize) -> Result<()> {
             "{} parts, {} quads, {} triangles",
             stats.parts, stats.quads, stats.triangles
         );
+    } else if Format::of(&a.output)? == Format::Schem {
+        let r = with_progress(format!("writing {}", a.output.display()), || {
+            Ok(formats::schem::export(&scene, &a.output, &blocks)?)
+        })?;
+        if r.as_nearest > 0 {
+            eprintln!(
+                "  {} materials written as the nearest block of the table",
+                r.as_nearest
+            );
+        }
+    } else if Format::of(&a.output)? == Format::Qb {
+        let r = with_progress(format!("writing {}", a.output.display()), || {
+            Ok(formats::qb::export(&scene, &a.output)?)
+        })?;
+        if r.as_colour + r.hidden > 0 {
+            eprintln!(
+                "  {} non-lambertian materials written as their colour, {} hidden objects left out",
+                r.as_colour, r.hidden
+            );
+        }
     } else {
         save(&scene, &a.output)?;
     }

@@ -365,8 +365,8 @@ fn run_step(
             let path = out_dir.join(p);
             if matches!(step, Step::Export(_)) {
                 ensure!(
-                    crate::formats::Format::of(&path)? == crate::formats::Format::Vox,
-                    "export writes .vox files"
+                    crate::formats::Format::of(&path)? != crate::formats::Format::Project,
+                    "export writes .vox, .qb or .schem files"
                 );
             }
             doc.save(&path)?;

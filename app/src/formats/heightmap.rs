@@ -25,10 +25,11 @@ pub struct Heights {
 /// Reads the PNG's samples.
 pub fn read(path: &Path) -> Result<Heights, FormatError> {
     let bytes = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
-    decode(&bytes).map_err(|m| FormatError::invalid(path, m))
+    from_png(&bytes).map_err(|m| FormatError::invalid(path, m))
 }
 
-fn decode(bytes: &[u8]) -> Result<Heights, String> {
+/// Reads a PNG's samples from its bytes (the reason when it cannot).
+pub fn from_png(bytes: &[u8]) -> Result<Heights, String> {
     let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
     decoder.set_transformations(png::Transformations::EXPAND);
     let mut reader = decoder.read_info().map_err(|e| format!("not a PNG: {e}"))?;

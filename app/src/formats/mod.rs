@@ -1,5 +1,7 @@
-//! Scene file formats: RON projects (`project`, with the voxel payload in `payload`) and
-//! MagicaVoxel `.vox` (`vox`, its chunk structure checked first by `vox::check`).
+//! Scene file formats: RON projects (`project`, with the voxel payload in `payload`),
+//! MagicaVoxel `.vox` (`vox`, its chunk structure checked first by `vox::check`), Qubicle
+//! `.qb` (`qb`) and Sponge `.schem` (`schem`, with its block table); meshes, pictures,
+//! palettes and heightmaps out or in (`mesh`, `picture`, `palette`, `heightmap`).
 
 pub mod heightmap;
 pub mod mesh;
@@ -7,6 +9,9 @@ pub mod palette;
 pub mod payload;
 pub mod picture;
 pub mod project;
+pub mod qb;
+pub mod schem;
+pub mod table;
 pub mod vox;
 
 use crate::scene::Scene;
@@ -22,6 +27,15 @@ pub fn load(path: &Path, workers: usize) -> Result<Scene, FormatError> {
             let bytes = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
             Ok(vox::import_objects(&bytes, path, workers)?.scene)
         }
+        Format::Qb => {
+            let bytes = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
+            Ok(qb::import(&bytes, path, workers)?.0)
+        }
+        Format::Schem => {
+            let bytes = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
+            let table = schem::BlockTable::builtin();
+            Ok(schem::import(&bytes, path, &table, workers)?.0)
+        }
     }
 }
 
@@ -31,6 +45,8 @@ pub fn save(scene: &Scene, path: &Path) -> Result<(), FormatError> {
     match Format::of(path)? {
         Format::Project => project::save(scene, path),
         Format::Vox => vox::export_file(scene, path).map(|_| ()),
+        Format::Qb => qb::export(scene, path).map(|_| ()),
+        Format::Schem => schem::export(scene, path, &schem::BlockTable::builtin()).map(|_| ()),
     }
 }
 
@@ -131,6 +147,10 @@ pub enum Format {
     Project,
     /// MagicaVoxel (`.vox`).
     Vox,
+    /// Qubicle binary (`.qb`).
+    Qb,
+    /// Sponge schematic (`.schem`).
+    Schem,
 }
 
 impl Format {
@@ -144,9 +164,11 @@ impl Format {
         {
             Some("ron") => Ok(Format::Project),
             Some("vox") => Ok(Format::Vox),
+            Some("qb") => Ok(Format::Qb),
+            Some("schem") => Ok(Format::Schem),
             _ => Err(FormatError::invalid(
                 path,
-                "unknown file type: expected .ron or .vox",
+                "unknown file type: expected .ron, .vox, .qb or .schem",
             )),
         }
     }

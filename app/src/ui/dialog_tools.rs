@@ -107,7 +107,10 @@ mod tests {
         let (_, z) = zenity_args(Purpose::Open, "");
         assert_eq!(
             z,
-            ["--file-selection", "--file-filter=Scenes | *.ron *.vox"]
+            [
+                "--file-selection",
+                "--file-filter=Scenes | *.ron *.vox *.qb *.schem"
+            ]
         );
         let (_, k) = kdialog_args(Purpose::Import, "/m/");
         assert_eq!(k, ["--getopenfilename", "/m/", "*.vox (MagicaVoxel)"]);

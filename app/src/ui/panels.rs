@@ -159,7 +159,7 @@ pub fn draw(
                     ("Save  Ctrl+S", Action::Save),
                     ("Save As…  Ctrl+Shift+S", Action::SaveAs),
                     ("Import .vox…  Ctrl+I", Action::Import),
-                    ("Export .vox…  Ctrl+E", Action::Export),
+                    ("Export .vox / .qb / .schem…  Ctrl+E", Action::Export),
                     ("Export mesh…  Ctrl+Shift+E", Action::ExportMesh),
                 ] {
                     if ui.button(label).clicked() {

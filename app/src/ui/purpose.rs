@@ -28,9 +28,10 @@ impl Purpose {
     /// The extensions this purpose's files have, and their description.
     pub fn filter(self) -> (&'static str, &'static [&'static str]) {
         match self {
-            Purpose::Open => ("Scenes", &["ron", "vox"]),
+            Purpose::Open => ("Scenes", &["ron", "vox", "qb", "schem"]),
             Purpose::SaveAs => ("voxbrick project", &["ron"]),
-            Purpose::Import | Purpose::Export => ("MagicaVoxel", &["vox"]),
+            Purpose::Import => ("MagicaVoxel", &["vox"]),
+            Purpose::Export => ("Voxel formats", &["vox", "qb", "schem"]),
             Purpose::ExportMesh => ("Mesh", &["glb", "gltf", "obj", "ply"]),
             Purpose::Heightmap => ("Heightmap (PNG, 8 or 16 bit)", &["png"]),
             Purpose::LoadPalette => ("Palette", &["png", "vox"]),
@@ -57,7 +58,7 @@ impl Purpose {
             Purpose::Open => "Open a scene",
             Purpose::SaveAs => "Save the scene as",
             Purpose::Import => "Import a .vox",
-            Purpose::Export => "Export as .vox",
+            Purpose::Export => "Export as .vox, .qb or .schem",
             Purpose::ExportMesh => "Export a mesh",
             Purpose::Heightmap => "A new terrain from a heightmap",
             Purpose::LoadPalette => "Load a palette",

@@ -1,13 +1,16 @@
 //! File formats end to end: project round trips and hostile files, atomic saves (here);
 //! .vox import of every sample, import → export → import, scenes beyond 256³, rotations
 //! (`vox_files.rs`); meshes out (`mesh.rs`); heightmaps in (`heightmap.rs`); finished
-//! pictures out (`pictures.rs`).
+//! pictures out (`pictures.rs`); Qubicle and Sponge schematic files (`qubicle.rs`,
+//! `schematics.rs`).
 
 #[path = "../common/mod.rs"]
 mod common;
 mod heightmap;
 mod mesh;
 mod pictures;
+mod qubicle;
+mod schematics;
 mod vox_files;
 
 use app::Scene;
