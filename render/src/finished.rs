@@ -314,7 +314,7 @@ impl Viewport {
             Stop::Samples(n) => {
                 let mut left = n;
                 while left > 0 {
-                    let batch = left.min(16);
+                    let batch = left.min(batch_spp(finish.tile));
                     add(a.add(self, view, params, variant, batch)?);
                     left -= batch;
                     if !report(f64::from(n - left) / f64::from(n)) {
@@ -331,7 +331,7 @@ impl Viewport {
                     params,
                     variant,
                     (&mut a, &mut b),
-                    (target, max),
+                    (target, max, finish.tile),
                     &mut add,
                     report,
                 )?
@@ -384,6 +384,13 @@ impl Viewport {
     }
 }
 
+/// Samples per pixel between two progress reports (and cancel checks): about 2 M paths for
+/// a full tile of `side`², 1 to 16. The same for every tile of a picture, so tiles add their
+/// samples in the batches the untiled picture does when the tile side is the same.
+fn batch_spp(side: u32) -> u32 {
+    ((1u64 << 21) / (side as u64 * side as u64).max(1)).clamp(1, 16) as u32
+}
+
 /// Calls `progress` with the part done; false: cancel.
 fn report_done(
     progress: &mut dyn FnMut(Progress) -> bool,
@@ -408,7 +415,7 @@ fn noise_loop(
     params: &SceneParams,
     variant: Variant,
     (a, b): (&mut Acc, &mut Acc),
-    (target, max): (f64, u32),
+    (target, max, tile): (f64, u32, u32),
     add: &mut dyn FnMut(Option<f64>),
     report: &mut dyn FnMut(f64) -> bool,
 ) -> Result<(Image, u32, Option<f64>), PictureError> {
@@ -417,7 +424,7 @@ fn noise_loop(
     let mut want = 8.min(half_max);
     loop {
         while half < want {
-            let batch = (want - half).min(16);
+            let batch = (want - half).min(batch_spp(tile));
             add(a.add(vp, view, params, variant, batch)?);
             add(b.add(vp, view, params, variant, batch)?);
             half += batch;

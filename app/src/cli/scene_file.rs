@@ -244,9 +244,21 @@ pub(crate) fn convert(a: ConvertArgs, workers: usize) -> Result<()> {
             voxel_size: a.voxel_size,
             keep_transforms: a.keep_transforms,
         };
-        let stats = with_progress(format!("writing {}", a.output.display()), || {
-            Ok(app::formats::mesh::export(&scene, &a.output, &options)?)
-        })?;
+        // A bar with the part done and the time left (Ctrl + C stops: nothing is written).
+        let bar = indicatif::ProgressBar::new(1000);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{msg} {bar:40} {percent:>3}% {elapsed} (about {eta} left)",
+            )
+            .expect("valid template"),
+        );
+        bar.set_message(format!("writing {}", a.output.display()));
+        let stats = app::formats::mesh::export_watched(&scene, &a.output, &options, &|f| {
+            bar.set_position((f * 1000.0) as u64);
+            true
+        });
+        bar.finish_and_clear();
+        let stats = stats?;
         eprintln!(
             "{} parts, {} quads, {} triangles",
             stats.parts, stats.quads, stats.triangles

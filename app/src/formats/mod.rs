@@ -61,6 +61,12 @@ pub enum FormatError {
         /// The cause (shown in the message, so not chained again).
         error: std::io::Error,
     },
+    /// The user stopped it (nothing was written).
+    #[error("{path}: cancelled, nothing written")]
+    Cancelled {
+        /// The file.
+        path: String,
+    },
     /// The content is not a valid file of this format.
     #[error("{path}: {message}")]
     Invalid {

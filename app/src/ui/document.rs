@@ -250,7 +250,10 @@ impl Editor {
                     path
                 };
                 let options = self.settings.mesh_export.clone();
-                self.files.export_mesh(&self.doc, path, options)
+                let progress =
+                    std::sync::Arc::new(super::progress::TaskProgress::waking(self.files.waker()));
+                self.mesh_task = Some((path.clone(), progress.clone()));
+                self.files.export_mesh(&self.doc, path, options, progress)
             }
             // Asks for the offset first (the import dialog), then `ImportVox`.
             Purpose::Import => self.panels.import = Some((path, [0, 0, 0])),
@@ -294,6 +297,7 @@ impl Editor {
             &self.settings.render_image,
             path,
             device,
+            self.files.waker(),
         ));
     }
 
@@ -302,7 +306,15 @@ impl Editor {
         let Some(outcome) = self.render_task.as_ref().and_then(|t| t.take_outcome()) else {
             return;
         };
-        let path = self.render_task.take().expect("a task").path;
+        let task = self.render_task.take().expect("a task");
+        let path = task.path;
+        if outcome.is_err() && task.progress.cancelled() {
+            self.report
+                .line(format_args!("render cancelled {}", path.display()));
+            self.panels
+                .notify(format!("Render cancelled: {} not written", path.display()));
+            return;
+        }
         match outcome {
             Ok(done) => {
                 self.report
@@ -328,7 +340,22 @@ impl Editor {
             Done::Palette(Ok(colours)) => self.execute(Command::SetPalette(colours)),
             Done::Palette(Err(e)) => self.panels.errors.push(format!("{e:#}")),
             Done::PaletteSaved(_, Ok(())) => {}
+            Done::MeshExported(path, Err(e))
+                if matches!(
+                    e.downcast_ref::<crate::formats::FormatError>(),
+                    Some(crate::formats::FormatError::Cancelled { .. })
+                ) =>
+            {
+                self.mesh_task = None;
+                self.report
+                    .line(format_args!("mesh export cancelled {}", path.display()));
+                self.panels.notify(format!(
+                    "Mesh export cancelled: {} not written",
+                    path.display()
+                ));
+            }
             Done::MeshExported(path, Ok(stats)) => {
+                self.mesh_task = None;
                 self.report
                     .line(format_args!("exported mesh {}", path.display()));
                 self.panels.notify(format!(
@@ -338,7 +365,10 @@ impl Editor {
                     path.display()
                 ));
             }
-            Done::MeshExported(_, Err(e)) => self.panels.errors.push(format!("{e:#}")),
+            Done::MeshExported(_, Err(e)) => {
+                self.mesh_task = None;
+                self.panels.errors.push(format!("Could not export {e:#}"))
+            }
             Done::PaletteSaved(path, Err(e)) => self
                 .panels
                 .errors

@@ -192,6 +192,11 @@ pub struct FileWorker {
 }
 
 impl FileWorker {
+    /// What wakes an idle editor (jobs of their own call it when they end).
+    pub fn waker(&self) -> Arc<dyn Fn() + Send + Sync> {
+        self.wake.clone()
+    }
+
     /// A worker that calls `wake` when a job finishes (to redraw an idle editor).
     pub fn new(wake: Arc<dyn Fn() + Send + Sync>) -> Self {
         let (done_tx, done) = crossbeam_channel::unbounded();
@@ -277,18 +282,22 @@ impl FileWorker {
     }
 
     /// Writes the document's scene as a mesh (the format by the extension) on a worker
-    /// thread, reading it under a read lock.
+    /// thread, reading it under a read lock, telling `progress` how far it is and stopping
+    /// (nothing written) when it is cancelled.
     pub fn export_mesh(
         &mut self,
         doc: &SharedDocument,
         path: PathBuf,
         options: crate::formats::mesh::MeshOptions,
+        progress: std::sync::Arc<super::progress::TaskProgress>,
     ) {
         let doc = doc.clone();
         self.spawn(format!("exporting {}", path.display()), move || {
             let result = match doc.read() {
-                Ok(d) => crate::formats::mesh::export(&d.scene, &path, &options)
-                    .map_err(|e| anyhow::anyhow!("Could not export {e}")),
+                Ok(d) => crate::formats::mesh::export_watched(&d.scene, &path, &options, &|f| {
+                    progress.set(f)
+                })
+                .map_err(anyhow::Error::from),
                 Err(_) => Err(anyhow::anyhow!("the document is unavailable")),
             };
             Done::MeshExported(path, result)

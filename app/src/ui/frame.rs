@@ -439,6 +439,14 @@ impl Editor {
                     dims,
                 );
                 events = panels::draw(ui, &mut self.panels, &doc, &mut self.settings);
+                if let Some((path, p)) = &self.mesh_task {
+                    super::progress::window(
+                        ui.ctx(),
+                        "Exporting a mesh",
+                        &path.display().to_string(),
+                        p,
+                    );
+                }
                 events.extend(super::render_image::window(
                     ui.ctx(),
                     &mut self.panels.render_image_open,

@@ -45,6 +45,7 @@ pub mod panels;
 mod pending;
 mod pointer;
 mod preview;
+pub mod progress;
 pub mod purpose;
 mod recording;
 mod rect_selecting;
@@ -190,6 +191,8 @@ pub struct Editor {
     viewing: viewing::Viewing,
     /// File → Render image…'s job, while it runs.
     render_task: Option<render_image::RenderTask>,
+    /// File → Export mesh's file and progress, while it runs.
+    mesh_task: Option<(PathBuf, std::sync::Arc<progress::TaskProgress>)>,
     settings: ViewSettings,
     panels: PanelState,
     /// When pointer or key input last went to the UI (a panel, a menu, a window): for
@@ -299,6 +302,7 @@ impl Editor {
             saves: saves::Saves::new(),
             viewing: viewing::Viewing::new(view),
             render_task: None,
+            mesh_task: None,
             ui_touched: None,
             flight: flight::Flight::new(headless),
             motion: motion::Motion::new(),

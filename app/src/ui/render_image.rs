@@ -8,11 +8,11 @@
 //! render's batches never share one); edits made meanwhile are not in the picture.
 
 use super::intent::UiEvent;
+use super::progress::TaskProgress;
 use crate::formats::picture::PictureFormat;
 use crate::picture::{Preset, Rendered, Shot, content_bounds, render_shots};
 use render::finished::{Finish, Stop};
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// The options of File → Render image….
@@ -73,21 +73,16 @@ impl RenderImageOptions {
     }
 }
 
-/// What the job's thread shares with the editor.
-#[derive(Default)]
-struct Shared {
-    /// Part done and seconds left.
-    progress: (f64, Option<f64>),
-    /// The outcome, once there is one.
-    outcome: Option<Result<Vec<Rendered>, String>>,
-}
+/// How a render ended: the pictures written, or why not.
+pub type Outcome = Result<Vec<Rendered>, String>;
 
 /// A render under way.
 pub struct RenderTask {
     /// The file it writes.
     pub path: PathBuf,
-    shared: Arc<Mutex<Shared>>,
-    cancel: Arc<AtomicBool>,
+    /// Its progress and Cancel.
+    pub progress: Arc<TaskProgress>,
+    outcome: Arc<Mutex<Option<Outcome>>>,
 }
 
 impl RenderTask {
@@ -99,39 +94,33 @@ impl RenderTask {
         options: &RenderImageOptions,
         path: PathBuf,
         device: String,
+        wake: Arc<dyn Fn() + Send + Sync>,
     ) -> Self {
-        let shared = Arc::new(Mutex::new(Shared::default()));
-        let cancel = Arc::new(AtomicBool::new(false));
-        let (s, c, o, p) = (
-            shared.clone(),
-            cancel.clone(),
+        let progress = Arc::new(TaskProgress::waking(wake));
+        let outcome = Arc::new(Mutex::new(None));
+        let (p, out, o, file) = (
+            progress.clone(),
+            outcome.clone(),
             options.clone(),
             path.clone(),
         );
         std::thread::spawn(move || {
-            let outcome = run(&scene_text, camera, &o, &p, &device, &s, &c);
-            s.lock().expect("render job state").outcome = Some(outcome);
+            let result = run(&scene_text, camera, &o, &file, &device, &p);
+            if let Ok(mut slot) = out.lock() {
+                *slot = Some(result);
+            }
+            p.wake();
         });
         Self {
             path,
-            shared,
-            cancel,
+            progress,
+            outcome,
         }
     }
 
-    /// Asks the job to stop (it ends at its next batch; nothing is written).
-    pub fn cancel(&self) {
-        self.cancel.store(true, Ordering::Relaxed);
-    }
-
-    /// Part done (0..1) and seconds left.
-    pub fn progress(&self) -> (f64, Option<f64>) {
-        self.shared.lock().map_or((0.0, None), |s| s.progress)
-    }
-
     /// The outcome once the job ended (taken once).
-    pub fn take_outcome(&self) -> Option<Result<Vec<Rendered>, String>> {
-        self.shared.lock().ok()?.outcome.take()
+    pub fn take_outcome(&self) -> Option<Outcome> {
+        self.outcome.lock().ok()?.take()
     }
 }
 
@@ -141,8 +130,7 @@ fn run(
     o: &RenderImageOptions,
     path: &std::path::Path,
     device: &str,
-    shared: &Mutex<Shared>,
-    cancel: &AtomicBool,
+    progress: &TaskProgress,
 ) -> Result<Vec<Rendered>, String> {
     let finish = o.finish();
     finish.validate().map_err(|e| e.to_string())?;
@@ -159,10 +147,7 @@ fn run(
         out: path.to_path_buf(),
     }];
     render_shots(&mut session, &view, &shots, &finish, o.format, &mut |p| {
-        if let Ok(mut s) = shared.lock() {
-            s.progress = (p.done, p.remaining());
-        }
-        !cancel.load(Ordering::Relaxed)
+        progress.set(p.done)
     })
     .map_err(|e| e.to_string())
 }
@@ -177,21 +162,7 @@ pub fn window(
 ) -> Option<UiEvent> {
     let mut event = None;
     if let Some(t) = task {
-        let (done, left) = t.progress();
-        egui::Window::new("Rendering")
-            .collapsible(false)
-            .resizable(false)
-            .show(ctx, |ui| {
-                ui.label(format!("{}", t.path.display()));
-                ui.add(egui::ProgressBar::new(done as f32).show_percentage());
-                ui.label(left.map_or("estimating the time left…".to_string(), |s| {
-                    format!("about {} left", seconds(s))
-                }));
-                if ui.button("Cancel").clicked() {
-                    t.cancel();
-                }
-            });
-        ctx.request_repaint_after(std::time::Duration::from_millis(250));
+        super::progress::window(ctx, "Rendering", &t.path.display().to_string(), &t.progress);
     }
     if !*open {
         return None;
@@ -254,14 +225,4 @@ pub fn window(
             }
         });
     event
-}
-
-/// Seconds as `1 h 2 min`, `3 min 4 s` or `5 s`.
-fn seconds(s: f64) -> String {
-    let s = s.max(0.0).round() as u64;
-    match s {
-        0..60 => format!("{s} s"),
-        60..3600 => format!("{} min {} s", s / 60, s % 60),
-        _ => format!("{} h {} min", s / 3600, s % 3600 / 60),
-    }
 }

@@ -309,3 +309,36 @@ fn meshes_pass_the_gltf_validator_and_trimesh_finds_the_scenes_faces_bounds_and_
         assert!(!dir.join(f).exists(), "{f} written");
     }
 }
+
+/// A long export reports its progress (never backwards, up to the file) and stops when
+/// told to, writing nothing; a finished export after it is whole.
+#[test]
+fn a_mesh_export_reports_progress_and_a_cancel_writes_nothing() {
+    let d = scratch("mesh-cancel");
+    let scene = app::ui::files::new_scene((256, 64, 256), true, 2).unwrap();
+    let out = d.join("terrain.glb");
+    let seen = std::sync::Mutex::new(Vec::new());
+    let options = MeshOptions::default();
+    mesh::export_watched(&scene, &out, &options, &|f| {
+        seen.lock().unwrap().push(f);
+        true
+    })
+    .unwrap();
+    let seen = seen.into_inner().unwrap();
+    assert!(seen.len() >= 3, "{seen:?}");
+    assert!(seen.windows(2).all(|w| w[0] <= w[1]), "{seen:?}");
+    assert_eq!(*seen.last().unwrap(), 0.9);
+    let whole = std::fs::read(&out).unwrap();
+    std::fs::remove_file(&out).unwrap();
+    for stop_at in [0, seen.len() - 1] {
+        let calls = std::sync::atomic::AtomicUsize::new(0);
+        let e = mesh::export_watched(&scene, &out, &options, &|_| {
+            calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed) < stop_at
+        })
+        .unwrap_err();
+        assert!(matches!(e, FormatError::Cancelled { .. }), "{e}");
+        assert!(!out.exists(), "a cancelled export wrote {}", out.display());
+    }
+    mesh::export(&scene, &out, &options).unwrap();
+    assert_eq!(std::fs::read(&out).unwrap(), whole);
+}

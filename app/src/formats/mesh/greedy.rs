@@ -101,8 +101,14 @@ type Plane = (usize, i32, i32);
 
 /// The quads of every showing face of `src` (`see_through[m]`: material m is a dielectric),
 /// merged into rectangles with `greedy`, one quad per face without. Sorted (plane, then
-/// position), so the same voxels give the same quads.
-pub fn quads(src: &dyn Bricks, see_through: &[bool; 256], greedy: bool) -> Vec<Quad> {
+/// position), so the same voxels give the same quads. `watch` hears the part of the bricks
+/// done every 1,024 bricks; when it says stop, None comes back.
+pub fn quads(
+    src: &dyn Bricks,
+    see_through: &[bool; 256],
+    greedy: bool,
+    watch: &dyn Fn(f64) -> bool,
+) -> Option<Vec<Quad>> {
     let mut planes: HashMap<Plane, Vec<(i32, i32, u8)>> = HashMap::new();
     let mut bricks = src.non_empty();
     bricks.sort_by_key(|b| (b.x, b.y, b.z));
@@ -110,7 +116,11 @@ pub fn quads(src: &dyn Bricks, see_through: &[bool; 256], greedy: bool) -> Vec<Q
     let has_clear = |mask: &Mask, mats: &[u8; 512]| {
         any_clear && mask.ones().any(|bit| see_through[mats[bit] as usize])
     };
-    for b in bricks {
+    let count = bricks.len().max(1) as f64;
+    for (i, b) in bricks.into_iter().enumerate() {
+        if i % 1024 == 1023 && !watch(i as f64 / count) {
+            return None;
+        }
         let Some((mask, mats)) = src.brick(b) else {
             continue;
         };
@@ -168,7 +178,7 @@ pub fn quads(src: &dyn Bricks, see_through: &[bool; 256], greedy: bool) -> Vec<Q
             }
         }
     }
-    out
+    Some(out)
 }
 
 /// A voxel's position in its brick from its bit.

@@ -115,72 +115,107 @@ fn see_through(table: &MaterialTable) -> [bool; 256] {
 
 /// The scene's mesh.
 pub fn build(scene: &Scene, options: &MeshOptions) -> Mesh {
+    build_watched(scene, options, &|_| true).expect("never stopped")
+}
+
+/// [`build`], telling `watch` the part done (0..1) as it goes; None when it says stop.
+pub fn build_watched(
+    scene: &Scene,
+    options: &MeshOptions,
+    watch: &dyn Fn(f64) -> bool,
+) -> Option<Mesh> {
     let table = scene.world.materials().clone();
     let clear = see_through(&table);
     let parts = if options.per_object {
         let objects = scene.objects();
         let tree = objects.tree();
-        tree.drawn()
-            .into_iter()
-            .filter_map(|d| {
-                let model = objects.model(d.model)?;
-                let size = model.size();
-                let rot = d.placement.rot;
-                let half = size.div_euclid(IVec3::splat(2));
-                // A corner p of the model lands at R·(p − ⌊s/2⌋) + t (the pivot rule).
-                let place = |p: IVec3| rot.apply(p - half) + d.placement.t;
-                let node = tree.node(d.node).ok()?;
-                let local = greedy::quads(model, &clear, options.greedy);
-                if options.keep_transforms {
-                    return Some(Part {
-                        name: node.name.clone(),
-                        groups: groups_above(tree, d.node),
-                        quads: local
-                            .into_iter()
-                            .map(|q| Quad {
-                                corners: q.corners.map(|p| p - half),
-                                ..q
-                            })
-                            .collect(),
-                        transform: Some((rot.matrix(), d.placement.t)),
-                    });
-                }
-                let quads = local
-                    .into_iter()
-                    .map(|q| {
-                        let mut corners = q.corners.map(place);
-                        if rot.is_reflection() {
-                            corners.reverse();
-                        }
-                        Quad {
-                            corners,
-                            normal: rot.apply(q.normal),
-                            material: q.material,
-                        }
-                    })
-                    .collect();
-                Some(Part {
-                    name: node.name.clone(),
-                    groups: groups_above(tree, d.node),
-                    quads,
-                    transform: None,
-                })
-            })
-            .collect()
+        let drawn = tree.drawn();
+        let n = drawn.len().max(1) as f64;
+        let mut parts = Vec::new();
+        for (k, d) in drawn.into_iter().enumerate() {
+            let part = |f: f64| watch((k as f64 + f) / n);
+            if !part(0.0) {
+                return None;
+            }
+            let local = match objects.model(d.model) {
+                Some(model) => greedy::quads(model, &clear, options.greedy, &part)?,
+                None => continue,
+            };
+            parts.extend(placed_part(
+                tree,
+                objects.model(d.model),
+                &d,
+                local,
+                options,
+            ));
+        }
+        parts
     } else {
         let view = scene.world.read();
         vec![Part {
             name: "scene".into(),
             groups: Vec::new(),
-            quads: greedy::quads(&view, &clear, options.greedy),
+            quads: greedy::quads(&view, &clear, options.greedy, watch)?,
             transform: None,
         }]
     };
-    Mesh {
+    Some(Mesh {
         parts,
         table,
         voxel_size: options.voxel_size,
+    })
+}
+
+/// A drawn object's part: its model's `local` quads placed (or kept in the model's frame,
+/// with the placement as the part's transform, for glTF with `keep_transforms`).
+fn placed_part(
+    tree: &brickmap::objects::ObjectTree,
+    model: Option<&brickmap::objects::Model>,
+    d: &brickmap::objects::Drawn,
+    local: Vec<Quad>,
+    options: &MeshOptions,
+) -> Option<Part> {
+    let model = model?;
+    let size = model.size();
+    let rot = d.placement.rot;
+    let half = size.div_euclid(IVec3::splat(2));
+    // A corner p of the model lands at R·(p − ⌊s/2⌋) + t (the pivot rule).
+    let place = |p: IVec3| rot.apply(p - half) + d.placement.t;
+    let node = tree.node(d.node).ok()?;
+    if options.keep_transforms {
+        return Some(Part {
+            name: node.name.clone(),
+            groups: groups_above(tree, d.node),
+            quads: local
+                .into_iter()
+                .map(|q| Quad {
+                    corners: q.corners.map(|p| p - half),
+                    ..q
+                })
+                .collect(),
+            transform: Some((rot.matrix(), d.placement.t)),
+        });
     }
+    let quads = local
+        .into_iter()
+        .map(|q| {
+            let mut corners = q.corners.map(place);
+            if rot.is_reflection() {
+                corners.reverse();
+            }
+            Quad {
+                corners,
+                normal: rot.apply(q.normal),
+                material: q.material,
+            }
+        })
+        .collect();
+    Some(Part {
+        name: node.name.clone(),
+        groups: groups_above(tree, d.node),
+        quads,
+        transform: None,
+    })
 }
 
 /// The names of the groups above `node`, outermost first (the root left out).
@@ -229,6 +264,20 @@ impl MeshFormat {
 
 /// Writes `scene` as a mesh to `path` (the format by its extension), atomically.
 pub fn export(scene: &Scene, path: &Path, options: &MeshOptions) -> Result<MeshStats, FormatError> {
+    export_watched(scene, path, options, &|_| true)
+}
+
+/// [`export`], telling `watch` the part done (0..1; the faces are 90 %, the file the rest);
+/// when it says stop, nothing is written and [`FormatError::Cancelled`] comes back.
+pub fn export_watched(
+    scene: &Scene,
+    path: &Path,
+    options: &MeshOptions,
+    watch: &dyn Fn(f64) -> bool,
+) -> Result<MeshStats, FormatError> {
+    let cancelled = || FormatError::Cancelled {
+        path: path.display().to_string(),
+    };
     let format = MeshFormat::of(path).ok_or_else(|| {
         FormatError::invalid(path, "a mesh is written as .obj, .glb, .gltf or .ply")
     })?;
@@ -238,7 +287,7 @@ pub fn export(scene: &Scene, path: &Path, options: &MeshOptions) -> Result<MeshS
             format!("voxel size {} must be positive", options.voxel_size),
         ));
     }
-    let mesh = build(scene, options);
+    let mesh = build_watched(scene, options, &|f| watch(0.9 * f)).ok_or_else(cancelled)?;
     if mesh.parts.iter().all(|p| p.quads.is_empty()) {
         return Err(FormatError::invalid(
             path,
@@ -248,16 +297,17 @@ pub fn export(scene: &Scene, path: &Path, options: &MeshOptions) -> Result<MeshS
     let mesh = if options.keep_transforms && format != MeshFormat::Glb && format != MeshFormat::Gltf
     {
         // Only glTF has node transforms: the others get them applied.
-        build(
-            scene,
-            &MeshOptions {
-                keep_transforms: false,
-                ..options.clone()
-            },
-        )
+        let flat = MeshOptions {
+            keep_transforms: false,
+            ..options.clone()
+        };
+        build_watched(scene, &flat, &|f| watch(0.9 * f)).ok_or_else(cancelled)?
     } else {
         mesh
     };
+    if !watch(0.9) {
+        return Err(cancelled());
+    }
     match format {
         MeshFormat::Obj => obj::write(&mesh, path)?,
         MeshFormat::Glb => gltf::write(&mesh, path, true)?,
