@@ -87,6 +87,18 @@ impl Scene {
         }
     }
 
+    /// An imported scene of objects composited into `world`: the default sun and sky, the
+    /// camera framing the content, editing the first object.
+    pub fn imported(world: World, objects: Objects) -> Self {
+        world.take_dirty();
+        let mut params = SceneParams::framing(world.read().dims().voxels().as_dvec3());
+        if let Some((a, b)) = world.read().occupied_bounds() {
+            params.camera = params.camera.framing(a.as_dvec3(), b.as_dvec3()).0;
+        }
+        let active = Self::first_object(&objects);
+        Self::with_objects(world, objects, active, params)
+    }
+
     /// The first object of a tree in drawing order, shown or hidden (what a loaded scene
     /// edits first).
     pub fn first_object(objects: &Objects) -> Option<NodeId> {

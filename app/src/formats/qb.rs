@@ -290,13 +290,7 @@ pub fn import(bytes: &[u8], path: &Path, workers: usize) -> Result<(Scene, QbRep
     }
     let objects = Objects::new(tree, models, &world)
         .map_err(|e| invalid(format!("the matrices do not fit together: {e}")))?;
-    world.take_dirty();
-    let mut params = render::SceneParams::framing(dims.voxels().as_dvec3());
-    if let Some((a, b)) = world.read().occupied_bounds() {
-        params.camera = params.camera.framing(a.as_dvec3(), b.as_dvec3()).0;
-    }
-    let active = Scene::first_object(&objects);
-    Ok((Scene::with_objects(world, objects, active, params), report))
+    Ok((Scene::imported(world, objects), report))
 }
 
 /// The scene's drawn objects as matrices (each as it shows: turned, at its place relative

@@ -57,6 +57,34 @@ fn resolved(world: &World) -> Vec<(IVec3, MaterialKind, u32, [u8; 3])> {
     out
 }
 
+/// The files of `assets/DIR` ending in `.EXT`, sorted (at least `least` of them).
+fn asset_files(dir: &str, ext: &str, least: usize) -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets")
+        .join(dir);
+    let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == ext))
+        .collect();
+    out.sort();
+    assert!(out.len() >= least, "{out:?}");
+    out
+}
+
+/// [`resolved`] relative to the lowest corner of the voxels' box (scenes placed apart).
+fn content(world: &World) -> Vec<(IVec3, MaterialKind, u32, [u8; 3])> {
+    let all = resolved(world);
+    let lo = all
+        .iter()
+        .map(|v| v.0)
+        .reduce(IVec3::min)
+        .unwrap_or(IVec3::ZERO);
+    all.into_iter()
+        .map(|(p, k, v, c)| (p - lo, k, v, c))
+        .collect()
+}
+
 /// A tree in pre-order: each node's name, kind (for an object its model's voxels with their
 /// resolved materials, which two imports may number differently), visibility, layer and
 /// world placement.

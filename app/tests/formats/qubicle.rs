@@ -8,31 +8,7 @@ use super::*;
 use app::formats::qb;
 
 fn files() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/qb");
-    let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "qb"))
-        .collect();
-    out.sort();
-    assert!(out.len() >= 5, "{out:?}");
-    out
-}
-
-/// The solid voxels with resolved materials, relative to the lowest one.
-fn content(world: &World) -> Vec<(IVec3, MaterialKind, u32, [u8; 3])> {
-    let all = resolved(world);
-    let lo = all
-        .iter()
-        .map(|v| v.0)
-        .reduce(IVec3::min)
-        .unwrap_or(IVec3::ZERO);
-    let mut out: Vec<_> = all
-        .into_iter()
-        .map(|(p, k, v, c)| (p - lo, k, v, c))
-        .collect();
-    out.sort_by_key(|v| (v.0.x, v.0.y, v.0.z));
-    out
+    asset_files("qb", "qb", 5)
 }
 
 #[test]

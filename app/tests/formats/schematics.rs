@@ -11,28 +11,7 @@ use app::formats::schem::{self, BlockTable, nbt};
 use std::collections::BTreeMap;
 
 fn files() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/schem");
-    let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "schem"))
-        .collect();
-    out.sort();
-    assert!(out.len() >= 5, "{out:?}");
-    out
-}
-
-/// The solid voxels with resolved materials, relative to the lowest corner of their box.
-fn content(world: &World) -> Vec<(IVec3, MaterialKind, u32, [u8; 3])> {
-    let all = resolved(world);
-    let lo = all
-        .iter()
-        .map(|v| v.0)
-        .reduce(IVec3::min)
-        .unwrap_or(IVec3::ZERO);
-    all.into_iter()
-        .map(|(p, k, v, c)| (p - lo, k, v, c))
-        .collect()
+    asset_files("schem", "schem", 5)
 }
 
 #[test]

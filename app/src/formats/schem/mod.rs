@@ -262,13 +262,7 @@ pub fn import(
     .map_err(|e| invalid(e.to_string()))?;
     let objects = Objects::new(tree, BTreeMap::from([(ModelId(0), model)]), &world)
         .map_err(|e| invalid(format!("the schematic does not fit: {e}")))?;
-    world.take_dirty();
-    let mut params = render::SceneParams::framing(dims.voxels().as_dvec3());
-    if let Some((a, b)) = world.read().occupied_bounds() {
-        params.camera = params.camera.framing(a.as_dvec3(), b.as_dvec3()).0;
-    }
-    let active = Scene::first_object(&objects);
-    Ok((Scene::with_objects(world, objects, active, params), report))
+    Ok((Scene::imported(world, objects), report))
 }
 
 /// The exact box of the solid voxels (None: empty).
