@@ -320,8 +320,11 @@ impl Editor {
                 self.report
                     .line(format_args!("rendered image {}", path.display()));
                 let spp = done.first().map_or(0, |r| r.samples.1);
-                self.panels
-                    .notify(format!("Rendered {} ({spp} spp)", path.display()));
+                let what = match done.len() {
+                    1 => path.display().to_string(),
+                    n => format!("{n} pictures from {}", path.display()),
+                };
+                self.panels.notify(format!("Rendered {what} ({spp} spp)"));
             }
             Err(e) => {
                 self.report

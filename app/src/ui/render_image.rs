@@ -35,6 +35,9 @@ pub struct RenderImageOptions {
     pub preset: Preset,
     /// The file's format.
     pub format: PictureFormat,
+    /// A turntable of this many frames about the content's centre (0: one picture); the
+    /// files are numbered from the chosen name.
+    pub turntable: u32,
 }
 
 impl Default for RenderImageOptions {
@@ -48,6 +51,7 @@ impl Default for RenderImageOptions {
             alpha: false,
             preset: Preset::Scene,
             format: PictureFormat::Png8,
+            turntable: 0,
         }
     }
 }
@@ -140,12 +144,16 @@ fn run(
     let view = scene.world.read();
     let mut params = scene.params.clone();
     let aspect = o.size.0 as f64 / o.size.1 as f64;
-    params.camera = o.preset.camera(&camera, content_bounds(&view), aspect);
+    let bounds = content_bounds(&view);
+    params.camera = o.preset.camera(&camera, bounds, aspect);
     let mut session = crate::gpu::session(device, &view).map_err(|e| format!("{e:#}"))?;
-    let shots = [Shot {
-        params,
-        out: path.to_path_buf(),
-    }];
+    let shots = match o.turntable {
+        0 => vec![Shot {
+            params,
+            out: path.to_path_buf(),
+        }],
+        n => crate::picture::turntable(&params, (bounds.0 + bounds.1) * 0.5, n as usize, path),
+    };
     render_shots(&mut session, &view, &shots, &finish, o.format, &mut |p| {
         progress.set(p.done)
     })
@@ -206,6 +214,10 @@ pub fn window(
                     ui.end_row();
                     ui.checkbox(&mut o.denoise, "denoise");
                     ui.checkbox(&mut o.alpha, "transparent background");
+                    ui.end_row();
+                    ui.label("turntable frames");
+                    ui.add(egui::DragValue::new(&mut o.turntable).range(0..=3600))
+                        .on_hover_text("0: one picture; N: N pictures turning once about the content, numbered name_0000…");
                     ui.end_row();
                     ui.label("format");
                     egui::ComboBox::from_id_salt("render format")
