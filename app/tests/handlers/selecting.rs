@@ -197,11 +197,7 @@ pub fn the_magic_wand_selects_with_a_click(s: &mut Session) {
     s.quiet();
     let picked = count(s);
     assert!(picked > 0, "the wand selected nothing");
-    let label = {
-        let doc = s.ed.document();
-        let d = doc.read().unwrap();
-        d.history.undo_steps().last().map(|st| st.label.clone())
-    };
+    let label = s.last_command().map(|(l, _)| l);
     assert!(label.is_some_and(|l| l.starts_with("Magic wand at")));
     // The same click intersected with itself keeps it all.
     s.ed.input(Input::Modifiers(app::ui::input::Mods {
@@ -244,11 +240,7 @@ pub fn extrude_drags_a_face_and_shift_click_fills_a_plane(s: &mut Session) {
     assert_eq!(s.state(), before, "nothing changes before the release");
     s.left(false);
     s.quiet();
-    let label = |s: &Session| {
-        let doc = s.ed.document();
-        let d = doc.read().unwrap();
-        d.history.undo_steps().last().map(|st| st.label.clone())
-    };
+    let label = |s: &Session| s.last_command().map(|(l, _)| l);
     assert_eq!(s.state().1, before.1 + 1, "one step");
     assert_ne!(s.state().0, before.0);
     assert!(label(s).is_some_and(|l| l.starts_with("Extrude the face at")));

@@ -67,6 +67,16 @@ impl Session {
         Some(s)
     }
 
+    /// The last undo step's label and command.
+    pub fn last_command(&self) -> Option<(String, app::editor::command::Command)> {
+        let doc = self.ed.document();
+        let d = doc.read().unwrap();
+        d.history
+            .undo_steps()
+            .last()
+            .map(|st| (st.label.clone(), st.command.clone()))
+    }
+
     /// Until every edit and file job is done.
     pub fn settle(&mut self) {
         let started = Instant::now();

@@ -6,15 +6,6 @@ use app::editor::command::{Command, PaintMode};
 use winit::event::MouseButton;
 use winit::keyboard::KeyCode;
 
-fn last_command(s: &Session) -> Option<(String, Command)> {
-    let doc = s.ed.document();
-    let d = doc.read().unwrap();
-    d.history
-        .undo_steps()
-        .last()
-        .map(|st| (st.label.clone(), st.command.clone()))
-}
-
 fn tap(s: &mut Session, code: KeyCode) {
     s.key(code, true);
     s.key(code, false);
@@ -61,7 +52,7 @@ pub fn the_stamp_puts_the_clipboard_down_along_a_drag(s: &mut Session) {
     assert_eq!(s.state().0, before.0, "nothing changes before the release");
     s.left(false);
     s.quiet();
-    let (label, command) = last_command(s).expect("a step");
+    let (label, command) = s.last_command().expect("a step");
     let Command::Stamp {
         at: places,
         quarters,
@@ -119,7 +110,7 @@ pub fn the_colour_modes_are_chosen_in_the_tools_panel(s: &mut Session) {
     s.frame();
     s.left(false);
     s.quiet();
-    let (label, command) = last_command(s).expect("a step");
+    let (label, command) = s.last_command().expect("a step");
     let Command::Stroke(stroke) = command else {
         panic!("{label}: not a stroke");
     };
@@ -158,7 +149,7 @@ pub fn the_face_wand_and_screen_rectangles_select(s: &mut Session) {
     s.left(true);
     s.left(false);
     s.quiet();
-    let (label, _) = last_command(s).expect("a step");
+    let (label, _) = s.last_command().expect("a step");
     assert!(label.starts_with("Select the face region at"), "{label}");
     let face = selected(s);
     assert!(face > 0);
@@ -196,7 +187,7 @@ pub fn the_face_wand_and_screen_rectangles_select(s: &mut Session) {
         0 < visible && visible < all,
         "visible {visible}, all depth {all}"
     );
-    let (label, _) = last_command(s).expect("a step");
+    let (label, _) = s.last_command().expect("a step");
     assert!(label.contains("visible voxels"), "{label}");
     s.ctrl(KeyCode::KeyD);
     s.click_on("box", MouseButton::Left);

@@ -184,17 +184,28 @@ fn the_face_wand_and_box_intersections_match_references() {
         doc.undo().unwrap();
         assert_eq!(state(&doc), before);
     }
-    // A side face that is not exposed selects nothing (refused: no step).
+    // A face that is not exposed (inside the ground) selects nothing: with Replace it
+    // empties the selection, one step whose undo brings the selection back.
+    doc.execute(Command::Select(SelectOp::Replace {
+        min: IVec3::new(1, 1, 1),
+        max: IVec3::new(4, 4, 4),
+    }))
+    .unwrap();
+    let boxed = selected_set(&doc);
+    assert!(!boxed.is_empty());
     let steps = doc.history.undo_len();
-    let _ = doc.execute(Command::Select(SelectOp::Face {
+    doc.execute(Command::Select(SelectOp::Face {
         start: top - IVec3::Y * 3,
         normal: IVec3::Y,
         by_material: false,
         diagonal: false,
         how: Combine::Replace,
-    }));
+    }))
+    .unwrap();
     assert!(selected_set(&doc).is_empty());
-    assert!(doc.history.undo_len() <= steps + 1);
+    assert_eq!(doc.history.undo_len(), steps + 1);
+    doc.undo().unwrap();
+    assert_eq!(selected_set(&doc), boxed);
     // Box ∩ box.
     let (a0, a1) = (IVec3::new(10, 5, 10), IVec3::new(30, 20, 30));
     let (b0, b1) = (IVec3::new(25, 0, 0), IVec3::new(60, 10, 12));
