@@ -30,26 +30,17 @@ pub fn read(path: &Path) -> Result<Heights, FormatError> {
 
 /// Reads a PNG's samples from its bytes (the reason when it cannot).
 pub fn from_png(bytes: &[u8]) -> Result<Heights, String> {
-    let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-    decoder.set_transformations(png::Transformations::EXPAND);
-    let mut reader = decoder.read_info().map_err(|e| format!("not a PNG: {e}"))?;
-    let (w, h) = (reader.info().width, reader.info().height);
-    let limit = brickmap::grid::MAX_BRICKS_X * 8;
-    if w > limit || h > brickmap::grid::MAX_BRICKS_Z * 8 {
-        return Err(format!(
-            "a heightmap is at most {limit} × {} pixels, this one is {w} × {h}",
-            brickmap::grid::MAX_BRICKS_Z * 8
-        ));
-    }
-    let mut buf = vec![
-        0;
-        reader
-            .output_buffer_size()
-            .ok_or("the image is too large")?
-    ];
-    let info = reader
-        .next_frame(&mut buf)
-        .map_err(|e| format!("reading the image: {e}"))?;
+    let (info, buf) = super::decode_png(bytes, png::Transformations::EXPAND, |w, h| {
+        let limit = brickmap::grid::MAX_BRICKS_X * 8;
+        if w > limit || h > brickmap::grid::MAX_BRICKS_Z * 8 {
+            return Err(format!(
+                "a heightmap is at most {limit} × {} pixels, this one is {w} × {h}",
+                brickmap::grid::MAX_BRICKS_Z * 8
+            ));
+        }
+        Ok(())
+    })?;
+    let (w, h) = (info.width, info.height);
     let sixteen = info.bit_depth == png::BitDepth::Sixteen;
     let channels = info.color_type.samples();
     let bytes_per = if sixteen { 2 } else { 1 };

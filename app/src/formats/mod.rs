@@ -17,6 +17,29 @@ pub mod vox;
 use crate::scene::Scene;
 use std::path::Path;
 
+/// A PNG's first frame with `transformations`, after `check` accepted its width and height
+/// (before the pixels are read); the error says what is wrong.
+pub(crate) fn decode_png(
+    bytes: &[u8],
+    transformations: png::Transformations,
+    check: impl Fn(u32, u32) -> Result<(), String>,
+) -> Result<(png::OutputInfo, Vec<u8>), String> {
+    let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+    decoder.set_transformations(transformations);
+    let mut reader = decoder.read_info().map_err(|e| format!("not a PNG: {e}"))?;
+    check(reader.info().width, reader.info().height)?;
+    let mut buf = vec![
+        0;
+        reader
+            .output_buffer_size()
+            .ok_or("the image is too large")?
+    ];
+    let info = reader
+        .next_frame(&mut buf)
+        .map_err(|e| format!("reading the image: {e}"))?;
+    Ok((info, buf))
+}
+
 /// Loads a `.ron` project (version 2 as written, version 1 as one object) or imports a
 /// `.vox` file with its groups, objects, layers and shared models (it gets the default sun
 /// and sky), choosing by the extension.

@@ -38,24 +38,16 @@ pub fn load(path: &Path) -> Result<Vec<[u8; 3]>, FormatError> {
 }
 
 fn from_png(bytes: &[u8]) -> Result<Vec<[u8; 3]>, String> {
-    let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-    let mut reader = decoder.read_info().map_err(|e| format!("not a PNG: {e}"))?;
-    let (w, h) = (reader.info().width, reader.info().height);
-    if w as u64 * h as u64 != SIZE as u64 {
-        return Err(format!(
-            "a palette image has 256 pixels (MagicaVoxel's are 256 × 1), this one is {w} × {h}"
-        ));
-    }
-    let mut buf = vec![
-        0;
-        reader
-            .output_buffer_size()
-            .ok_or("the image is too large")?
-    ];
-    let info = reader
-        .next_frame(&mut buf)
-        .map_err(|e| format!("reading the image: {e}"))?;
+    let strip = png::Transformations::EXPAND | png::Transformations::STRIP_16;
+    let (info, buf) = super::decode_png(bytes, strip, |w, h| {
+        if w as u64 * h as u64 != SIZE as u64 {
+            return Err(format!(
+                "a palette image has 256 pixels (MagicaVoxel's are 256 × 1), this one is {w} × {h}"
+            ));
+        }
+        Ok(())
+    })?;
+    let w = info.width;
     let channels = info.color_type.samples();
     let rows = buf[..info.buffer_size()].chunks(info.line_size);
     let mut out = Vec::with_capacity(SIZE);
