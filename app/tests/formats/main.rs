@@ -72,6 +72,28 @@ fn asset_files(dir: &str, ext: &str, least: usize) -> Vec<PathBuf> {
     out
 }
 
+/// `count` copies of `bytes`, each with 1 to 4 bytes overwritten at places and with values
+/// drawn from a xorshift sequence seeded with `seed` (deterministic hostile inputs).
+fn mutations(bytes: &[u8], count: usize, mut seed: u32) -> Vec<Vec<u8>> {
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 17;
+        seed ^= seed << 5;
+        seed
+    };
+    (0..count)
+        .map(|_| {
+            let mut m = bytes.to_vec();
+            for _ in 0..1 + next() % 4 {
+                let r = next();
+                let at = r as usize % m.len();
+                m[at] = (r >> 8) as u8;
+            }
+            m
+        })
+        .collect()
+}
+
 /// [`resolved`] relative to the lowest corner of the voxels' box (scenes placed apart).
 fn content(world: &World) -> Vec<(IVec3, MaterialKind, u32, [u8; 3])> {
     let all = resolved(world);

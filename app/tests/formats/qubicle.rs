@@ -96,16 +96,7 @@ fn damaged_and_hostile_qubicle_files_are_refused_without_a_panic() {
             );
         }
         // Deterministic mutations: an error or a valid scene.
-        let mut seed = 0x9e37_79b9u32;
-        for _ in 0..400 {
-            let mut m = bytes.clone();
-            for _ in 0..1 + seed % 4 {
-                seed ^= seed << 13;
-                seed ^= seed >> 17;
-                seed ^= seed << 5;
-                let at = seed as usize % m.len();
-                m[at] = (seed >> 8) as u8;
-            }
+        for m in mutations(&bytes, 400, 0x9e37_79b9) {
             if let Ok((scene, report)) = qb::import(&m, path, 1) {
                 let view = scene.world.read();
                 view.validate().unwrap();

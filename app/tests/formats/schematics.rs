@@ -202,16 +202,7 @@ fn damaged_and_hostile_schematics_are_refused_without_a_panic() {
         let mut raw = Vec::new();
         std::io::Read::read_to_end(&mut flate2::read::GzDecoder::new(&bytes[..]), &mut raw)
             .unwrap();
-        let mut seed = 0x2545_f491u32;
-        for _ in 0..300 {
-            let mut m = raw.clone();
-            for _ in 0..1 + seed % 3 {
-                seed ^= seed << 13;
-                seed ^= seed >> 17;
-                seed ^= seed << 5;
-                let at = seed as usize % m.len();
-                m[at] = (seed >> 8) as u8;
-            }
+        for m in mutations(&raw, 300, 0x2545_f491) {
             if let Ok((scene, r)) = schem::import(&m, path, &table, 1) {
                 scene.world.read().validate().unwrap();
                 assert_eq!(scene.world.read().solid_count(), r.voxels);
