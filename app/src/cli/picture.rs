@@ -24,6 +24,15 @@ pub(crate) fn render_finished(a: RenderArgs, workers: usize) -> Result<()> {
     if a.alpha && format == PictureFormat::Pfm {
         bail!("a PFM has no alpha: write .png or .exr with --alpha");
     }
+    // A missing folder is found before the render, not after it.
+    let folder = a.out.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(dir) = folder.filter(|d| !d.is_dir()) {
+        bail!(
+            "{}: the folder {} does not exist",
+            a.out.display(),
+            dir.display()
+        );
+    }
     if a.turntable == Some(0) {
         bail!("--turntable wants at least one frame");
     }
