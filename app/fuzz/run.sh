@@ -9,7 +9,7 @@ seconds=${1:-600}
 root=../..
 mkdir -p corpus/project_ron corpus/vox_import corpus/qb_import corpus/schem_import corpus/heightmap
 cp "$root"/assets/vox/*.vox seeds/vox_import/*.vox corpus/vox_import/
-cp "$root"/assets/qb/*.qb corpus/qb_import/
+cp "$root"/assets/qb/*.qb seeds/qb_import/*.qb corpus/qb_import/
 cp "$root"/assets/schem/*.schem corpus/schem_import/
 cp "$root"/assets/vox/*.png corpus/heightmap/ 2>/dev/null || true
 cargo build --release --manifest-path "$root/Cargo.toml" -p app --bin voxbrick -q
@@ -21,6 +21,8 @@ voxbrick=$root/target/release/voxbrick
 "$voxbrick" render corpus/heightmap/t.ron --device cpu --spp 1 --width 32 --height 24 --out corpus/heightmap/grey.png 2>/dev/null || true
 rm -f corpus/heightmap/t.ron
 for target in ${TARGETS:-project_ron vox_import qb_import schem_import heightmap}; do
+    # A crash stops that target only (its input is in artifacts/$target); the others still run.
     cargo +nightly fuzz run --fuzz-dir . "$target" "corpus/$target" -- \
-        -max_total_time="$seconds" -rss_limit_mb=4096 -timeout=20 -print_final_stats=1 2>&1 | tail -25
+        -max_total_time="$seconds" -rss_limit_mb=4096 -timeout=20 -print_final_stats=1 2>&1 | tail -25 ||
+        echo "$target: the fuzzer stopped on a finding (see artifacts/$target)"
 done

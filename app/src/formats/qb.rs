@@ -32,6 +32,9 @@ use std::path::Path;
 pub const MAX_CELLS: u64 = 1 << 28;
 /// The longest matrix side.
 pub const MAX_SIDE: u32 = 4096;
+/// The farthest a matrix's corner may lie from the origin on an axis (the largest grid is
+/// far smaller; this keeps every sum of positions and sizes inside i32).
+pub const MAX_POSITION: u32 = 1 << 24;
 
 const RLE: u32 = 2;
 const NEXT_SLICE: u32 = 6;
@@ -132,6 +135,12 @@ pub fn parse(bytes: &[u8]) -> Result<Vec<Matrix>, String> {
         let mut pos = [0i32; 3];
         for p in &mut pos {
             *p = r.u32(&what)? as i32;
+        }
+        if pos.iter().any(|p| p.unsigned_abs() > MAX_POSITION) {
+            return Err(format!(
+                "{what} lies at ({}, {}, {}), beyond ±{MAX_POSITION} voxels",
+                pos[0], pos[1], pos[2]
+            ));
         }
         if size.iter().any(|&s| s == 0 || s > MAX_SIDE) {
             return Err(format!(

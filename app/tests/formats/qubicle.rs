@@ -104,6 +104,13 @@ fn damaged_and_hostile_qubicle_files_are_refused_without_a_panic() {
             }
         }
     }
+    // The fuzzer's find: a matrix at z = 2³¹ − 2 (its end overflowed i32).
+    let far = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/qb_import/far_position.qb");
+    let e = qb::import(&std::fs::read(&far).unwrap(), &far, 1)
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("beyond ±16777216 voxels"), "{e}");
     // A matrix of 4096³ declared in a small file.
     let mut huge = std::fs::read(files()[0].clone()).unwrap();
     let name_len = huge[24] as usize;
