@@ -17,6 +17,11 @@ pub(crate) fn render_finished(a: RenderArgs, workers: usize) -> Result<()> {
             "--noise, --alpha, --denoise, --view, sequences, tiles, EXR and 16-bit PNG are the GPU's (the CPU reference writes plain renders)"
         );
     }
+    if a.hdr.is_some() {
+        bail!(
+            "--hdr is for plain renders: a finished render writes linear .exr or .pfm with --out"
+        );
+    }
     if a.scale != 1.0 {
         bail!("--scale is for plain renders (a finished render traces every pixel)");
     }
