@@ -35,7 +35,7 @@ struct Cli {
 /// The editor window (no subcommand).
 #[derive(clap::Args)]
 struct EditorArgs {
-    /// A scene to open (.ron or .vox); default: the built-in default scene.
+    /// A scene to open (.ron, .vox, .qb, .schem); default: the built-in default scene.
     file: Option<PathBuf>,
     /// Run a replay script's steps in the live editor, capture the presented frame and exit.
     #[arg(long)]

@@ -190,7 +190,9 @@ fn errors_are_one_clear_line_and_touch_nothing() {
     let err = fails(&["convert", s(&bad), s(&target)]);
     assert!(err.contains("not a valid .vox"), "{err}");
     assert_eq!(std::fs::read_to_string(&target).unwrap(), "precious");
-    assert!(fails(&["info", s(&d.join("scene.txt"))]).contains("expected .ron or .vox"));
+    assert!(
+        fails(&["info", s(&d.join("scene.txt"))]).contains("expected .ron, .vox, .qb or .schem")
+    );
     assert!(fails(&["new", s(&d.join("x.ron"))]).contains("--terrain"));
     assert!(fails(&["new", "--terrain", "--size", "8x8", s(&d.join("x.ron"))]).contains("WxHxD"));
     assert!(

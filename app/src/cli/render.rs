@@ -10,7 +10,7 @@ use std::time::Instant;
 /// `voxbrick render`'s arguments.
 #[derive(clap::Args)]
 pub(crate) struct RenderArgs {
-    /// A .ron or .vox file (a .vox gets the default camera, sun and sky).
+    /// A .ron, .vox, .qb or .schem file (the last three get the default sun and sky).
     pub(crate) scene: PathBuf,
     /// Output image: .png, .exr or .pfm (a turntable or a path numbers it: NAME_0000.png…).
     #[arg(long)]

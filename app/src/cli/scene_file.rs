@@ -297,7 +297,7 @@ pub(crate) fn convert(a: ConvertArgs, workers: usize) -> Result<()> {
 /// `voxbrick info`: a scene file's dimensions, voxel count, materials, memory and view.
 #[derive(clap::Args)]
 pub(crate) struct InfoArgs {
-    /// A .ron or .vox file.
+    /// A .ron, .vox, .qb or .schem file.
     file: PathBuf,
     /// Print every node of the object tree (else the first 200).
     #[arg(long)]

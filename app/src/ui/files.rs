@@ -256,7 +256,7 @@ impl FileWorker {
         });
     }
 
-    /// Loads a scene (.ron or .vox) on a worker thread.
+    /// Loads a scene (.ron, .vox, .qb, .schem) on a worker thread.
     pub fn load(&mut self, path: PathBuf, workers: usize) {
         self.spawn(format!("opening {}", path.display()), move || {
             // The format's error names the file already.

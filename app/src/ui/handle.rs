@@ -77,15 +77,13 @@ impl Editor {
                 }
             }
             Input::Dropped(path) => {
-                if path
-                    .extension()
-                    .is_some_and(|e| e.eq_ignore_ascii_case("vox") || e.eq_ignore_ascii_case("ron"))
-                {
+                if crate::formats::Format::of(&path).is_ok() {
                     self.guard_unsaved(Pending::Open(Some(path)));
                 } else {
-                    self.panels
-                        .errors
-                        .push(format!("{} is not a .ron or .vox file", path.display()));
+                    self.panels.errors.push(format!(
+                        "{} is not a .ron, .vox, .qb or .schem file",
+                        path.display()
+                    ));
                 }
             }
             Input::Modifiers(m) => self.pointer.mods = m,

@@ -85,7 +85,7 @@ use winit::window::WindowId;
 /// How the editor starts.
 #[derive(Clone, Debug, Default)]
 pub struct EditorOptions {
-    /// A file to open (.ron or .vox); None: the built-in default scene.
+    /// A file to open (.ron, .vox, .qb, .schem); None: the built-in default scene.
     pub file: Option<PathBuf>,
     /// Run a replay script's steps through the live editor, capture and exit.
     pub script: Option<PathBuf>,
