@@ -227,19 +227,13 @@ impl Viewport {
         let tiles = finish.tiles(side);
         let (w, h) = finish.size;
         let total = w as f64 * h as f64;
-        let mut image = Image {
-            width: w,
-            height: h,
-            pixels: vec![[0.0; 3]; w as usize * h as usize],
-        };
-        let mut alpha = finish.alpha.then(|| vec![0.0f32; w as usize * h as usize]);
         let mut picture = Picture {
             image: Image {
-                width: 0,
-                height: 0,
-                pixels: Vec::new(),
+                width: w,
+                height: h,
+                pixels: vec![[0.0; 3]; w as usize * h as usize],
             },
-            alpha: None,
+            alpha: finish.alpha.then(|| vec![0.0f32; w as usize * h as usize]),
             samples: (u32::MAX, 0),
             noise: None,
             tiles: tiles.len(),
@@ -265,9 +259,9 @@ impl Viewport {
             for row in 0..size.1 {
                 let from = (row * size.0) as usize;
                 let to = ((origin.1 + row) * w + origin.0) as usize;
-                image.pixels[to..to + size.0 as usize]
+                picture.image.pixels[to..to + size.0 as usize]
                     .copy_from_slice(&tile.image.pixels[from..from + size.0 as usize]);
-                if let (Some(alpha), Some(cov)) = (&mut alpha, &tile.alpha) {
+                if let (Some(alpha), Some(cov)) = (&mut picture.alpha, &tile.alpha) {
                     alpha[to..to + size.0 as usize]
                         .copy_from_slice(&cov[from..from + size.0 as usize]);
                 }
@@ -282,8 +276,6 @@ impl Viewport {
                 return Err(PictureError::Cancelled);
             }
         }
-        picture.image = image;
-        picture.alpha = alpha;
         Ok(picture)
     }
 
