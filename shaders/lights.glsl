@@ -1,37 +1,119 @@
-// The light faces of emissive voxels (brickmap/src/lights.rs: layout, weights, descent),
-// binding 10. A face is chosen by descending the sum tree from the root, exactly as
-// `Lights::sample` does on the CPU. Keep in sync with both.
+// The light faces of emissive voxels (brickmap/src/lights/: layout, weights, the light tree's
+// bounds and importance, the face → slot table), binding 10. A face is chosen by descending
+// the tree from the root by each child's importance from the shading point, exactly as
+// `Lights::sample_from` does on the CPU (in f64 there). Keep in sync with both.
 layout(std430, set = 0, binding = 10) readonly buffer LightFaces { uint light_words[]; };
 
 const uint LIGHT_WEIGHTS = 4u;  // 256 f32 material weights after the 4-word header
 const uint LIGHT_NODES = 260u;  // 2C f32 nodes: root 1, children 2i and 2i + 1, leaves C..2C
+// Then 2C node bounds of 4 words, C face records of 2 words, the table's 2C words.
 
+uint light_capacity() { return light_words[0]; }
 float light_node(uint i) { return uintBitsToFloat(light_words[LIGHT_NODES + i]); }
 float light_total() { return light_node(1u); }
 float light_weight(int material) { return uintBitsToFloat(light_words[LIGHT_WEIGHTS + uint(material)]); }
+uint light_faces_at() { return LIGHT_NODES + 10u * light_capacity(); }
 
-// The slot holding u ∈ [0, 1) of the total weight (its probability is its leaf / total).
-// Call only when the total is positive.
-uint sample_light(float u) {
-    uint c = light_words[0];
-    float x = u * light_total();
+// cos(max(0, θ − β)) for cos θ = cos_t and the half-angle β of a sphere of radius² r2 at
+// distance² d2 (tree.rs `cone_bound`).
+float light_cone_bound(float cos_t, float r2, float d2) {
+    if (d2 <= r2) return 1.0;
+    float sin_b2 = r2 / d2;
+    float cos_b = sqrt(1.0 - sin_b2);
+    if (cos_t >= cos_b) return 1.0;
+    float sin_t = sqrt(max(1.0 - cos_t * cos_t, 0.0));
+    return max(cos_t * cos_b + sin_t * sqrt(sin_b2), 1e-4);
+}
+
+// Benchmark only (trace.comp's EXPERIMENT bit 11): faces chosen by weight alone, the tree's
+// bounds ignored (and the sun and the faces half each), as before the light tree.
+#ifndef LIGHTS_BY_WEIGHT
+#define LIGHTS_BY_WEIGHT false
+#endif
+
+// Node i's importance from point p with axis normal n (tree.rs `importance`): 0 exactly when
+// none of its faces can light p.
+float light_importance(uint i, vec3 p, ivec3 n) {
+    float w = light_node(i);
+    uint at = LIGHT_NODES + 2u * light_capacity() + 4u * i;
+    uint mask = light_words[at + 3u];
+    if (mask == 0u || !(w > 0.0)) return 0.0;
+    if (LIGHTS_BY_WEIGHT) return w;
+    uvec3 b = uvec3(light_words[at], light_words[at + 1u], light_words[at + 2u]);
+    vec3 lo = vec3(b & 0xFFFFu);
+    vec3 hi = vec3(b >> 16) + 1.0;
+    vec3 v = p - (lo + hi) * 0.5;
+    // +axis faces lie on planes from lo + 1 up, −axis faces on planes up to hi − 1.
+    bvec3 pos = bvec3(uvec3(mask >> 1, mask >> 3, mask >> 5) & 1u);
+    bvec3 neg = bvec3(uvec3(mask, mask >> 2, mask >> 4) & 1u);
+    bvec3 pos_ok = bvec3(uvec3(pos) & uvec3(greaterThan(p, lo + 1.0)));
+    bvec3 neg_ok = bvec3(uvec3(neg) & uvec3(lessThan(p, hi - 1.0)));
+    const float NONE = -1.0 / 0.0;
+    vec3 best3 = max(mix(vec3(NONE), v, pos_ok), mix(vec3(NONE), -v, neg_ok));
+    float best = max(best3.x, max(best3.y, best3.z));
+    if (best == NONE) return 0.0;
+    vec3 nf = vec3(n);
+    vec3 corner = mix(lo, hi, greaterThan(nf, vec3(0.0)));
+    if (!(dot(nf, corner - p) > 0.0)) return 0.0;
+    vec3 e = hi - lo;
+    float r2 = dot(e, e) * 0.25;
+    float d2 = dot(v, v);
+    float d = sqrt(d2);
+    float cos_l = 1.0;
+    float cos_r = 1.0;
+    if (d > 0.0) {
+        cos_l = light_cone_bound(best / d, r2, d2);
+        cos_r = light_cone_bound(-dot(v, nf) / d, r2, d2);
+    }
+    return w * cos_l * cos_r / max(d2, r2);
+}
+
+// The slot chosen for p with normal n from u ∈ [0, 1) (rescaled at each level) and its
+// probability, or NO_LIGHT when no face can light p.
+uint sample_light(float u, vec3 p, ivec3 n, out float prob) {
+    prob = 0.0;
+    uint c = light_capacity();
     uint i = 1u;
+    float pr = 1.0;
     while (i < c) {
-        float l = light_node(2u * i);
-        float r = light_node(2u * i + 1u);
-        if ((x < l && l > 0.0) || r <= 0.0) {
+        float l = light_importance(2u * i, p, n);
+        float r = light_importance(2u * i + 1u, p, n);
+        if (!(l + r > 0.0)) return 0xFFFFFFFFu;
+        float pl = l / (l + r);
+        if (u < pl) {
+            u /= pl;
+            pr *= pl;
             i = 2u * i;
         } else {
-            x -= l;
+            u = (u - pl) / (1.0 - pl);
+            pr *= 1.0 - pl;
             i = 2u * i + 1u;
         }
+        u = min(u, 0.99999994);
     }
+    prob = pr;
     return i - c;
+}
+
+// The probability that sample_light at p with normal n chooses `slot` (the caller knows the
+// root's importance is positive).
+float light_probability(uint slot, vec3 p, ivec3 n) {
+    uint c = light_capacity();
+    uint leaf = c + slot;
+    float pr = 1.0;
+    for (uint level = uint(findMSB(c)); level > 0u; level--) {
+        uint parent = leaf >> level;
+        float l = light_importance(2u * parent, p, n);
+        float r = light_importance(2u * parent + 1u, p, n);
+        if (!(l + r > 0.0)) return 0.0;
+        pr *= (((leaf >> (level - 1u)) & 1u) == 0u ? l : r) / (l + r);
+    }
+    return pr;
 }
 
 // A slot's face: its voxel, which face (−x, +x, −y, +y, −z, +z) and the voxel's material.
 void light_face(uint slot, out ivec3 voxel, out uint face, out int material) {
-    uint at = LIGHT_NODES + 2u * light_words[0] + 2u * slot;
+    uint at = light_faces_at() + 2u * slot;
     uint w0 = light_words[at];
     uint w1 = light_words[at + 1u];
     voxel = ivec3(int(w0 & 0xFFFu), int(w1 & 0xFFFFu), int((w0 >> 12) & 0xFFFu));
@@ -39,10 +121,40 @@ void light_face(uint slot, out ivec3 voxel, out uint face, out int material) {
     material = int(w1 >> 16);
 }
 
+uint light_mix(uint x) {
+    x = x * 747796405u + 2891336453u;
+    x = ((x >> ((x >> 28u) + 4u)) ^ x) * 277803737u;
+    return (x >> 22u) ^ x;
+}
+
+// The slot of the light face (voxel, face), or 0xFFFFFFFF (lookup.rs `FaceTable::find`).
+uint light_slot_of(ivec3 voxel, uint face) {
+    uint c = light_capacity();
+    uint w0 = uint(voxel.x) | (uint(voxel.z) << 12) | (face << 24);
+    uint y = uint(voxel.y);
+    uint faces = light_faces_at();
+    uint table = faces + 2u * c;
+    uint mask = 2u * c - 1u;
+    uint i = light_mix(w0 ^ light_mix(y)) & mask;
+    for (uint k = 0u; k <= mask; k++) {
+        uint e = light_words[table + i];
+        if (e == 0u) break;
+        uint at = faces + 2u * (e - 1u);
+        if (light_words[at] == w0 && (light_words[at + 1u] & 0xFFFFu) == y) return e - 1u;
+        i = (i + 1u) & mask;
+    }
+    return 0xFFFFFFFFu;
+}
+
 vec3 face_normal(uint face) {
     vec3 n = vec3(0.0);
     n[face >> 1] = (face & 1u) != 0u ? 1.0 : -1.0;
     return n;
+}
+
+// The face index (−x, +x, −y, +y, −z, +z) of an axis normal.
+uint face_of(ivec3 n) {
+    return n.x != 0 ? (n.x > 0 ? 1u : 0u) : (n.y != 0 ? (n.y > 0 ? 3u : 2u) : (n.z > 0 ? 5u : 4u));
 }
 
 // The point (u1, u2) of a voxel's face (render/src/cpu/mod.rs `face_point`).

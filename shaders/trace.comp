@@ -27,9 +27,10 @@ layout(constant_id = 6) const uint MAX_BOUNCES = 4u;
 layout(constant_id = 7) const bool COUNT_RAYS = false;
 // Benchmark experiments (bench-gpu --experiment), 0 in every real render: bit 0 ends paths
 // at the first hit (primary rays only), bit 1 decodes colours without pow, bit 2 counts
-// every shadow ray as unblocked without tracing it, bit 3 skips sun sampling (NEE), bit 4
+// every shadow ray as unblocked without tracing it, bit 3 skips light sampling (NEE), bit 4
 // makes shaders/shadow.comp skip its work, bit 6 starts a subgroup's next samples together,
-// bits 7..10 turn traversal skips off (brickmap.glsl SKIPS_OFF).
+// bits 7..10 turn traversal skips off (brickmap.glsl SKIPS_OFF), bit 11 chooses light faces by
+// weight alone (lights.glsl LIGHTS_BY_WEIGHT).
 layout(constant_id = 8) const uint EXPERIMENT = 0u;
 // Shadow rays go to a queue that shaders/shadow.comp traces next, one per invocation, instead
 // of being traced here: in a warp only some lanes have a shadow ray at a vertex, and tracing
@@ -62,6 +63,7 @@ layout(constant_id = 15) const bool TRANSPARENT = false;
 #define MEDIUM_POSSIBLE HAS_DIELECTRIC
 #define COUNT_STEPS COUNT_RAYS
 #define SKIPS_OFF ((EXPERIMENT >> 7) & 15u)
+#define LIGHTS_BY_WEIGHT ((EXPERIMENT & 2048u) != 0u)
 #include "brickmap.glsl"
 #include "scene.glsl"
 // Per pixel: the sum of its samples' radiance (rgb) and their count (a).
@@ -272,63 +274,61 @@ float path_pdf;     // pdf the BSDF chose path_d with; < 0: delta or camera
 bool path_camera;   // the next ray is the camera ray
 float path_dim;     // DIM: the weight the camera hit gave the path
 uint path_vertex;   // index of the vertex the next ray finds (1: the camera ray's hit)
-bool path_lights;   // the vertex path_d left sampled the light faces (MIS on a hit)
+// LIGHTS: what the vertex path_d left sampled (MIS on a hit of the sun or a light face): the
+// probabilities it chose the sun and the light faces with, and its normal (path_o its point).
+float path_sun_share;
+float path_face_share;
+ivec3 path_n;
 // A pending shadow ray from path_o, starting in path_start: when nothing blocks it before
 // shadow_t (except in the voxel of the light face in slot shadow_slot; NO_LIGHT for the
-// sun), shadow_l counts. With LIGHTS a vertex may have two (the sun's and a light face's):
-// the second waits in shadow2_* and moves up when the first is traced or queued.
+// sun), shadow_l counts. A vertex makes at most one (the sun's or a light face's).
 bool shadow_pending;
 vec3 shadow_d;
 float shadow_t;
 vec3 shadow_l;
 uint shadow_slot;
-bool shadow2_pending;
-vec3 shadow2_d;
-float shadow2_t;
-vec3 shadow2_l;
-uint shadow2_slot;
 
 void next_shadow() {
-    if (!LIGHTS) {
-        shadow_pending = false;
-        return;
-    }
-    shadow_pending = shadow2_pending;
-    shadow_d = shadow2_d;
-    shadow_t = shadow2_t;
-    shadow_l = shadow2_l;
-    shadow_slot = shadow2_slot;
-    shadow2_pending = false;
+    shadow_pending = false;
 }
 
-// Queues a shadow ray from the current vertex (the first free of the two).
 void add_shadow(vec3 d, float t, vec3 l, uint light_slot) {
-    if (!LIGHTS || !shadow_pending) {
-        shadow_pending = true;
-        shadow_d = d;
-        shadow_t = t;
-        shadow_l = l;
-        shadow_slot = light_slot;
-    } else {
-        shadow2_pending = true;
-        shadow2_d = d;
-        shadow2_t = t;
-        shadow2_l = l;
-        shadow2_slot = light_slot;
-    }
+    shadow_pending = true;
+    shadow_d = d;
+    shadow_t = t;
+    shadow_l = l;
+    shadow_slot = light_slot;
 }
 
-bool solid_or_outside(ivec3 c) {
-    if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, ivec3(p.grid.xyz) * 8))) return true;
-    return material_at(c) >= 0;
+// cos(max(0, θ − β)) for cos θ = c and sin β = sin_b (render/src/cpu/direct.rs `widened`).
+float widened(float c, float sin_b) {
+    float cos_b = sqrt(max(1.0 - sin_b * sin_b, 0.0));
+    if (c >= cos_b) return 1.0;
+    return c * cos_b + sqrt(max(1.0 - c * c, 0.0)) * sin_b;
 }
 
-// The probability that light sampling from a point in front of the light face (voxel,
-// outward normal) ends on it: its weight, plus its opposite's when that is a light face too
-// (a face chosen facing away is swapped for its opposite). CpuScene::face_probability.
-float face_probability(int material, ivec3 voxel, ivec3 normal) {
-    float k = solid_or_outside(voxel - normal) ? 1.0 : 2.0;
-    return light_weight(material) / light_total() * k;
+// What the sun disc may give point pt with normal n (SunDisc::estimate): 0 exactly when no
+// point of it can light pt.
+float sun_estimate(vec3 pt, ivec3 n) {
+    vec3 to = p.sun_centre.xyz - pt;
+    float d2 = dot(to, to);
+    float d = sqrt(d2);
+    if (d <= p.sun_centre.w) return 0.0;
+    vec3 w = to / d;
+    float sin_b = p.sun_centre.w / d;
+    float cr = widened(dot(w, vec3(n)), sin_b);
+    float cl = widened(-dot(w, p.sun_normal.xyz), sin_b);
+    if (!(cr > 0.0 && cl > 0.0)) return 0.0;
+    vec3 l = p.sun_radiance.rgb;
+    return (l.r + l.g + l.b) * sun_area() * cl * cr / d2;
+}
+
+// The sun's share of a vertex's light sample (direct.rs `sun_share`, LEAST_SHARE 0.1).
+float sun_share(float sun, float faces) {
+    if (!(faces > 0.0)) return 1.0;
+    if (!(sun > 0.0)) return 0.0;
+    if (LIGHTS_BY_WEIGHT) return 0.5;
+    return 0.1 + 0.8 * sun / (sun + faces);
 }
 
 void begin_path(uvec2 px, uint s) {
@@ -347,9 +347,10 @@ void begin_path(uvec2 px, uint s) {
     path_camera = true;
     path_dim = 1.0;
     path_vertex = 1u;
-    path_lights = false;
+    path_sun_share = 1.0;
+    path_face_share = 0.0;
+    path_n = ivec3(0);
     shadow_pending = false;
-    shadow2_pending = false;
 }
 
 // What the path's ray found (a voxel at t_voxel, or nothing): adds what it sees, prepares
@@ -382,7 +383,8 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
     float t_sun = sun_hit(o, d, cos_l);
     if (t_sun > 0.0 && t_sun < t_voxel) {
         if (TRANSPARENT && path_camera) return false;
-        float w = path_pdf < 0.0 ? 1.0 : power_heuristic(path_pdf, t_sun * t_sun / (cos_l * sun_area()));
+        float share = LIGHTS ? path_sun_share : 1.0;
+        float w = path_pdf < 0.0 ? 1.0 : power_heuristic(path_pdf, share * t_sun * t_sun / (cos_l * sun_area()));
         pixel_sum += path_beta * p.sun_radiance.rgb * w;
         return false;
     }
@@ -408,8 +410,10 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
     if (HAS_EMISSIVE && here >= 0 && s.kind == EMISSIVE) {
         // It reflects nothing. Full weight unless the last vertex sampled the light faces.
         float w = 1.0;
-        if (LIGHTS && path_lights && path_pdf >= 0.0) {
-            float pdf_light = face_probability(here, voxel, normal) * t_voxel * t_voxel / -dot(d, n);
+        if (LIGHTS && path_face_share > 0.0 && path_pdf >= 0.0) {
+            uint slot = light_slot_of(voxel, face_of(normal));
+            float pdf_light = slot == NO_LIGHT ? 0.0
+                : path_face_share * light_probability(slot, o, path_n) * t_voxel * t_voxel / -dot(d, n);
             w = power_heuristic(path_pdf, pdf_light);
         }
         pixel_sum += path_beta * s.albedo * s.param * w;
@@ -438,7 +442,7 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
             path_medium = here;
         }
         path_pdf = -1.0;
-        path_lights = false;
+        path_face_share = 0.0;
     } else {
         vec3 ft;
         vec3 fb;
@@ -447,7 +451,25 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
         path_start = front; // the shadow ray's first cell too
         bool delta = HAS_METAL && s.kind == METAL && s.param <= 0.0;
         uint base = vertex_dims(path_vertex);
-        if (SUN && !delta && p.sun_normal.w != 0.0 && (EXPERIMENT & 8u) == 0u) {
+        // One light per vertex (render/src/cpu/direct.rs): with LIGHTS from a vertex in air,
+        // the sun or the light faces by their estimated contributions (dimension base + 2,
+        // rescaled for the tree's descent); else the sun.
+        bool sun_on = SUN && p.sun_normal.w != 0.0;
+        float share = sun_on ? 1.0 : 0.0;
+        float u = 0.0;
+        path_face_share = 0.0;
+        if (LIGHTS && !delta && path_medium == AIR && light_total() > 0.0) {
+            float faces = light_importance(1u, pt, normal);
+            share = sun_on ? sun_share(sun_on ? sun_estimate(pt, normal) : 0.0, faces) : 0.0;
+            path_face_share = faces > 0.0 ? 1.0 - share : 0.0;
+            path_n = normal;
+            dims(base + 2u);
+            u = rand();
+        }
+        path_sun_share = share;
+        if ((EXPERIMENT & 8u) != 0u || delta) {
+            path_face_share = 0.0;
+        } else if (sun_on && u < share) {
             dims(base);
             float r = p.sun_centre.w * sqrt(rand());
             float phi = 2.0 * PI * rand();
@@ -461,47 +483,38 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
                 float pdf_bsdf;
                 vec3 fv = eval_bsdf(s, wo, wi, pdf_bsdf);
                 if (fv != vec3(0.0)) {
-                    float pdf_light = dist * dist / (cl * sun_area());
+                    float pdf_light = share * dist * dist / (cl * sun_area());
                     vec3 l = path_beta * fv * wi.z * p.sun_radiance.rgb * power_heuristic(pdf_light, pdf_bsdf) / pdf_light;
                     if ((EXPERIMENT & 4u) != 0u) pixel_sum += l;
                     else add_shadow(w, dist, l, NO_LIGHT);
                 }
             }
-        }
-        // Light faces, from vertices in air (inside a medium every shadow ray is blocked at
-        // once: shadow rays stop at any voxel). A face by weight, a point uniform on it.
-        path_lights = false;
-        if (LIGHTS && !delta && path_medium == AIR && light_total() > 0.0) {
-            path_lights = true;
-            dims(base + 2u);
-            uint slot = sample_light(rand());
-            ivec3 lv;
-            uint lf;
-            int lm;
-            light_face(slot, lv, lf, lm);
-            dims(base + 4u);
-            float u1 = rand();
-            float u2 = rand();
-            vec3 y = face_point(lv, lf, u1, u2);
-            bool usable = true;
-            if (dot(pt - y, face_normal(lf)) <= 0.0) {
-                // It faces away: its opposite instead (a light face only if uncovered).
-                lf ^= 1u;
-                usable = !solid_or_outside(lv + ivec3(face_normal(lf)));
-                y = face_point(lv, lf, u1, u2);
-            }
-            vec3 to = y - pt;
-            float dist = length(to);
-            vec3 w = to / dist;
-            float cl = -dot(w, face_normal(lf));
-            vec3 wi = vec3(dot(w, ft), dot(w, fb), dot(w, n));
-            if (usable && cl > 0.0 && wi.z > 0.0) {
-                float pdf_bsdf;
-                vec3 fv = eval_bsdf(s, wo, wi, pdf_bsdf);
-                if (fv != vec3(0.0)) {
-                    Shading e = material(lm);
-                    float pdf_light = face_probability(lm, lv, ivec3(face_normal(lf))) * dist * dist / cl;
-                    add_shadow(w, dist, path_beta * fv * wi.z * e.albedo * e.param * power_heuristic(pdf_light, pdf_bsdf) / pdf_light, slot);
+        } else if (LIGHTS && path_face_share > 0.0) {
+            // A light face from the tree by importance, a point uniform on it.
+            float prob;
+            uint slot = sample_light(min((u - share) / (1.0 - share), 0.99999994), pt, normal, prob);
+            if (slot != NO_LIGHT) {
+                ivec3 lv;
+                uint lf;
+                int lm;
+                light_face(slot, lv, lf, lm);
+                dims(base + 4u);
+                float u1 = rand();
+                float u2 = rand();
+                vec3 y = face_point(lv, lf, u1, u2);
+                vec3 to = y - pt;
+                float dist = length(to);
+                vec3 w = to / dist;
+                float cl = -dot(w, face_normal(lf));
+                vec3 wi = vec3(dot(w, ft), dot(w, fb), dot(w, n));
+                if (cl > 0.0 && wi.z > 0.0) {
+                    float pdf_bsdf;
+                    vec3 fv = eval_bsdf(s, wo, wi, pdf_bsdf);
+                    if (fv != vec3(0.0)) {
+                        Shading e = material(lm);
+                        float pdf_light = path_face_share * prob * dist * dist / cl;
+                        add_shadow(w, dist, path_beta * fv * wi.z * e.albedo * e.param * power_heuristic(pdf_light, pdf_bsdf) / pdf_light, slot);
+                    }
                 }
             }
         }
@@ -577,7 +590,7 @@ void main() {
                 // The shadow rays made by this vertex go to the queue (one, then the second);
                 // the subgroup reserves its slots with one atomic each time. A ray that does
                 // not fit stays pending and is traced here.
-                for (int k = 0; k < (LIGHTS ? 2 : 1); k++) {
+                for (int k = 0; k < 1; k++) {
                     bool want = shadow_pending;
                     uvec4 ballot = subgroupBallot(want);
                     uint n = subgroupBallotBitCount(ballot);

@@ -211,3 +211,77 @@ fn faces_are_sampled_in_proportion_to_their_weights() {
     // Only light slots are ever drawn.
     assert_eq!(counts.len() as u32, lights.len());
 }
+
+#[test]
+fn a_point_draws_faces_by_importance_with_the_probability_it_reports() {
+    let (w, lamp) = world();
+    // 60 lamps in a pseudo-random scatter, then a third of them erased and 20 more added (free
+    // slots reused, the capacity grown, the table's entries moved by removals).
+    let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = |n: u32| {
+        rng = rng
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((rng >> 33) % n as u64) as i32
+    };
+    let mut at = Vec::new();
+    for _ in 0..80 {
+        at.push(IVec3::new(next(128), 1 + next(14), next(32)));
+    }
+    for v in &at[..60] {
+        set(&w, *v, VoxelOp::Set(lamp));
+    }
+    for v in at[..60].iter().step_by(3) {
+        set(&w, *v, VoxelOp::Clear);
+    }
+    for v in &at[60..] {
+        set(&w, *v, VoxelOp::Set(lamp));
+    }
+    let v = w.read();
+    v.validate().unwrap();
+    let lights = v.lights();
+    for (slot, f) in lights.iter() {
+        assert_eq!(lights.slot_of(f.voxel, f.face), Some(slot));
+    }
+    assert_eq!(lights.slot_of(IVec3::new(0, 0, 0), 0), None);
+    let points = [
+        (glam::DVec3::new(20.5, 1.0, 9.5), IVec3::Y), // on the floor
+        (glam::DVec3::new(64.0, 8.25, 16.5), IVec3::NEG_X),
+        (glam::DVec3::new(100.5, 15.0, 0.5), IVec3::Z),
+    ];
+    for (p, n) in points {
+        let mut sum = 0.0;
+        for (slot, f) in lights.iter() {
+            let prob = lights.probability_from(slot, p, n);
+            sum += prob;
+            // A face whose centre is in front of it and of the receiver has a chance.
+            let centre = f.voxel.as_dvec3() + 0.5 + f.normal().as_dvec3() * 0.5;
+            let seen = (p - centre).dot(f.normal().as_dvec3()) > 0.0
+                && (centre - p).dot(n.as_dvec3()) > 0.0;
+            assert!(!seen || prob > 0.0, "{p} {n}: face {f:?} has no chance");
+        }
+        assert!(sum > 0.5 && sum <= 1.0 + 1e-9, "{p} {n}: {sum}");
+        let draws = 200_000u32;
+        let mut counts = std::collections::HashMap::new();
+        for k in 0..draws {
+            let u = (k as f64 + 0.5) / draws as f64;
+            if let Some((slot, prob)) = lights.sample_from(u, p, n) {
+                let expected = lights.probability_from(slot, p, n);
+                assert!(
+                    (prob - expected).abs() <= 1e-12 * expected,
+                    "{prob} {expected}"
+                );
+                *counts.entry(slot).or_insert(0u32) += 1;
+            }
+        }
+        for (slot, _) in lights.iter() {
+            let expected = lights.probability_from(slot, p, n) * draws as f64;
+            let got = *counts.get(&slot).unwrap_or(&0) as f64;
+            // Stratified u: the counts are exact up to the rounding of each subtree's share.
+            assert!(
+                (got - expected).abs() < 2.0 + 1e-3 * expected,
+                "slot {slot}: {got} vs {expected}"
+            );
+        }
+    }
+}

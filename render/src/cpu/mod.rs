@@ -12,6 +12,7 @@
 //! - Rays leave a surface from a known cell (`brickmap::cast_from_cell`), never from an
 //!   epsilon-offset point.
 
+mod direct;
 pub mod sampling;
 
 use crate::image::Image;
@@ -259,9 +260,9 @@ impl<'a, 'w> CpuScene<'a, 'w> {
         // Solid-angle pdf of the BSDF sample that made the current ray; None after a delta
         // scattering or at the camera (then a sun hit takes full weight).
         let mut bsdf_pdf: Option<f64> = None;
-        // Whether the vertex the current ray left sampled the emissive faces (then a hit on
-        // one is weighted against that by the power heuristic).
-        let mut lights_sampled = false;
+        // What the vertex the current ray left sampled (a hit on the sun or a light face is
+        // weighted against that by the power heuristic).
+        let mut sampled = direct::Sampled::default();
         for vertex in 1..=self.max_bounces + 1 {
             let hit = self.trace(o, d, start, medium);
             let t_voxel = hit.map_or(f64::INFINITY, |h| h.t);
@@ -270,7 +271,7 @@ impl<'a, 'w> CpuScene<'a, 'w> {
                 && t_sun < t_voxel
             {
                 let w = bsdf_pdf.map_or(1.0, |p| {
-                    power_heuristic(p, t_sun * t_sun / (cos_l * sun.area()))
+                    power_heuristic(p, sampled.sun * t_sun * t_sun / (cos_l * sun.area()))
                 });
                 l += beta * sun.radiance * w;
                 break;
@@ -292,11 +293,11 @@ impl<'a, 'w> CpuScene<'a, 'w> {
             {
                 // They reflect nothing. Full weight unless the last vertex sampled them.
                 let w = match (bsdf_pdf, self.lights) {
-                    (Some(pdf), Some(lights)) if lights_sampled => {
-                        let m = self.view.voxel(hit.voxel).ok().flatten().unwrap_or(0);
+                    (Some(pdf), Some(lights)) => {
                         let cos_l = -d.dot(n);
-                        let area = self.face_probability(lights, m, hit.voxel, hit.normal);
-                        power_heuristic(pdf, area * hit.t * hit.t / cos_l)
+                        let light =
+                            direct::face_pdf(lights, &sampled, hit.voxel, hit.normal, hit.t, cos_l);
+                        power_heuristic(pdf, light)
                     }
                     _ => 1.0,
                 };
@@ -329,25 +330,29 @@ impl<'a, 'w> CpuScene<'a, 'w> {
                     medium = here.and_then(|_| self.view.voxel(hit.voxel).ok().flatten());
                 }
                 bsdf_pdf = None;
-                lights_sampled = false;
+                sampled = direct::Sampled::default();
             } else {
                 let s = here.expect("a surface interaction has a material");
                 let frame = Frame::new(n);
                 let wo = frame.to_local(-d);
-                // Next-event estimation of the sun, for non-delta surfaces.
-                let delta = s.kind == MaterialKind::Metal && s.param <= 0.0;
-                if !delta && let Some(sun) = &self.sun {
-                    l += beta * self.sample_sun(sun, s, &frame, wo, p, front, rng);
-                }
-                // Emissive faces are sampled from vertices in air (from inside a medium every
+                // Next-event estimation (the sun or a light face), for non-delta surfaces.
+                // Light faces are sampled from vertices in air (from inside a medium every
                 // shadow ray is blocked at once: shadow rays stop at any voxel).
-                lights_sampled = false;
-                if !delta
-                    && medium.is_none()
-                    && let Some(lights) = self.lights
-                {
-                    l += beta * self.sample_lights(lights, s, &frame, wo, p, front, rng);
-                    lights_sampled = true;
+                let delta = s.kind == MaterialKind::Metal && s.param <= 0.0;
+                sampled = direct::Sampled::default();
+                if !delta {
+                    let vertex = direct::Vertex {
+                        s,
+                        frame: &frame,
+                        wo,
+                        p,
+                        n: hit.normal,
+                        front,
+                        in_air: medium.is_none(),
+                    };
+                    let (light, what) = self.direct(&vertex, rng);
+                    l += beta * light;
+                    sampled = what;
                 }
                 let Some((wi, weight, pdf)) = sample_bsdf(s, wo, rng) else {
                     break;
@@ -368,89 +373,6 @@ impl<'a, 'w> CpuScene<'a, 'w> {
             }
         }
         l
-    }
-
-    /// Direct light from the sun at a surface point, by uniform area sampling of the disc,
-    /// weighted against BSDF sampling by the power heuristic.
-    #[allow(clippy::too_many_arguments)]
-    fn sample_sun(
-        &self,
-        sun: &SunDisc,
-        s: Shading,
-        frame: &Frame,
-        wo: DVec3,
-        p: DVec3,
-        front: IVec3,
-        rng: &mut Pcg32,
-    ) -> DVec3 {
-        let r = sun.radius * rng.next_f64().sqrt();
-        let phi = 2.0 * PI * rng.next_f64();
-        let y = sun.centre + (sun.e1 * phi.cos() + sun.e2 * phi.sin()) * r;
-        let Some(c) = Connection::new(s, frame, wo, p, y, sun.normal) else {
-            return DVec3::ZERO;
-        };
-        if self.occluded(p, c.w, front, c.dist) {
-            return DVec3::ZERO;
-        }
-        c.light(sun.radiance, c.dist * c.dist / (c.cos_l * sun.area()))
-    }
-
-    /// The probability that light sampling from a point in front of light face (`voxel`,
-    /// outward `normal`) ends on that face: its own weight, plus its opposite face's when
-    /// that is a light face too (a face chosen facing away is swapped for its opposite).
-    fn face_probability(&self, lights: &Lights, m: u8, voxel: IVec3, normal: IVec3) -> f64 {
-        let behind = voxel - normal;
-        let opposite_lit = self.view.voxel(behind).is_ok_and(|v| v.is_none());
-        lights.weight(m) as f64 / lights.total() as f64 * if opposite_lit { 2.0 } else { 1.0 }
-    }
-
-    /// Direct light from the emissive faces at a surface point: a face chosen by weight
-    /// (`Lights::sample`), swapped for the opposite face of its voxel when it faces away
-    /// from the point, a point uniform on it, weighted against BSDF sampling by the power
-    /// heuristic. The shadow ray may end in the light's voxel and nowhere before it.
-    #[allow(clippy::too_many_arguments)]
-    fn sample_lights(
-        &self,
-        lights: &Lights,
-        s: Shading,
-        frame: &Frame,
-        wo: DVec3,
-        p: DVec3,
-        front: IVec3,
-        rng: &mut Pcg32,
-    ) -> DVec3 {
-        let Some(slot) = lights.sample(rng.next_f64()) else {
-            return DVec3::ZERO;
-        };
-        let mut face = lights.face(slot);
-        let (u1, u2) = (rng.next_f64(), rng.next_f64());
-        let mut y = face_point(face.voxel, face.face, u1, u2);
-        if (p - y).dot(face.normal().as_dvec3()) <= 0.0 {
-            face.face ^= 1; // faces away: its opposite (a light face only if uncovered)
-            if self.view.voxel(face.voxel + face.normal()) != Ok(None) {
-                return DVec3::ZERO;
-            }
-            y = face_point(face.voxel, face.face, u1, u2);
-        }
-        let Some(c) = Connection::new(s, frame, wo, p, y, face.normal().as_dvec3()) else {
-            return DVec3::ZERO;
-        };
-        self.count_ray();
-        let ray = Ray {
-            origin: p,
-            dir: c.w,
-        };
-        let blocker = brickmap::cast_from_cell(self.view, &ray, front, c.dist);
-        if blocker
-            .ok()
-            .flatten()
-            .is_some_and(|h| h.voxel != face.voxel)
-        {
-            return DVec3::ZERO;
-        }
-        let e = self.materials[face.material as usize];
-        let area = self.face_probability(lights, face.material, face.voxel, face.normal());
-        c.light(e.albedo * e.param, area * c.dist * c.dist / c.cos_l)
     }
 
     /// Renders an image: `spp` samples per pixel, box filter, on every core.
@@ -489,47 +411,6 @@ impl<'a, 'w> CpuScene<'a, 'w> {
             height: job.height,
             pixels,
         }
-    }
-}
-
-/// A shading point joined to a point on a light (next-event estimation).
-struct Connection {
-    /// Unit direction to the light point, and its distance.
-    w: DVec3,
-    dist: f64,
-    /// Cosine at the light (its outward normal against −w).
-    cos_l: f64,
-    /// Cosine at the surface, BSDF value and the pdf BSDF sampling would choose w with.
-    cos_s: f64,
-    f: DVec3,
-    pdf_bsdf: f64,
-}
-
-impl Connection {
-    /// None when the light faces away, the point lies below the surface or the BSDF is 0.
-    fn new(s: Shading, frame: &Frame, wo: DVec3, p: DVec3, y: DVec3, n_l: DVec3) -> Option<Self> {
-        let to = y - p;
-        let dist = to.length();
-        let w = to / dist;
-        let cos_l = -w.dot(n_l);
-        let wi = frame.to_local(w);
-        if !(cos_l > 0.0 && wi.z > 0.0) {
-            return None;
-        }
-        let (f, pdf_bsdf) = eval_bsdf(s, wo, wi);
-        (f != DVec3::ZERO).then_some(Self {
-            w,
-            dist,
-            cos_l,
-            cos_s: wi.z,
-            f,
-            pdf_bsdf,
-        })
-    }
-    /// The light's contribution when unblocked: radiance `l` sampled with solid-angle pdf
-    /// `pdf_light`, weighted against BSDF sampling by the power heuristic.
-    fn light(&self, l: DVec3, pdf_light: f64) -> DVec3 {
-        self.f * self.cos_s * l * power_heuristic(pdf_light, self.pdf_bsdf) / pdf_light
     }
 }
 

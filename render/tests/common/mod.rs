@@ -632,8 +632,34 @@ pub fn lamp_rooms() -> Vec<(&'static str, World, SceneParams)> {
     put(&w, glass, IVec3::new(2, 1, 18), IVec3::new(29, 14, 18)); // a pane across the room
     put(&w, glass, IVec3::new(2, 3, 27), IVec3::new(4, 5, 29));
     put(&w, m, IVec3::new(3, 4, 28), IVec3::new(3, 4, 28)); // sealed in glass
-    let p = params(camera(&w), black, None, 4);
+    let p = params(camera(&w), black.clone(), None, 4);
     out.push(("behind glass", w, p));
+
+    // The sun through a roof open over half the room, and two lamps: each vertex chooses
+    // between the sun and the light faces by their estimated contributions.
+    let w = room((4, 2, 4));
+    let m = lamp(&w, 1, 8.0, [255, 200, 150]);
+    put(&w, m, IVec3::new(4, 8, 22), IVec3::new(6, 9, 24));
+    put(&w, m, IVec3::new(24, 1, 20), IVec3::new(26, 2, 22));
+    w.apply(EditOp::Shape {
+        shape: Shape::Box {
+            min: IVec3::new(1, 15, 1),
+            max: IVec3::new(30, 15, 14),
+        },
+        mode: Mode::Remove,
+    })
+    .unwrap();
+    let sun = Sun {
+        enabled: true,
+        position: DVec3::new(150.0, 420.0, 40.0),
+        radius: 30.0,
+        colour: [1.0, 0.95, 0.9],
+        intensity: 40.0,
+        animate: false,
+        speed_deg_per_s: 0.0,
+    };
+    let p = params(camera(&w), black, Some(sun), 4);
+    out.push(("the sun and lamps", w, p));
     out
 }
 

@@ -524,7 +524,7 @@ fn bench_error(b: BenchError, workers: usize) -> Result<String> {
         let slot = usize::from(*lamps);
         if scenes[slot].is_none() {
             let mut scene = if *lamps {
-                super::bench_lights::thesis_with_lamps(workers)?
+                super::light_scenes::thesis_with_lamps(workers)?
             } else {
                 app::builtin::thesis_scene(workers)?
             };

@@ -44,6 +44,9 @@ pub(crate) struct BenchGpu {
     /// choice for the image size).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8))]
     slices: Option<u32>,
+    /// The complexities' sample numbers: sobol (the default) or independent.
+    #[arg(long, value_parser = super::args::sequence)]
+    sequence: Option<render::Sequence>,
 }
 
 /// Times the complexities (or, with `--convergence` / `--lights`, those measurements) and
@@ -58,6 +61,7 @@ pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
         inline_shadows,
         convergence,
         lights,
+        sequence,
         reference_spp,
         slices,
     } = bench;
@@ -113,6 +117,9 @@ pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
         let mut params = scene.params.clone();
         params.settings.max_bounces = bounces;
         params.sun.enabled = sun;
+        if let Some(s) = sequence {
+            params.settings.sequence = s;
+        }
         // The scene's variant and the everything variant, alternated in rounds of
         // back-to-back dispatches (one submission each, so the GPU stays busy and its clocks
         // stay up) so both see the same machine state; the first two rounds of each are

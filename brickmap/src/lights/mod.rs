@@ -1,5 +1,5 @@
-//! Emissive voxels as lights: every exposed face of an emissive voxel, in a sum tree the
-//! renderers sample from by power (CPU reference and GPU alike, from the same bytes).
+//! Emissive voxels as lights: every exposed face of an emissive voxel, in a light tree the
+//! renderers sample from (CPU reference and GPU alike, from the same bytes).
 //!
 //! A *light face* is a face of a voxel whose material is emissive with positive weight, whose
 //! neighbour across the face is inside the grid and empty. Those are exactly the emissive
@@ -13,14 +13,27 @@
 //! - 256 f32 material weights (0 for materials that are not lights);
 //! - 2C f32 tree nodes: node 1 the root (total weight), node i's children 2i and 2i + 1,
 //!   leaves C..2C (slot s at C + s holds its face's weight, 0 when free); node 0 unused;
+//! - 2C node bounds of four words (`tree`): lo.x | hi.x << 16, lo.y | hi.y << 16,
+//!   lo.z | hi.z << 16 (voxels, inclusive) and the mask of face directions below the node;
 //! - C face records of two words: x | z << 12 | face << 24, and y | material << 16, with face
-//!   0..6 = −x, +x, −y, +y, −z, +z.
+//!   0..6 = −x, +x, −y, +y, −z, +z;
+//! - 2C words of the face → slot table (`lookup`).
+//!
+//! A shading point descends the tree by importance (`tree`): near faces that face it are
+//! chosen more often than far ones or ones facing away. Faces take slots in the Morton order of
+//! their bricks, so a subtree gathers nearby faces and its bounds are tight.
 //!
 //! Kept exact under edits: after an edit the world recomputes the faces of the bricks it
 //! changed and of their face neighbours that hold lit voxels ([`Lights::apply`]); a brick
 //! whose faces did not change writes nothing. Each changed leaf rewrites its ancestors (each
-//! the sum of its two children, so the tree is a function of its leaves): an edit costs its
-//! bricks and log C nodes per changed face, never anything proportional to the scene.
+//! the sum and union of its two children, so the tree is a function of its leaves) and its
+//! table entries: an edit costs its bricks and log C nodes per changed face, never anything
+//! proportional to the scene. Faces an edit adds take free slots, wherever those lie: the tree
+//! stays exact, its bounds may loosen until the next rescan (loading, a material becoming a
+//! light).
+
+pub mod lookup;
+pub mod tree;
 
 use crate::brick::{BrickMaterials, Mask};
 use crate::dirty::DirtyRanges;
@@ -121,6 +134,8 @@ pub fn srgb_to_linear(c: u8) -> f64 {
 /// then face order.
 pub(crate) struct BrickLights {
     cell: u32,
+    /// Morton code of the brick (the order its new faces take slots in).
+    morton: u64,
     lit: bool,
     faces: Vec<[u32; 2]>,
 }
@@ -130,7 +145,10 @@ pub(crate) struct BrickLights {
 pub struct Lights {
     capacity: u32,
     nodes: Vec<f32>,
+    /// Each node's bounds (`tree`): 2C entries like `nodes`.
+    bounds: Vec<[u32; 4]>,
     faces: Vec<[u32; 2]>,
+    table: lookup::FaceTable,
     weights: [f32; 256],
     /// Slots of each brick cell's faces, in its face order.
     slots: HashMap<u32, Vec<u32>>,
@@ -148,7 +166,9 @@ impl Default for Lights {
         Self {
             capacity: 1,
             nodes: vec![0.0; 2],
+            bounds: vec![tree::EMPTY_BOUNDS; 2],
             faces: vec![[0, 0]; 1],
+            table: lookup::FaceTable::with_len(2),
             weights: [0.0; 256],
             slots: HashMap::new(),
             lit_cells: HashSet::new(),
@@ -193,6 +213,16 @@ impl Lights {
     pub fn leaf(&self, slot: u32) -> f32 {
         self.nodes[(self.capacity + slot) as usize]
     }
+    /// The slot of the light face of `voxel` in direction `face`, if it is one.
+    pub fn slot_of(&self, voxel: IVec3, face: u8) -> Option<u32> {
+        let [w0, w1] = LightFace {
+            voxel,
+            face,
+            material: 0,
+        }
+        .pack();
+        self.table.find(&self.faces, w0, w1)
+    }
     /// Every light face with its slot.
     pub fn iter(&self) -> impl Iterator<Item = (u32, LightFace)> + '_ {
         self.slots.values().flatten().map(|&s| (s, self.face(s)))
@@ -223,21 +253,34 @@ impl Lights {
 
     /// Size of the GPU image in bytes.
     pub fn gpu_size(&self) -> u64 {
-        NODES_OFFSET + self.capacity as u64 * 16
+        self.table_offset() + self.capacity as u64 * 8
+    }
+
+    fn bounds_offset(&self) -> u64 {
+        NODES_OFFSET + self.capacity as u64 * 8
     }
 
     fn faces_offset(&self) -> u64 {
-        NODES_OFFSET + self.capacity as u64 * 8
+        self.bounds_offset() + self.capacity as u64 * 32
+    }
+
+    fn table_offset(&self) -> u64 {
+        self.faces_offset() + self.capacity as u64 * 8
     }
 
     /// The bytes `range` of the GPU image into `dst` (which holds `range`).
     pub fn copy_range(&self, range: &Range<u64>, dst: &mut [u8]) {
         let header = [self.capacity, self.count, 0, 0];
-        let parts: [(&[u8], u64); 4] = [
+        let parts: [(&[u8], u64); 6] = [
             (bytemuck::cast_slice(&header), 0),
             (bytemuck::cast_slice(&self.weights), WEIGHTS_OFFSET),
             (bytemuck::cast_slice(&self.nodes), NODES_OFFSET),
+            (bytemuck::cast_slice(&self.bounds), self.bounds_offset()),
             (bytemuck::cast_slice(&self.faces), self.faces_offset()),
+            (
+                bytemuck::cast_slice(&self.table.entries),
+                self.table_offset(),
+            ),
         ];
         for (src, at) in parts {
             let lo = at.max(range.start);
@@ -306,10 +349,12 @@ impl Lights {
     }
 
     /// Puts recomputed bricks in: a brick whose faces are unchanged writes nothing; the
-    /// others reuse their slots, free the extra ones or take free ones, and rewrite their
-    /// leaves and the leaves' ancestors.
-    pub(crate) fn apply(&mut self, bricks: Vec<BrickLights>) {
-        let mut touched: Vec<u32> = Vec::new();
+    /// others reuse their slots, free the extra ones or take free ones (bricks in Morton
+    /// order), and rewrite their leaves, the leaves' ancestors and their table entries.
+    pub(crate) fn apply(&mut self, mut bricks: Vec<BrickLights>) {
+        bricks.sort_by_key(|b| b.morton);
+        let mut changed_bricks = Vec::new();
+        let mut entries = Vec::new();
         for b in bricks {
             if b.lit {
                 self.lit_cells.insert(b.cell);
@@ -328,35 +373,55 @@ impl Lights {
                 }
                 continue;
             }
-            let mut mine = Vec::with_capacity(b.faces.len());
+            // Out of the table while every face record is still the one it was entered with.
+            // (Their records are cleared at once: a growth rebuilds the table from the
+            // records written.)
+            for &s in &old {
+                self.table.remove(&self.faces, s, &mut entries);
+                self.faces[s as usize] = [0, 0];
+            }
+            changed_bricks.push((b.cell, old, b.faces));
+        }
+        let mut touched: Vec<u32> = Vec::new();
+        for (cell, old, faces) in changed_bricks {
+            let mut mine = Vec::with_capacity(faces.len());
             let mut old = old.into_iter();
-            for f in b.faces {
+            for f in faces {
                 let slot = match old.next() {
                     Some(s) => s,
-                    None => self.take_slot(),
+                    None => self.take_slot(&mut entries),
                 };
                 self.faces[slot as usize] = f;
-                let w = self.weights[LightFace::unpack(f).material as usize];
-                self.nodes[(self.capacity + slot) as usize] = w;
+                let face = LightFace::unpack(f);
+                let leaf = (self.capacity + slot) as usize;
+                self.nodes[leaf] = self.weights[face.material as usize];
+                self.bounds[leaf] = tree::leaf_bounds(face);
+                entries.push(self.table.insert(&self.faces, slot));
                 touched.push(slot);
                 mine.push(slot);
             }
             for s in old {
                 self.faces[s as usize] = [0, 0];
-                self.nodes[(self.capacity + s) as usize] = 0.0;
+                let leaf = (self.capacity + s) as usize;
+                self.nodes[leaf] = 0.0;
+                self.bounds[leaf] = tree::EMPTY_BOUNDS;
                 self.free.push(s);
                 self.count -= 1;
                 touched.push(s);
             }
             if !mine.is_empty() {
-                self.slots.insert(b.cell, mine);
+                self.slots.insert(cell, mine);
             }
         }
         if touched.is_empty() {
             return;
         }
         self.dirty.record(0..8); // capacity and count
-        let faces_at = self.faces_offset();
+        let (faces_at, bounds_at, table_at) = (
+            self.faces_offset(),
+            self.bounds_offset(),
+            self.table_offset(),
+        );
         let c = self.capacity;
         touched.sort_unstable();
         touched.dedup();
@@ -364,12 +429,20 @@ impl Lights {
             self.dirty
                 .record(faces_at + s as u64 * 8..faces_at + s as u64 * 8 + 8);
         }
-        // Ancestors, level by level: each the sum of its children.
+        entries.sort_unstable();
+        entries.dedup();
+        for e in entries {
+            let at = table_at + e as u64 * 4;
+            self.dirty.record(at..at + 4);
+        }
+        // Ancestors, level by level: each the sum and union of its children.
         let mut level: Vec<u32> = touched.iter().map(|s| c + s).collect();
         loop {
             for &i in &level {
                 let at = NODES_OFFSET + i as u64 * 4;
                 self.dirty.record(at..at + 4);
+                let at = bounds_at + i as u64 * 16;
+                self.dirty.record(at..at + 16);
             }
             if level.first().is_none_or(|&i| i <= 1) {
                 break;
@@ -377,40 +450,58 @@ impl Lights {
             let mut parents: Vec<u32> = level.iter().map(|i| i / 2).collect();
             parents.dedup();
             for &p in &parents {
-                let p = p as usize;
-                self.nodes[p] = self.nodes[2 * p] + self.nodes[2 * p + 1];
+                self.set_node(p as usize);
             }
             level = parents;
         }
     }
 
-    fn take_slot(&mut self) -> u32 {
+    /// Node `i` from its children.
+    fn set_node(&mut self, i: usize) {
+        self.nodes[i] = self.nodes[2 * i] + self.nodes[2 * i + 1];
+        self.bounds[i] = tree::union(self.bounds[2 * i], self.bounds[2 * i + 1]);
+    }
+
+    /// A free slot, growing the capacity when none is left (`entries` then loses its
+    /// meaning: growing marks the whole image dirty).
+    fn take_slot(&mut self, entries: &mut Vec<usize>) -> u32 {
         self.count += 1;
         if let Some(s) = self.free.pop() {
             return s;
         }
         if self.used == self.capacity {
             self.grow();
+            entries.clear();
         }
         self.used += 1;
         self.used - 1
     }
 
-    /// Doubles the capacity: leaves move, every node is recomputed, the whole image is dirty.
+    /// Doubles the capacity: leaves move, every node is recomputed, the table is built
+    /// again (from the face records written so far), the whole image is dirty.
     fn grow(&mut self) {
         let (old, new) = (self.capacity as usize, self.capacity as usize * 2);
         let mut nodes = vec![0f32; 2 * new];
         nodes[new..new + old].copy_from_slice(&self.nodes[old..2 * old]);
         self.nodes = nodes;
+        let mut bounds = vec![tree::EMPTY_BOUNDS; 2 * new];
+        bounds[new..new + old].copy_from_slice(&self.bounds[old..2 * old]);
+        self.bounds = bounds;
         self.faces.resize(new, [0, 0]);
         self.capacity = new as u32;
         self.rebuild_nodes();
+        self.table = lookup::FaceTable::with_len(2 * new);
+        for s in 0..self.used {
+            if self.faces[s as usize] != [0, 0] {
+                self.table.insert(&self.faces, s);
+            }
+        }
         self.mark_all_dirty();
     }
 
     fn rebuild_nodes(&mut self) {
         for i in (1..self.capacity as usize).rev() {
-            self.nodes[i] = self.nodes[2 * i] + self.nodes[2 * i + 1];
+            self.set_node(i);
         }
     }
 
@@ -422,6 +513,36 @@ impl Lights {
             if self.nodes[i] != self.nodes[2 * i] + self.nodes[2 * i + 1] {
                 return Err(format!("light node {i} is not the sum of its children"));
             }
+            if self.bounds[i] != tree::union(self.bounds[2 * i], self.bounds[2 * i + 1]) {
+                return Err(format!(
+                    "light node {i}'s bounds are not its children's union"
+                ));
+            }
+        }
+        for s in 0..c {
+            let record = self.faces[s];
+            let expected = if self.nodes[c + s] > 0.0 {
+                tree::leaf_bounds(LightFace::unpack(record))
+            } else {
+                tree::EMPTY_BOUNDS
+            };
+            if self.bounds[c + s] != expected {
+                return Err(format!("slot {s}: leaf bounds are not its face's"));
+            }
+            if self.nodes[c + s] > 0.0 {
+                let (w0, y) = lookup::key(record);
+                if self.table.find(&self.faces, w0, y) != Some(s as u32) {
+                    return Err(format!("slot {s}: its face does not find it in the table"));
+                }
+            }
+        }
+        let entries = self.table.entries.iter().filter(|&&e| e != 0).count();
+        if entries != self.count as usize || self.table.entries.len() != 2 * c {
+            return Err(format!(
+                "the face table holds {entries} of {} entries for {} faces",
+                self.table.entries.len(),
+                self.count
+            ));
         }
         let mut expected: HashMap<u32, Vec<[u32; 2]>> = HashMap::new();
         let mut lit = HashSet::new();
@@ -492,8 +613,10 @@ pub trait VoxelSource {
 pub(crate) fn brick_lights(view: &impl VoxelSource, weights: &[f32; 256], b: UVec3) -> BrickLights {
     let dims: GridDims = view.grid();
     let cell = dims.cell_index(b) as u32;
+    let morton = tree::morton(b);
     let none = BrickLights {
         cell,
+        morton,
         lit: false,
         faces: Vec::new(),
     };
@@ -512,6 +635,7 @@ pub(crate) fn brick_lights(view: &impl VoxelSource, weights: &[f32; 256], b: UVe
     }
     BrickLights {
         cell,
+        morton,
         lit: true,
         faces,
     }
