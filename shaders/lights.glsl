@@ -30,6 +30,11 @@ float light_cone_bound(float cos_t, float r2, float d2) {
 #ifndef LIGHTS_BY_WEIGHT
 #define LIGHTS_BY_WEIGHT false
 #endif
+// Benchmark only (EXPERIMENT bit 12): cosine bounds by a linear widening (two special
+// functions per node instead of seven).
+#ifndef LIGHTS_CHEAP
+#define LIGHTS_CHEAP false
+#endif
 
 // Node i's importance from point p with axis normal n (tree.rs `importance`): 0 exactly when
 // none of its faces can light p.
@@ -58,6 +63,13 @@ float light_importance(uint i, vec3 p, ivec3 n) {
     vec3 e = hi - lo;
     float r2 = dot(e, e) * 0.25;
     float d2 = dot(v, v);
+    if (LIGHTS_CHEAP) {
+        float inv_d = inversesqrt(max(d2, 1e-20));
+        float rd = 0.5 * length(e) * inv_d;
+        float cl = clamp(best * inv_d + rd, 1e-4, 1.0);
+        float cr = clamp(-dot(v, nf) * inv_d + rd, 1e-4, 1.0);
+        return w * cl * cr / max(d2, r2);
+    }
     float d = sqrt(d2);
     float cos_l = 1.0;
     float cos_r = 1.0;

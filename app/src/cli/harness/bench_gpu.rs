@@ -44,6 +44,9 @@ pub(crate) struct BenchGpu {
     /// choice for the image size).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=8))]
     slices: Option<u32>,
+    /// With --lights: write each scene's reference image (tone mapped PNG) into this folder.
+    #[arg(long, value_name = "DIR", requires = "lights")]
+    images: Option<std::path::PathBuf>,
     /// The complexities' sample numbers: sobol (the default) or independent.
     #[arg(long, value_parser = super::args::sequence)]
     sequence: Option<render::Sequence>,
@@ -62,6 +65,7 @@ pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
         convergence,
         lights,
         sequence,
+        images,
         reference_spp,
         slices,
     } = bench;
@@ -71,8 +75,14 @@ pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
     use render::vulkan::trace::Variant;
     if let Some(reference_spp) = lights {
         let device = device.as_deref().unwrap_or("gpu");
-        let text =
-            super::bench_lights::bench_lights(device, workers, (width, height), reference_spp)?;
+        let text = super::bench_lights::bench_lights(
+            device,
+            workers,
+            (width, height),
+            reference_spp,
+            images.as_deref(),
+            experiment,
+        )?;
         return emit(&text);
     }
     let scene = thesis_scene(workers)?;

@@ -31,6 +31,8 @@ pub(crate) fn bench_lights(
     workers: usize,
     (width, height): (u32, u32),
     reference_spp: u32,
+    images: Option<&std::path::Path>,
+    experiment: u32,
 ) -> Result<String> {
     let mut text = String::new();
     for (name, scene) in [
@@ -54,14 +56,17 @@ pub(crate) fn bench_lights(
             let ctx = session.ctx();
             text += &format!("device       {} ({})\n", ctx.name, ctx.driver);
         }
-        let on = Variant::for_scene(&view, params);
+        let on = Variant {
+            experiment,
+            ..Variant::for_scene(&view, params)
+        };
         if !on.lights {
             bail!("{name}: no light faces");
         }
         let variants = [
             on,
             Variant {
-                experiment: BY_WEIGHT,
+                experiment: experiment | BY_WEIGHT,
                 ..on
             },
             Variant {
@@ -81,6 +86,23 @@ pub(crate) fn bench_lights(
                 .render(&view, params, &job(reference_spp, 1), how)?
                 .image)
         })?;
+        if let Some(dir) = images {
+            std::fs::create_dir_all(dir)?;
+            let file = dir.join(format!("{}.png", name.split(' ').next().unwrap_or("scene")));
+            let mut out = std::io::BufWriter::new(std::fs::File::create(&file)?);
+            reference.write_png(&mut out, params.settings.exposure)?;
+        }
+        for (label, v) in ["light tree", "by weight", "BSDF only"]
+            .iter()
+            .zip(variants)
+        {
+            let stats = session.statistics(v);
+            let stats: Vec<String> = stats.iter().map(|(k, v)| format!("{k}={v}")).collect();
+            text += &format!(
+                "{name}, {label}: pipeline statistics: {}\n",
+                stats.join(", ")
+            );
+        }
         text += &format!(
             "{name}: {} light faces, {width}x{height}, reference {reference_spp} spp with light sampling\n  \
              spp   light tree: GPU ms  relMSE     | by weight: GPU ms  relMSE     | BSDF only: GPU ms  relMSE     | efficiency over BSDF only: tree  by weight\n",
