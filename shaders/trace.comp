@@ -28,7 +28,8 @@ layout(constant_id = 7) const bool COUNT_RAYS = false;
 // Benchmark experiments (bench-gpu --experiment), 0 in every real render: bit 0 ends paths
 // at the first hit (primary rays only), bit 1 decodes colours without pow, bit 2 counts
 // every shadow ray as unblocked without tracing it, bit 3 skips light sampling (NEE), bit 4
-// makes shaders/shadow.comp skip its work, bit 6 starts a subgroup's next samples together,
+// makes shaders/shadow.comp skip its work, bit 13 makes Sobol numbers without caching a pair
+// (the same numbers, fewer live values), bit 6 starts a subgroup's next samples together,
 // bits 7..10 turn traversal skips off (brickmap.glsl SKIPS_OFF), bit 11 chooses light faces by
 // weight alone (lights.glsl LIGHTS_BY_WEIGHT), bit 12 takes its cheap cosine bounds
 // (LIGHTS_CHEAP).
@@ -137,6 +138,16 @@ float rand() {
     }
     uint d = sob_dim++;
     uint pair = d >> 1;
+    if ((EXPERIMENT & 8192u) != 0u) {
+        // Lean: nothing cached but the index and the dimension (the pixel's seed made again
+        // from its picture index, only the coordinate asked for scrambled): fewer live values.
+        uint seed = hash(p.seed.x ^ hash(picture_index(gl_GlobalInvocationID.xy) * 9781u + 0x2545f491u));
+        uint s = hash(seed ^ hash(pair * 0x9e3779b9u + 0x7f4a7c15u));
+        uint i = owen_scramble(sob_index, s);
+        uint v = (d & 1u) == 0u ? owen_scramble(bitfieldReverse(i), hash(s ^ 0xa511e9b3u))
+                                : owen_scramble(sobol_1(i), hash(s ^ 0x63d83595u));
+        return float(v >> 8) * (1.0 / 16777216.0);
+    }
     if (pair != sob_pair) {
         // The pair's own shuffle of the pixel's samples and its own scrambles: pairs are
         // independent of each other, each pair's points a scrambled (0, 2)-sequence.
