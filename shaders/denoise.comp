@@ -20,7 +20,9 @@ layout(std430, set = 0, binding = 1) readonly buffer Guides { vec4 guides[]; }; 
 layout(std430, set = 0, binding = 2) buffer Moments { vec4 moments[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Src { vec4 src[]; };        // rgb, variance
 layout(std430, set = 0, binding = 4) writeonly buffer Dst { vec4 dst[]; };
-// flags: bit 0 this batch restarted the accumulation (moments), bit 1 the last step.
+// flags: bit 0 this batch restarted the accumulation (moments), bit 1 the last step, bit 2
+// the source is a moving camera's temporal history (shaders/temporal.comp): its count is
+// frames blended, not unbiased samples, so the last step does not fade to it.
 layout(push_constant) uniform Push { uvec2 size; uint mode; uint step; uint flags; } pc;
 
 // Luminance edge-stopping: differences are measured in standard deviations of the mean
@@ -164,7 +166,8 @@ void filter_step(ivec2 px, uint i) {
     }
     vec3 result = sum / wsum;
     if (last) {
-        float raw = clamp(log2(max(accum[i].w, 1.0) / FADE_FROM) / log2(FADE_TO / FADE_FROM), 0.0, 1.0);
+        float raw = (pc.flags & 4u) != 0u ? 0.0
+            : clamp(log2(max(accum[i].w, 1.0) / FADE_FROM) / log2(FADE_TO / FADE_FROM), 0.0, 1.0);
         dst[i] = vec4(mix(result, demodulated(i), raw) * albedo, 1.0);
     } else {
         dst[i] = vec4(result, vsum / (wsum * wsum));

@@ -15,6 +15,9 @@ const uint EXPERIMENT = 0u;
 #include "scene.glsl"
 
 layout(std430, set = 0, binding = 6) writeonly buffer Guides { vec4 guides[]; };
+// The first surface the centre ray meets, mirror and glass included (what temporal
+// reprojection follows, shaders/temporal.comp): its point and 8 · kind + face, w = −1 for none.
+layout(std430, set = 0, binding = 7) writeonly buffer Primary { vec4 primary[]; };
 
 // Mirror and smooth-dielectric interfaces followed before the guide's surface.
 const int DELTA_BOUNCES = 4;
@@ -32,6 +35,7 @@ void main() {
     // its light most likely goes: refraction unless Fresnel reflects more, or total internal
     // reflection), so a reflection or what lies behind glass is filtered on its own plane.
     int medium = camera_medium(o);
+    primary[index] = vec4(0.0, 0.0, 0.0, -1.0);
     vec3 tint = vec3(1.0);
     float travelled = 0.0;
     ivec3 start = ivec3(0);
@@ -45,6 +49,8 @@ void main() {
         int here = material_at(voxel);
         // Inside a medium the first interaction may be leaving it into air: the medium's face.
         Shading s = material(here >= 0 ? here : max(medium, 0));
+        int face = normal.x != 0 ? (normal.x > 0 ? 1 : 0) : (normal.y != 0 ? (normal.y > 0 ? 3 : 2) : (normal.z > 0 ? 5 : 4));
+        if (bounce == 0) primary[index] = vec4(o + d * t, float(8 * s.kind + face));
         bool crossing = (here >= 0 && s.kind == DIELECTRIC) || (here < 0 && medium >= 0);
         bool mirror = here >= 0 && s.kind == METAL && s.param <= 0.0;
         if (bounce < DELTA_BOUNCES && (crossing || mirror)) {
@@ -76,7 +82,6 @@ void main() {
         // (perspective; `cam_up` is scaled by tan(fov / 2)) or the view's (orthographic).
         float pixel = 2.0 * length(p.cam_up.xyz) / float(p.window.w);
         float footprint = p.cam_pos.w > 0.5 ? pixel : pixel * travelled;
-        int face = normal.x != 0 ? (normal.x > 0 ? 1 : 0) : (normal.y != 0 ? (normal.y > 0 ? 3 : 2) : (normal.z > 0 ? 5 : 4));
         guides[2u * index] = vec4(o + d * t, footprint);
         guides[2u * index + 1u] = vec4(tint * s.albedo, float(8 * s.kind + face));
         return;

@@ -20,6 +20,7 @@ use crate::vulkan::pass::{SetCache, run_batch};
 use crate::vulkan::primary::{GpuHit, PrimaryTracer};
 use crate::vulkan::progressive::Progressive;
 pub use crate::vulkan::progressive::{RenderHow, Rendered};
+use crate::vulkan::temporal::Temporal;
 use crate::vulkan::tonemap::ToneMapper;
 use crate::vulkan::trace::{Dim, PathTracer, TraceParams, Variant, Window};
 use crate::vulkan::world::{GpuWorld, UploadReport};
@@ -28,6 +29,9 @@ use ash::vk;
 use brickmap::{World, WorldView};
 use std::mem::ManuallyDrop;
 use std::sync::Arc;
+
+mod denoised;
+pub use denoised::DenoisedRender;
 
 /// The most bytes per traced pixel one buffer of a frame holds (the denoiser's guides; the
 /// accumulation holds 16): the internal size is fitted so that it stays within the device's
@@ -54,6 +58,9 @@ pub struct FrameRequest<'a> {
     /// Display the denoised accumulation ([`crate::vulkan::denoise`]; a view setting, never
     /// in reference renders).
     pub denoise: bool,
+    /// With `denoise`: while the camera moves, reuse the previous frames' radiance where they
+    /// saw the same surfaces (temporal reprojection, `vulkan::temporal`).
+    pub reproject: bool,
     /// Camera hits outside this box weighted by its factor (a view setting: the editor's
     /// dimming of the objects it is not editing).
     pub dim: Option<Dim>,
@@ -84,20 +91,6 @@ pub struct Frame {
     pub acquired: vk::Semaphore,
 }
 
-/// A render with the viewport's denoiser ([`Viewport::render_denoised`]).
-#[derive(Clone, Debug)]
-pub struct DenoisedRender {
-    /// The accumulation's mean (linear).
-    pub raw: Image,
-    /// The denoised image (linear).
-    pub denoised: Image,
-    /// GPU time of the trace dispatches (None when the queue cannot time).
-    pub trace_seconds: Option<f64>,
-    /// GPU time of one filter (guides and moments not included: they run with the batches),
-    /// the median of the timed repetitions; None when not timed.
-    pub filter_seconds: Option<f64>,
-}
-
 /// The GPU session. Fields are released in `Drop`, the context last.
 pub struct Viewport {
     world: ManuallyDrop<GpuWorld>,
@@ -116,6 +109,14 @@ pub struct Viewport {
     held: u32,
     /// The edge-aware denoiser (made when first asked for).
     denoiser: Option<Denoiser>,
+    /// Its temporal reprojection while the camera moves (made with it).
+    temporal: Option<Temporal>,
+    /// The last frame's `TraceParams::scene_key` and variant: when a restart keeps it, only
+    /// the camera moved (the temporal history stays valid).
+    scene_key: Option<u64>,
+    /// What the last denoised frame's filter read when it was not the accumulation (the
+    /// temporal history or handover).
+    filter_input: Option<Binding>,
     ctx: Arc<GpuContext>,
 }
 
@@ -178,6 +179,9 @@ impl Viewport {
             last_gpu_seconds: None,
             held: 0,
             denoiser: None,
+            temporal: None,
+            scene_key: None,
+            filter_input: None,
             ctx,
         })
     }
@@ -209,116 +213,6 @@ impl Viewport {
     ) -> Result<Rendered, GpuError> {
         self.tracer
             .render(&self.ctx, &self.world, view, params, job, how)
-    }
-
-    /// Renders `job` with `variant` as the viewport does with its denoiser on, one batch per
-    /// dispatch (the tracer's batch shape), and waits; the filter is timed over `timed`
-    /// repetitions (0: not timed).
-    pub fn render_denoised(
-        &mut self,
-        view: &WorldView<'_>,
-        params: &SceneParams,
-        job: &RenderJob,
-        variant: Variant,
-        timed: u32,
-    ) -> Result<DenoisedRender, GpuError> {
-        let whole = Window::whole((job.width, job.height));
-        self.render_denoised_in(view, params, job, variant, timed, whole)
-    }
-
-    /// [`Viewport::render_denoised`] of `job`'s image as the part `window` of a larger
-    /// picture (a tile: its pixels and guides are the picture's there).
-    pub fn render_denoised_in(
-        &mut self,
-        view: &WorldView<'_>,
-        params: &SceneParams,
-        job: &RenderJob,
-        variant: Variant,
-        timed: u32,
-        window: Window,
-    ) -> Result<DenoisedRender, GpuError> {
-        let ctx = self.ctx.clone();
-        // The denoiser's buffers may be the live accumulation's.
-        self.wait_idle()?;
-        if self.denoiser.is_none() {
-            self.denoiser = Some(Denoiser::new(&ctx)?);
-        }
-        let size = (job.width, job.height);
-        let mut acc = Progressive::new(&ctx, size, size, job.seed)?;
-        acc.set_window(window);
-        let mut guide_params = match HostBuffer::new(
-            &ctx,
-            "guide params",
-            std::mem::size_of::<TraceParams>() as u64,
-            gpu_allocator::MemoryLocation::CpuToGpu,
-        ) {
-            Ok(b) => b,
-            Err(e) => {
-                acc.destroy(&ctx);
-                return Err(e);
-            }
-        };
-        let guides = TraceParams::in_window(view, params, job, window);
-        guide_params.write(bytemuck::bytes_of(&guides));
-        let mut sets = match SetCache::new(&ctx) {
-            Ok(s) => s,
-            Err(e) => {
-                acc.destroy(&ctx);
-                guide_params.destroy(&ctx);
-                return Err(e);
-            }
-        };
-        let denoiser = self.denoiser.as_mut().expect("made above");
-        denoiser.invalidate();
-        let world = &*self.world;
-        let result = acc
-            .accumulate_with(
-                &ctx,
-                &mut self.tracer,
-                world,
-                view,
-                params,
-                variant,
-                job.spp,
-                |accum, first| {
-                    let mut recorded = Ok(());
-                    ctx.submit_and_wait(|cmd| {
-                        recorded = denoiser.record_batch(
-                            &ctx,
-                            cmd,
-                            &mut sets,
-                            world,
-                            guide_params.binding(),
-                            accum,
-                            size,
-                            first,
-                        );
-                    })?;
-                    recorded
-                },
-            )
-            .and_then(|(trace_seconds, _)| {
-                let filter_sets = denoiser.filter_sets(&ctx, &mut sets, acc.accumulation())?;
-                let record = |cmd| {
-                    denoiser.record_filter_sets(&ctx, cmd, filter_sets);
-                };
-                let times = run_batch(&ctx, timed.max(1), timed > 0, record)?;
-                let raw = acc.hdr(&ctx)?;
-                let denoised = read_image(&ctx, denoiser.output().expect("filtered"), size)?;
-                let mut times: Vec<f64> = times;
-                times.sort_by(f64::total_cmp);
-                Ok(DenoisedRender {
-                    raw,
-                    denoised,
-                    trace_seconds,
-                    filter_seconds: times.get(times.len() / 2).copied(),
-                })
-            });
-        acc.destroy(&ctx);
-        guide_params.destroy(&ctx);
-        sets.destroy(&ctx);
-        denoiser.invalidate();
-        result
     }
 
     /// Benchmarks: GPU times of `count` back-to-back dispatches of `spp` samples per pixel
@@ -410,6 +304,31 @@ impl Viewport {
             .transpose()
     }
 
+    /// What the last denoised frame filtered when it was the temporal history (or the
+    /// handover after a stop) rather than the accumulation: its mean (waits; tests and
+    /// benchmarks).
+    pub fn live_filter_input(&mut self) -> Result<Option<Image>, GpuError> {
+        self.wait_idle()?;
+        let (Some(live), Some(input)) = (&self.live, self.filter_input) else {
+            return Ok(None);
+        };
+        let raw = read_device(&self.ctx, input)?;
+        let px: &[[f32; 4]] = bytemuck::cast_slice(&raw);
+        let (w, h) = live.internal();
+        Ok(Some(Image {
+            width: w,
+            height: h,
+            pixels: px
+                .iter()
+                .take(w as usize * h as usize)
+                .map(|p| {
+                    let n = if p[3] > 0.0 { p[3] } else { 1.0 };
+                    [p[0] / n, p[1] / n, p[2] / n]
+                })
+                .collect(),
+        }))
+    }
+
     /// The next frame slot, if its previous submission finished; never blocks.
     pub fn begin_frame(&mut self) -> Result<Option<Frame>, GpuError> {
         while self.frames.len() < FRAMES_IN_FLIGHT {
@@ -459,6 +378,7 @@ impl Viewport {
         }
         let internal = self.fit_internal(req.internal);
         let output = (req.output.0.max(1), req.output.1.max(1));
+        let mut recreated = false;
         if self
             .live
             .as_ref()
@@ -473,6 +393,7 @@ impl Viewport {
                 s.sets.clear(&ctx);
             }
             self.live = Some(Progressive::new(&ctx, internal, output, 1)?);
+            recreated = true;
             if let Some(d) = &mut self.denoiser {
                 d.invalidate();
             }
@@ -498,6 +419,14 @@ impl Viewport {
             };
             (base, variant)
         };
+        let key = {
+            use std::hash::{Hash, Hasher};
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            (base.scene_key(), variant).hash(&mut h);
+            h.finish()
+        };
+        let only_camera = !upload.changed() && self.scene_key == Some(key);
+        self.scene_key = Some(key);
         let slot = &mut self.frames[frame.slot];
         slot.ensure_ldr(&ctx, output.0 as u64 * output.1 as u64 * 4)?;
         // SAFETY: recording; earlier frames' and the staging ring's writes (same queue,
@@ -551,13 +480,42 @@ impl Viewport {
                     internal,
                     restarted,
                 )?;
-                shown = d.record_filter(&ctx, frame.cmd, &mut slot.sets, live.accumulation())?;
+                // While the camera moves, the filter reads the reprojected history instead.
+                let t = match &mut self.temporal {
+                    Some(t) => t,
+                    None => self.temporal.insert(Temporal::new(&ctx)?),
+                };
+                if !only_camera || !req.reproject {
+                    t.invalidate();
+                }
+                let source = match d.first_surfaces().filter(|_| added > 0 && req.reproject) {
+                    Some(surfaces) => t.record(
+                        &ctx,
+                        frame.cmd,
+                        &mut slot.sets,
+                        live.accumulation(),
+                        surfaces,
+                        base.camera(),
+                        internal,
+                        live.samples(),
+                        restarted,
+                        recreated,
+                    )?,
+                    None => None,
+                };
+                self.filter_input = source;
+                d.set_temporal_input(source.is_some() && restarted);
+                let source = source.unwrap_or_else(|| live.accumulation());
+                shown = d.record_filter(&ctx, frame.cmd, &mut slot.sets, source)?;
             } else if let Some(out) = d.filtered_output() {
                 shown = out;
             }
         } else if let Some(d) = &mut self.denoiser {
             // Batches added meanwhile are not in its moments.
             d.invalidate();
+            if let Some(t) = &mut self.temporal {
+                t.invalidate();
+            }
         }
         let slot = &mut self.frames[frame.slot];
         let ldr = slot.ldr.as_ref().expect("ensured above").binding();
@@ -672,6 +630,9 @@ impl Drop for Viewport {
             }
             if let Some(d) = self.denoiser.take() {
                 d.destroy(&self.ctx);
+            }
+            if let Some(t) = self.temporal.take() {
+                t.destroy(&self.ctx);
             }
             ManuallyDrop::take(&mut self.tone).destroy(&self.ctx);
             ManuallyDrop::take(&mut self.tracer).destroy(&self.ctx);

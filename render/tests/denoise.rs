@@ -141,6 +141,7 @@ fn interactive_frames_display_the_denoised_image_when_asked() {
         exposure: 0.0,
         bgra: false,
         denoise: true,
+        reproject: true,
         dim: None,
         grid: None,
     };
@@ -172,5 +173,109 @@ fn interactive_frames_display_the_denoised_image_when_asked() {
     req.internal = (40, 24);
     run(&mut vp, &req, 3);
     assert_eq!(vp.live_denoised().unwrap().unwrap().width, 40);
+    assert_eq!(ctx.validation_errors(), 0, "validation errors");
+}
+
+#[test]
+fn moving_frames_reuse_the_previous_frames_and_a_stop_hands_over_to_the_accumulation() {
+    let Some(ctx) = common::gpu_context(DeviceChoice::Best).map(Arc::new) else {
+        return;
+    };
+    let (world, mut params) = common::showcase();
+    let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
+    let size = (64, 48);
+    // An orbit about the point the camera looks at, 0.4° a frame.
+    let start = params.camera.clone();
+    let centre = world.dims().voxels().as_dvec3() * 0.5;
+    let target = start.position + start.forward() * (centre - start.position).length();
+    let at = |deg: f64| {
+        let (s, c) = deg.to_radians().sin_cos();
+        let v = start.position - target;
+        let v = glam::DVec3::new(v.x * c + v.z * s, v.y, -v.x * s + v.z * c);
+        render::Camera::looking_at(target + v, target, 60.0)
+    };
+    // relMSE of what the last frame displayed, of the raw accumulation and of what the filter
+    // read when that was the temporal history.
+    let errors = |vp: &mut Viewport, params: &render::SceneParams| {
+        let reference = vp
+            .render(
+                &world.read(),
+                params,
+                &RenderJob::sized(size, 256, 9),
+                RenderHow::SCENE,
+            )
+            .unwrap()
+            .image;
+        let e = |i: &Image| rel_mse(i, &reference).unwrap();
+        let shown = vp.live_denoised().unwrap().expect("denoised frames");
+        let raw = vp.live_hdr().unwrap().unwrap();
+        let input = vp.live_filter_input().unwrap();
+        (e(&shown), e(&raw), input.map(|i| e(&i)))
+    };
+    let frame = |vp: &mut Viewport, params: &render::SceneParams, reproject: bool| {
+        let req = FrameRequest {
+            params,
+            internal: size,
+            output: size,
+            spp: 1,
+            target_spp: 64,
+            exposure: 0.0,
+            bgra: false,
+            denoise: true,
+            reproject,
+            dim: None,
+            grid: None,
+        };
+        vp.draw(&world, &req).unwrap();
+    };
+    let orbit = |vp: &mut Viewport, params: &mut render::SceneParams, reproject: bool| {
+        for k in 0..=12 {
+            params.camera = at(0.4 * k as f64);
+            frame(vp, params, reproject);
+        }
+        assert_eq!(vp.samples(), 1, "every moving frame restarts");
+    };
+    // Without reprojection every moving frame is one filtered sample.
+    orbit(&mut vp, &mut params, false);
+    let (alone, raw, input) = errors(&mut vp, &params);
+    assert!(input.is_none(), "nothing but the accumulation filtered");
+    orbit(&mut vp, &mut params, true);
+    let (shown, raw_again, input) = errors(&mut vp, &params);
+    let input = input.expect("the history filtered");
+    eprintln!(
+        "12 frames into an orbit: one sample {raw:.4} / {raw_again:.4}, the history {input:.4}; displayed without reprojection {alone:.4}, with {shown:.4}"
+    );
+    assert!(input < 0.6 * raw_again, "{input} {raw_again}");
+    assert!(shown < 0.95 * alone, "{shown} {alone}");
+    // Stopped: the first still frame shows the history handed over, not one filtered sample.
+    frame(&mut vp, &params, true);
+    assert_eq!(vp.samples(), 2);
+    let (stopped, _, handed) = errors(&mut vp, &params);
+    eprintln!("the first still frame: displayed {stopped:.4}");
+    assert!(
+        handed.is_some() && stopped < 0.95 * alone,
+        "{stopped} {alone}"
+    );
+    // From 16 samples on the accumulation alone is filtered, as without reprojection.
+    for _ in 0..15 {
+        frame(&mut vp, &params, true);
+    }
+    assert_eq!(vp.samples(), 17);
+    assert!(vp.live_filter_input().unwrap().is_none());
+    // An edit is no camera move: its first frame has no history.
+    world
+        .apply(brickmap::EditOp::Voxels(vec![brickmap::VoxelEdit {
+            pos: glam::IVec3::new(1, 1, 1),
+            op: brickmap::VoxelOp::Clear,
+        }]))
+        .unwrap();
+    frame(&mut vp, &params, true);
+    assert_eq!(vp.samples(), 1);
+    let (_, raw, input) = errors(&mut vp, &params);
+    let input = input.expect("a fresh history");
+    assert!(
+        (input - raw).abs() <= 1e-6 * raw,
+        "{input} {raw}: the history is this frame's"
+    );
     assert_eq!(ctx.validation_errors(), 0, "validation errors");
 }

@@ -141,6 +141,7 @@ fn what_cannot_fit_is_refused_and_the_viewport_traces_a_smaller_image() {
         exposure: 0.0,
         bgra: false,
         denoise: true,
+        reproject: true,
         dim: None,
         grid: None,
     };

@@ -57,6 +57,7 @@ fn request(
         exposure: 0.0,
         bgra: false,
         denoise: false,
+        reproject: true,
         dim: None,
         grid: None,
     }
@@ -122,6 +123,7 @@ fn an_edit_or_a_camera_move_restarts_and_the_edit_is_visible_the_next_frame() {
             exposure: 0.0,
             bgra: false,
             denoise: false,
+            reproject: true,
             dim: None,
             grid: None,
         };

@@ -518,6 +518,7 @@ impl Session {
             exposure: 0.0,
             bgra: false,
             denoise: self.rng.chance(0.2),
+            reproject: true,
             dim: None,
             grid: None,
         };

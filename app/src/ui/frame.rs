@@ -529,6 +529,7 @@ impl Editor {
             bgra: false,
             // A script run's capture is compared with headless renders: never denoised.
             denoise: self.settings.denoise && self.script.is_none(),
+            reproject: self.settings.reproject,
             // Likewise never dimmed.
             dim: (self.settings.dim_others
                 && self.script.is_none()

@@ -34,6 +34,9 @@ pub struct ViewSettings {
     /// Show the viewport denoised (edge-aware, guided by the first hit; it gives way to the
     /// raw image between 8 and 64 spp). Renders and exports never are.
     pub denoise: bool,
+    /// With `denoise`: while the camera moves, reuse earlier frames where they saw the same
+    /// surfaces (a clean image while orbiting; the still image is unchanged).
+    pub reproject: bool,
     /// Outside arrange mode, darken what lies outside the edited object's box.
     pub dim_others: bool,
     /// The ground grid on the scene's floor (G).
@@ -60,6 +63,7 @@ impl Default for ViewSettings {
             moving_scale: 0.5,
             exposure: 0.0,
             denoise: false,
+            reproject: true,
             dim_others: false,
             grid: true,
             grid_spacing: 8,
@@ -382,6 +386,8 @@ pub fn draw(
                 });
                 ui.checkbox(&mut view.denoise, "denoise the viewport")
                     .on_hover_text("Edge-aware filter guided by the first hit's normal, albedo and depth; between 8 and 64 samples it gives way to the path-traced image. Renders and exports are never denoised.");
+                ui.add_enabled(view.denoise, egui::Checkbox::new(&mut view.reproject, "reuse earlier frames while moving"))
+                    .on_hover_text("While the camera moves, blend in the previous frames where they saw the same surfaces; once it stops, the path-traced image takes over within 16 samples.");
                 let mut settings = doc.scene.params.settings.clone();
                 if ui
                     .add(

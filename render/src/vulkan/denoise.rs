@@ -39,12 +39,15 @@ const PREPARE: u32 = 1;
 const FILTER_STEP: u32 = 2;
 const RESTART: u32 = 1;
 const LAST: u32 = 2;
+const NO_FADE: u32 = 4;
 
 /// The buffers of one image size.
 struct Buffers {
     size: (u32, u32),
     /// Two vec4 per pixel (shaders/guides.comp).
     guides: HostBuffer,
+    /// One vec4 per pixel: the first surface (shaders/guides.comp `primary`).
+    primary: HostBuffer,
     /// Per pixel: previous luminance sum and count, Σ S²/k, batches.
     moments: HostBuffer,
     ping: HostBuffer,
@@ -58,6 +61,13 @@ impl Buffers {
         let pixels = size.0 as u64 * size.1 as u64;
         let make = |name, bytes| HostBuffer::new(ctx, name, bytes, MemoryLocation::GpuOnly);
         let guides = make("denoise guides", pixels * 32)?;
+        let primary = match make("denoise first surfaces", pixels * 16) {
+            Ok(b) => b,
+            Err(e) => {
+                guides.destroy(ctx);
+                return Err(e);
+            }
+        };
         let rest = (|| {
             let moments = make("denoise moments", pixels * 16)?;
             let ping = match make("denoise ping", pixels * 16) {
@@ -80,19 +90,27 @@ impl Buffers {
             Ok((moments, ping, pong)) => Ok(Self {
                 size,
                 guides,
+                primary,
                 moments,
                 ping,
                 pong,
             }),
             Err(e) => {
                 guides.destroy(ctx);
+                primary.destroy(ctx);
                 Err(e)
             }
         }
     }
 
     fn destroy(self, ctx: &GpuContext) {
-        for b in [self.guides, self.moments, self.ping, self.pong] {
+        for b in [
+            self.guides,
+            self.primary,
+            self.moments,
+            self.ping,
+            self.pong,
+        ] {
             b.destroy(ctx);
         }
     }
@@ -115,12 +133,14 @@ pub struct Denoiser {
     current: bool,
     /// The output holds the filter of the accumulation's latest batch.
     filtered: bool,
+    /// The next filter reads a moving camera's temporal history (no fade to the raw mean).
+    temporal_input: bool,
 }
 
 impl Denoiser {
     /// Builds the pipelines (buffers come with the first size).
     pub fn new(ctx: &GpuContext) -> Result<Self, GpuError> {
-        let guides = ComputePass::new(ctx, GUIDES, 7, 0)?;
+        let guides = ComputePass::new(ctx, GUIDES, 8, 0)?;
         let filter = match ComputePass::new(ctx, FILTER, 5, std::mem::size_of::<Push>() as u32) {
             Ok(f) => f,
             Err(e) => {
@@ -134,6 +154,7 @@ impl Denoiser {
             buffers: None,
             current: false,
             filtered: false,
+            temporal_input: false,
         })
     }
 
@@ -182,7 +203,7 @@ impl Denoiser {
         let b = self.buffers.as_ref().expect("ensured");
         if fresh {
             let mut bound = world.bindings();
-            bound.extend([params, b.guides.binding()]);
+            bound.extend([params, b.guides.binding(), b.primary.binding()]);
             let set = sets.get(ctx, &self.guides, &bound)?;
             self.guides.record(
                 ctx,
@@ -207,6 +228,18 @@ impl Denoiser {
         self.current = true;
         self.filtered = false;
         Ok(())
+    }
+
+    /// The first surfaces of the current size (one vec4 per pixel: point, 8 · kind + face or
+    /// −1), if buffers exist.
+    pub fn first_surfaces(&self) -> Option<Binding> {
+        self.buffers.as_ref().map(|b| b.primary.binding())
+    }
+
+    /// Whether the next filter's source is a moving camera's temporal history (its counts are
+    /// frames blended, not unbiased samples: the last step then does not fade to it).
+    pub fn set_temporal_input(&mut self, on: bool) {
+        self.temporal_input = on;
     }
 
     /// The last filter's output (radiance, count 1 per pixel), if buffers exist.
@@ -288,7 +321,15 @@ impl Denoiser {
                 ctx,
                 cmd,
                 set,
-                push(FILTER_STEP, step, if last { LAST } else { 0 }),
+                push(
+                    FILTER_STEP,
+                    step,
+                    match (last, self.temporal_input) {
+                        (true, true) => LAST | NO_FADE,
+                        (true, false) => LAST,
+                        _ => 0,
+                    },
+                ),
             );
         }
         // SAFETY: recording.

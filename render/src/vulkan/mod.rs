@@ -16,6 +16,7 @@ pub mod progressive;
 pub mod staging;
 pub mod surface;
 pub mod swapchain;
+pub mod temporal;
 pub mod tonemap;
 pub mod trace;
 pub mod world;

@@ -434,9 +434,10 @@ pub struct SetCache {
 type SetKey = (vk::DescriptorSetLayout, Vec<(vk::Buffer, u64, u64)>);
 
 /// Sets a cache holds before it starts over.
-const CACHED_SETS: u32 = 32;
-/// New sets one frame may make: trace, shadow and display passes, with room to spare.
-pub const SET_HEADROOM: u32 = 8;
+const CACHED_SETS: u32 = 40;
+/// New sets one frame may make: trace, shadow, denoiser, temporal and display passes, with
+/// room to spare.
+pub const SET_HEADROOM: u32 = 10;
 /// Storage buffers per cached set at most.
 const CACHED_BUFFERS: u32 = 16;
 

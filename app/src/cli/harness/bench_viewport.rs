@@ -321,6 +321,7 @@ fn run(mut vp: Viewport, world: &World, params: &SceneParams, b: &BenchViewport)
             exposure: 0.0,
             bgra: true,
             denoise: false,
+            reproject: true,
             dim: None,
             grid: None,
         };
@@ -569,6 +570,7 @@ pub(crate) fn edit_request(
         exposure: 0.0,
         bgra: true,
         denoise: false,
+        reproject: true,
         dim: None,
         grid: None,
     }

@@ -71,6 +71,29 @@ fn v4(v: DVec3, w: f32) -> [f32; 4] {
 }
 
 impl TraceParams {
+    /// The camera as shaders read it (position with w = 1 when orthographic, forward, and
+    /// right and up scaled by the half-extents): what temporal reprojection projects with.
+    pub fn camera(&self) -> [[f32; 4]; 4] {
+        [self.cam_pos, self.cam_forward, self.cam_right, self.cam_up]
+    }
+
+    /// A hash of everything but the camera, the image's size and place and the batch's
+    /// samples and seed: equal keys mean only the camera (or the size) changed.
+    pub fn scene_key(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut rest = *self;
+        rest.cam_pos = [0.0; 4];
+        rest.cam_forward = [0.0; 4];
+        rest.cam_right = [0.0; 4];
+        rest.cam_up = [0.0; 4];
+        rest.image = [0, 0, 0, self.image[3]];
+        rest.seed = [0; 4];
+        rest.window = [0; 4];
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        bytemuck::bytes_of(&rest).hash(&mut h);
+        h.finish()
+    }
+
     /// The parameters of a render, derived exactly as `CpuScene::new` derives them.
     pub fn new(view: &WorldView<'_>, params: &SceneParams, job: &RenderJob) -> Self {
         Self::in_window(view, params, job, Window::whole((job.width, job.height)))
