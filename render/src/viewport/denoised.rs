@@ -19,7 +19,6 @@ pub struct DenoisedRender {
     pub filter_seconds: Option<f64>,
 }
 
-
 impl Viewport {
     /// Renders `job` with `variant` as the viewport does with its denoiser on, one batch per
     /// dispatch (the tracer's batch shape), and waits; the filter is timed over `timed`

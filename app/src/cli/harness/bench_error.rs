@@ -274,14 +274,16 @@ const TIMING_ROUNDS: usize = 4;
 /// GPU seconds of work before the steady-state timing.
 const WARM_UP_S: f64 = 0.5;
 
-fn flip(reference: &[u8], test: &[u8], (w, h): (u32, u32)) -> f64 {
+/// Mean FLIP between two sRGB 8-bit images.
+pub(crate) fn flip(reference: &[u8], test: &[u8], (w, h): (u32, u32)) -> f64 {
     let r = nv_flip::FlipImageRgb8::with_data(w, h, reference);
     let t = nv_flip::FlipImageRgb8::with_data(w, h, test);
     let map = nv_flip::flip(r, t, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
     f64::from(nv_flip::FlipPool::from_image(&map).mean())
 }
 
-fn srgb(image: &Image, exposure: f32) -> Vec<u8> {
+/// An image tone mapped to sRGB 8-bit as the display shows it.
+pub(crate) fn srgb(image: &Image, exposure: f32) -> Vec<u8> {
     image.to_srgb8(exposure).into_iter().flatten().collect()
 }
 

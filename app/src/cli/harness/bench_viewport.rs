@@ -5,6 +5,7 @@
 //! frame, and camera move → first frame showing it (frames and ms, submit to completion).
 
 mod objects;
+mod orbit;
 mod selection;
 
 use super::{args, emit, with_progress};
@@ -46,6 +47,14 @@ pub(crate) struct BenchViewport {
     /// update time.
     #[arg(long, value_delimiter = ',')]
     edits: Vec<f64>,
+    /// Instead: this many frames of the denoised viewport along an orbit, with and without
+    /// temporal reprojection, each against a converged reference of its view (at the first
+    /// of --scales), then the frames after the stop.
+    #[arg(long, value_name = "FRAMES", value_parser = clap::value_parser!(u32).range(2..=600))]
+    orbit: Option<u32>,
+    /// Samples per pixel of the orbit's references.
+    #[arg(long, default_value_t = 1024)]
+    reference_spp: u32,
 }
 
 /// Checks the arguments, builds the scene (the thesis scene, or the default one for
@@ -80,10 +89,22 @@ pub(crate) fn command(mut b: BenchViewport, workers: usize) -> Result<()> {
     let mut scene = thesis_scene(workers)?;
     scene.params.sun.enabled = true;
     scene.params.settings.max_bounces = 3;
-    let session = {
+    let mut session = {
         let view = scene.world.read();
         app::gpu::session_with(&device, &view, b.ui)?
     };
+    if let Some(frames) = b.orbit {
+        let internal = scaled(b.size, b.scales[0]);
+        let text = orbit::orbit_report(
+            &mut session,
+            &scene.world,
+            &scene.params,
+            internal,
+            frames as usize,
+            b.reference_spp.max(1),
+        )?;
+        return emit(&text);
+    }
     emit(&run(session, &scene.world, &scene.params, &b)?)
 }
 
@@ -333,10 +354,16 @@ fn run(mut vp: Viewport, world: &World, params: &SceneParams, b: &BenchViewport)
             cases.extend([
                 ("refining, denoised", false, true),
                 ("moving, denoised", true, true),
+                ("moving, denoised, no reprojection", true, true),
             ]);
         }
         for (label, moving, denoise) in cases {
-            let req = FrameRequest { denoise, ..req };
+            let reproject = !label.ends_with("no reprojection");
+            let req = FrameRequest {
+                denoise,
+                reproject,
+                ..req
+            };
             let (gpu, host, wall) = run_case(&mut vp, world, params, req, b.frames, moving)?;
             if let Some(presenter) = &mut presenter {
                 let (gpu, host, wall) =
