@@ -432,6 +432,8 @@ impl Viewport {
         // SAFETY: recording; earlier frames' and the staging ring's writes (same queue,
         // earlier in submission order) come before this frame's reads and writes.
         unsafe { after_earlier_passes(&ctx, frame.cmd) };
+        // Reprojection averages a moving camera's frames: they must be independent samples.
+        live.set_fresh_restarts(req.denoise && req.reproject);
         let (added, restarted) = if hold {
             (0, false)
         } else {
@@ -488,13 +490,16 @@ impl Viewport {
                 if !only_camera || !req.reproject {
                     t.invalidate();
                 }
-                let source = match d.first_surfaces().filter(|_| added > 0 && req.reproject) {
-                    Some(surfaces) => t.record(
+                let inputs = d.first_surfaces().zip(d.guides_and_moments());
+                let source = match inputs.filter(|_| added > 0 && req.reproject) {
+                    Some((surfaces, (guides, moments))) => t.record(
                         &ctx,
                         frame.cmd,
                         &mut slot.sets,
                         live.accumulation(),
                         surfaces,
+                        guides,
+                        moments,
                         base.camera(),
                         internal,
                         live.samples(),

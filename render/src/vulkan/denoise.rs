@@ -230,6 +230,14 @@ impl Denoiser {
         Ok(())
     }
 
+    /// The guides and the moments of the current size, if buffers exist (temporal
+    /// reprojection reads the first and writes the second).
+    pub fn guides_and_moments(&self) -> Option<(Binding, Binding)> {
+        self.buffers
+            .as_ref()
+            .map(|b| (b.guides.binding(), b.moments.binding()))
+    }
+
     /// The first surfaces of the current size (one vec4 per pixel: point, 8 · kind + face or
     /// −1), if buffers exist.
     pub fn first_surfaces(&self) -> Option<Binding> {

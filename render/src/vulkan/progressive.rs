@@ -50,6 +50,12 @@ pub struct Progressive {
     window: Window,
     /// Some batch was recorded into the buffer (it holds an image to display).
     traced: bool,
+    /// Accumulations started after the first, counted while `fresh_restarts` is on: each then
+    /// takes fresh scrambles, so a moving camera's frames are independent samples, which
+    /// temporal reprojection averages. Off, every restart repeats the job's numbers (the
+    /// same samples as a one-shot render of the job: tests compare them).
+    epoch: u32,
+    fresh_restarts: bool,
 }
 
 impl Progressive {
@@ -87,6 +93,8 @@ impl Progressive {
             seed,
             window: Window::whole(internal),
             traced: false,
+            epoch: 0,
+            fresh_restarts: false,
         })
     }
 
@@ -115,6 +123,11 @@ impl Progressive {
     /// keeps the old samples until the next batch overwrites them).
     pub fn has_image(&self) -> bool {
         self.traced
+    }
+
+    /// Whether restarts take fresh random numbers (see `epoch`).
+    pub fn set_fresh_restarts(&mut self, on: bool) {
+        self.fresh_restarts = on;
     }
 
     /// Drops the accumulated samples; the next frame starts over.
@@ -282,7 +295,13 @@ impl Progressive {
             tracer.samples_per_dispatch_for(pixels, variant),
             tracer.sample_slices(pixels),
         );
-        let p = base.batch(per, self.samples, self.samples > 0);
+        if restarted && self.traced && self.fresh_restarts {
+            self.epoch = self.epoch.wrapping_add(1);
+        }
+        let epoch = if self.fresh_restarts { self.epoch } else { 0 };
+        let p = base
+            .batch(per, self.samples, self.samples > 0)
+            .reseeded(epoch);
         self.traced = true;
         tracer.record(
             ctx,

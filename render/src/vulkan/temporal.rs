@@ -53,7 +53,7 @@ impl Kept {
         ctx.limits.check_image("the temporal history", size, 32)?;
         let pixels = size.0 as u64 * size.1 as u64;
         let make = |name, bytes| HostBuffer::new(ctx, name, bytes, MemoryLocation::GpuOnly);
-        let history = make("temporal history", pixels * 16)?;
+        let history = make("temporal history", pixels * 32)?;
         match make("temporal first surfaces", pixels * 16) {
             Ok(surfaces) => Ok(Self {
                 pixels,
@@ -92,7 +92,7 @@ impl Temporal {
     /// Builds the pipeline (buffers come with the first frame).
     pub fn new(ctx: &GpuContext) -> Result<Self, GpuError> {
         Ok(Self {
-            pass: ComputePass::new(ctx, TEMPORAL, 5, std::mem::size_of::<Push>() as u32)?,
+            pass: ComputePass::new(ctx, TEMPORAL, 7, std::mem::size_of::<Push>() as u32)?,
             last: None,
             valid: false,
             spare: None,
@@ -162,6 +162,8 @@ impl Temporal {
         sets: &mut SetCache,
         accum: Binding,
         surfaces: Binding,
+        guides: Binding,
+        moments: Binding,
         camera: [[f32; 4]; 4],
         size: (u32, u32),
         samples: u32,
@@ -204,6 +206,8 @@ impl Temporal {
                     prev_surfaces,
                     prev_history,
                     out.history.binding(),
+                    guides,
+                    moments,
                 ],
             )?;
             let push = Push {
@@ -251,6 +255,8 @@ impl Temporal {
                 last.surfaces.binding(),
                 last.history.binding(),
                 out,
+                guides,
+                moments,
             ],
         )?;
         let push = Push {

@@ -173,6 +173,19 @@ impl TraceParams {
         self
     }
 
+    /// The same parameters with the seed of accumulation number `epoch` of a session (0: the
+    /// job's own seed, unchanged): each epoch's numbers are independent of the others'.
+    pub fn reseeded(mut self, epoch: u32) -> Self {
+        if epoch > 0 {
+            let mut x = epoch.wrapping_mul(0x9e37_79b9) ^ 0x85eb_ca6b;
+            x ^= x >> 16;
+            x = x.wrapping_mul(0x7feb_352d);
+            x ^= x >> 15;
+            self.seed[0] ^= x;
+        }
+        self
+    }
+
     /// The same parameters with camera hits outside `dim`'s box weighted by its factor (read
     /// by [`Variant::dim`] variants only).
     pub fn dimmed(mut self, dim: Option<Dim>) -> Self {
