@@ -212,10 +212,10 @@ fn moving_frames_reuse_the_previous_frames_and_a_stop_hands_over_to_the_accumula
         let input = vp.live_filter_input().unwrap();
         (e(&shown), e(&raw), input.map(|i| e(&i)))
     };
-    let frame = |vp: &mut Viewport, params: &render::SceneParams, reproject: bool| {
+    let sized = |vp: &mut Viewport, params: &render::SceneParams, reproject: bool, internal| {
         let req = FrameRequest {
             params,
-            internal: size,
+            internal,
             output: size,
             spp: 1,
             target_spp: 64,
@@ -227,6 +227,9 @@ fn moving_frames_reuse_the_previous_frames_and_a_stop_hands_over_to_the_accumula
             grid: None,
         };
         vp.draw(&world, &req).unwrap();
+    };
+    let frame = |vp: &mut Viewport, params: &render::SceneParams, reproject: bool| {
+        sized(vp, params, reproject, size)
     };
     let orbit = |vp: &mut Viewport, params: &mut render::SceneParams, reproject: bool| {
         for k in 0..=12 {
@@ -262,6 +265,24 @@ fn moving_frames_reuse_the_previous_frames_and_a_stop_hands_over_to_the_accumula
     }
     assert_eq!(vp.samples(), 17);
     assert!(vp.live_filter_input().unwrap().is_none());
+    // Moving at half the size (the editor's moving scale), stopping at the full size: the
+    // history crosses the sizes (the first full-size frame reprojects it).
+    let mut stops = [0.0; 2];
+    for (i, reproject) in [false, true].into_iter().enumerate() {
+        for k in 0..=12 {
+            params.camera = at(10.0 + 0.4 * k as f64);
+            sized(&mut vp, &params, reproject, (size.0 / 2, size.1 / 2));
+        }
+        frame(&mut vp, &params, reproject);
+        assert_eq!(vp.samples(), 1, "a new size restarts");
+        assert_eq!(vp.live_filter_input().unwrap().is_some(), reproject);
+        stops[i] = errors(&mut vp, &params).0;
+    }
+    eprintln!(
+        "stopped after moving at half size: {:.4} without, {:.4} with",
+        stops[0], stops[1]
+    );
+    assert!(stops[1] < 0.8 * stops[0], "{stops:?}");
     // An edit is no camera move: its first frame has no history.
     world
         .apply(brickmap::EditOp::Voxels(vec![brickmap::VoxelEdit {

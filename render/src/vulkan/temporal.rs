@@ -86,6 +86,11 @@ pub struct Temporal {
     spare: Option<Kept>,
     /// A stopped camera's display source (radiance sum and count per pixel).
     still: Option<HostBuffer>,
+    /// A history too small for the current size, read once more and then retired (freed in
+    /// the next safe frame).
+    retired: Option<Kept>,
+    /// This frame's `last` is too small to be written next: retire it after the frame.
+    replace_last: bool,
 }
 
 impl Temporal {
@@ -97,6 +102,8 @@ impl Temporal {
             valid: false,
             spare: None,
             still: None,
+            retired: None,
+            replace_last: false,
         })
     }
 
@@ -105,11 +112,14 @@ impl Temporal {
         self.valid = false;
     }
 
-    /// Buffers large enough for `size` (what a frame of that size writes: both histories when
-    /// `moving`, else the handover buffer). Buffers only grow, and only in `safe` frames —
-    /// ones that waited for the GPU and dropped their descriptor sets (the viewport's first
-    /// frame at a new internal size) — so nothing in flight or cached uses what is freed.
-    /// False when a buffer is too small and the frame is not safe (the pass is skipped).
+    /// Buffers large enough for `size`: what a frame of that size writes (the next history
+    /// when `moving`) and what any later frame of that size writes (the handover buffer, so a
+    /// stop never has to grow it). A history kept for reading that is too small to be written
+    /// next time is retired after this frame and a new one takes its turn. Buffers are freed
+    /// only in `safe` frames — ones that waited for the GPU and dropped their descriptor sets
+    /// (the viewport's first frame at a new internal size) — so nothing in flight or cached
+    /// uses them: the retired history waits for the next safe frame. Returns false when a
+    /// buffer is too small and could only be replaced by freeing one in an unsafe frame.
     fn ensure(
         &mut self,
         ctx: &GpuContext,
@@ -118,24 +128,26 @@ impl Temporal {
         safe: bool,
     ) -> Result<bool, GpuError> {
         let pixels = size.0 as u64 * size.1 as u64;
-        if moving {
-            let small = |k: &Option<Kept>| k.as_ref().is_none_or(|k| k.pixels < pixels);
-            if small(&self.last) || small(&self.spare) {
-                if !safe && (self.last.is_some() || self.spare.is_some()) {
-                    return Ok(false);
-                }
-                // Both grow together (the history is lost), so the next frame's buffer fits.
-                for k in [self.last.take(), self.spare.take()].into_iter().flatten() {
-                    k.destroy(ctx);
-                }
-                self.valid = false;
-                self.spare = Some(Kept::new(ctx, size)?);
-                self.last = Some(Kept::new(ctx, size)?);
+        let small_spare = moving && self.spare.as_ref().is_none_or(|k| k.pixels < pixels);
+        let small_last = moving && self.last.as_ref().is_some_and(|k| k.pixels < pixels);
+        let small_still = self.still.as_ref().is_none_or(|b| b.size < pixels * 16);
+        let frees = (small_spare && self.spare.is_some())
+            || small_last
+            || (small_still && self.still.is_some());
+        if frees && !safe {
+            return Ok(false);
+        }
+        if safe && let Some(r) = self.retired.take() {
+            r.destroy(ctx);
+        }
+        if small_spare {
+            if let Some(old) = self.spare.take() {
+                old.destroy(ctx);
             }
-        } else if self.still.as_ref().is_none_or(|b| b.size < pixels * 16) {
-            if !safe && self.still.is_some() {
-                return Ok(false);
-            }
+            self.spare = Some(Kept::new(ctx, size)?);
+        }
+        self.replace_last = small_last;
+        if small_still {
             if let Some(old) = self.still.take() {
                 old.destroy(ctx);
             }
@@ -241,6 +253,11 @@ impl Temporal {
             out.size = size;
             let shown = out.history.binding();
             self.spare = self.last.replace(out);
+            if std::mem::take(&mut self.replace_last) {
+                // (A safe frame: the retired slot was emptied by `ensure`.)
+                self.retired = self.spare.take();
+                self.spare = Some(Kept::new(ctx, size)?);
+            }
             self.valid = true;
             return Ok(Some(shown));
         }
@@ -276,7 +293,7 @@ impl Temporal {
 
     /// Frees everything (no submission may still use it).
     pub fn destroy(self, ctx: &GpuContext) {
-        for k in [self.last, self.spare].into_iter().flatten() {
+        for k in [self.last, self.spare, self.retired].into_iter().flatten() {
             k.destroy(ctx);
         }
         if let Some(b) = self.still {
