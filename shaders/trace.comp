@@ -301,10 +301,6 @@ float shadow_t;
 vec3 shadow_l;
 uint shadow_slot;
 
-void next_shadow() {
-    shadow_pending = false;
-}
-
 void add_shadow(vec3 d, float t, vec3 l, uint light_slot) {
     shadow_pending = true;
     shadow_d = d;
@@ -595,19 +591,18 @@ void main() {
                     hit = voxel != target;
                 }
                 if (!hit) pixel_sum += shadow_l;
-                next_shadow();
+                shadow_pending = false;
             } else {
                 path_alive = scatter(hit, voxel, normal, t);
             }
             if (SHADOW_QUEUE) {
-                // The shadow rays made by this vertex go to the queue (one, then the second);
-                // the subgroup reserves its slots with one atomic each time. A ray that does
-                // not fit stays pending and is traced here.
-                for (int k = 0; k < 1; k++) {
-                    bool want = shadow_pending;
-                    uvec4 ballot = subgroupBallot(want);
-                    uint n = subgroupBallotBitCount(ballot);
-                    if (n == 0u) break;
+                // The shadow ray made by this vertex goes to the queue; the subgroup reserves
+                // its slots with one atomic. A ray that does not fit stays pending and is
+                // traced here.
+                bool want = shadow_pending;
+                uvec4 ballot = subgroupBallot(want);
+                uint n = subgroupBallotBitCount(ballot);
+                if (n > 0u) {
                     uint base = 0u;
                     if (subgroupElect()) {
                         base = atomicAdd(queue_count, n);
@@ -616,7 +611,7 @@ void main() {
                     base = subgroupBroadcastFirst(base);
                     uint slot = base + subgroupBallotExclusiveBitCount(ballot);
                     if (want && push_shadow_ray(slot, path_o, path_start, shadow_d, shadow_t, shadow_l, shadow_slot, index)) {
-                        next_shadow();
+                        shadow_pending = false;
                         if (COUNT_RAYS) g_rays[2]++;
                     }
                 }
