@@ -21,7 +21,7 @@ layout(constant_id = 2) const bool LIGHTS = false;
 // The trace pass's bindings: only the grid size (Params.grid) is read here.
 layout(std430, set = 0, binding = 5) readonly buffer ParamBuffer { vec4 params[14]; };
 layout(std430, set = 0, binding = 6) buffer Accum { vec4 accum[]; };
-layout(std430, set = 0, binding = 7) buffer Counters { uint counters[9]; };
+layout(std430, set = 0, binding = 7) buffer Counters { uint counters[11]; };
 #include "shadow_queue.glsl"
 #include "lights.glsl"
 

@@ -28,8 +28,7 @@ layout(constant_id = 7) const bool COUNT_RAYS = false;
 // Benchmark experiments (bench-gpu --experiment), 0 in every real render: bit 0 ends paths
 // at the first hit (primary rays only), bit 1 decodes colours without pow, bit 2 counts
 // every shadow ray as unblocked without tracing it, bit 3 skips light sampling (NEE), bit 4
-// makes shaders/shadow.comp skip its work, bit 13 makes Sobol numbers without caching a pair
-// (the same numbers, fewer live values), bit 6 starts a subgroup's next samples together,
+// makes shaders/shadow.comp skip its work, bit 6 starts a subgroup's next samples together,
 // bits 7..10 turn traversal skips off (brickmap.glsl SKIPS_OFF), bit 11 chooses light faces by
 // weight alone (lights.glsl LIGHTS_BY_WEIGHT), bit 12 takes its cheap cosine bounds
 // (LIGHTS_CHEAP).
@@ -73,8 +72,10 @@ layout(constant_id = 15) const bool TRANSPARENT = false;
 layout(std430, set = 0, binding = 6) buffer Accum { vec4 accum[]; };
 // COUNT_RAYS variants only: camera rays, continuation rays, shadow rays, the traversal
 // steps each kind took, then the most steps one camera or continuation ray took and one
-// shadow ray took, then the iteration caps hit (brickmap.glsl's g_capped).
-layout(std430, set = 0, binding = 7) buffer Counters { uint counters[9]; };
+// shadow ray took, then the iteration caps hit (brickmap.glsl's g_capped), then this pass's
+// traversal steps and, per traversal of a subgroup, its slowest lane's steps times the
+// subgroup's size (the lane steps the subgroup paid for: their ratio is the busy share).
+layout(std430, set = 0, binding = 7) buffer Counters { uint counters[11]; };
 #include "shadow_queue.glsl"
 #include "lights.glsl"
 uint g_rays[6];
@@ -85,13 +86,9 @@ uint hash(uint x) {
     x = ((x >> ((x >> 28u) + 4u)) ^ x) * 277803737u;
     return (x >> 22u) ^ x;
 }
-// Sobol: the sample's index in the pixel's sequence, the pixel's (and render's) scrambling
-// seed, the next dimension, and the last pair of dimensions made.
+// Sobol: the sample's index in the pixel's sequence and the next dimension.
 uint sob_index;
-uint sob_seed;
 uint sob_dim;
-uint sob_pair;
-vec2 sob_xy;
 
 // Burley 2020, "Practical Hash-based Owen Scrambling": a hash whose output bit j depends only
 // on input bits ≤ j (Laine and Karras), applied to the bit-reversed value, is a nested
@@ -138,27 +135,18 @@ float rand() {
     }
     uint d = sob_dim++;
     uint pair = d >> 1;
-    if ((EXPERIMENT & 8192u) != 0u) {
-        // Lean: nothing cached but the index and the dimension (the pixel's seed made again
-        // from its picture index, only the coordinate asked for scrambled): fewer live values.
-        uint seed = hash(p.seed.x ^ hash(picture_index(gl_GlobalInvocationID.xy) * 9781u + 0x2545f491u));
-        uint s = hash(seed ^ hash(pair * 0x9e3779b9u + 0x7f4a7c15u));
-        uint i = owen_scramble(sob_index, s);
-        uint v = (d & 1u) == 0u ? owen_scramble(bitfieldReverse(i), hash(s ^ 0xa511e9b3u))
-                                : owen_scramble(sobol_1(i), hash(s ^ 0x63d83595u));
-        return float(v >> 8) * (1.0 / 16777216.0);
-    }
-    if (pair != sob_pair) {
-        // The pair's own shuffle of the pixel's samples and its own scrambles: pairs are
-        // independent of each other, each pair's points a scrambled (0, 2)-sequence.
-        sob_pair = pair;
-        uint s = hash(sob_seed ^ hash(pair * 0x9e3779b9u + 0x7f4a7c15u));
-        uint i = owen_scramble(sob_index, s);
-        uint x = owen_scramble(bitfieldReverse(i), hash(s ^ 0xa511e9b3u));
-        uint y = owen_scramble(sobol_1(i), hash(s ^ 0x63d83595u));
-        sob_xy = vec2(float(x >> 8), float(y >> 8)) * (1.0 / 16777216.0);
-    }
-    return (d & 1u) == 0u ? sob_xy.x : sob_xy.y;
+    // Each pair of dimensions has its own shuffle of the pixel's samples and its own
+    // scrambles: pairs are independent of each other, each pair's points a scrambled
+    // (0, 2)-sequence. Nothing is cached but the index and the dimension (the pixel's seed is
+    // made again, only the coordinate asked for is scrambled): caching the seed and the
+    // pair's two numbers kept 16 more registers live through the traversal (96 against 80)
+    // and cost 5–6 % at complexities 2 and 3 on the H100.
+    uint seed = hash(p.seed.x ^ hash(picture_index(gl_GlobalInvocationID.xy) * 9781u + 0x2545f491u));
+    uint s = hash(seed ^ hash(pair * 0x9e3779b9u + 0x7f4a7c15u));
+    uint i = owen_scramble(sob_index, s);
+    uint v = (d & 1u) == 0u ? owen_scramble(bitfieldReverse(i), hash(s ^ 0xa511e9b3u))
+                            : owen_scramble(sobol_1(i), hash(s ^ 0x63d83595u));
+    return float(v >> 8) * (1.0 / 16777216.0);
 }
 
 vec3 sky(vec3 d) {
@@ -344,8 +332,6 @@ void begin_path(uvec2 px, uint s) {
     uint index = picture_index(px);
     rng = hash(p.seed.x ^ hash(index * 9781u + (p.seed.z + s) * 6271u + 1u));
     sob_index = p.seed.z + s;
-    sob_seed = hash(p.seed.x ^ hash(index * 9781u + 0x2545f491u));
-    sob_pair = 0xffffffffu;
     dims(0u);
     float jx = rand();
     camera_ray(vec2(picture_pixel(px)) + vec2(jx, rand()), path_o, path_d);
@@ -580,6 +566,14 @@ void main() {
             if (COUNT_RAYS) {
                 g_rays[kind + 3u] += g_steps;
                 atomicMax(counters[shadow ? 7 : 6], g_steps);
+                // The subgroup's most steps, bit by bit with votes (arithmetic subgroup
+                // operations are not among the ones the renderer requires).
+                uint most = 0u;
+                for (int b = 15; b >= 0; b--) {
+                    if (subgroupAny(g_steps >= (most | (1u << b)))) most |= 1u << b;
+                }
+                atomicAdd(counters[9], g_steps);
+                if (subgroupElect()) atomicAdd(counters[10], most * gl_SubgroupSize);
             }
             if (shadow) {
                 if (LIGHTS && hit && shadow_slot != NO_LIGHT) {

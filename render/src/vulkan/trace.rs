@@ -112,6 +112,9 @@ pub const MAX_SLICES: u32 = 8;
 /// Samples per invocation when a pixel's samples are split.
 pub const SLICED_SAMPLES: u32 = 4;
 
+/// Bytes of the ray counters (trace.comp's `counters`).
+const COUNTERS_BYTES: u64 = 44;
+
 /// Rays a render traced, by kind.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RayCounts {
@@ -128,6 +131,10 @@ pub struct RayCounts {
     /// Iteration caps hit in the traversal (a step budget or `cell_at`'s corrections run
     /// out); expected zero.
     pub capped: u64,
+    /// The trace pass's traversal steps (shadow rays traced by the shadow pass excluded),
+    /// and the lane steps its subgroups paid for them (per traversal, the slowest lane's
+    /// steps times the subgroup size): their ratio is the share of lanes kept busy.
+    pub lane_steps: [u64; 2],
 }
 
 impl RayCounts {
@@ -183,7 +190,12 @@ impl PathTracer {
             samples_per_dispatch: None,
             sample_slices: None,
             can_slice: ctx.shadow_queue,
-            counters: HostBuffer::new(ctx, "ray counters", 36, MemoryLocation::GpuToCpu)?,
+            counters: HostBuffer::new(
+                ctx,
+                "ray counters",
+                COUNTERS_BYTES,
+                MemoryLocation::GpuToCpu,
+            )?,
         })
     }
 
@@ -549,12 +561,13 @@ impl PathTracer {
 
     /// Zeroes the ray counters (before a counted render).
     pub(crate) fn reset_counters(&mut self) {
-        self.counters.write(&[0; 36]);
+        self.counters.write(&[0; COUNTERS_BYTES as usize]);
     }
 
     /// The ray counters after a counted render.
     pub(crate) fn read_counters(&self) -> RayCounts {
-        let c: [u32; 9] = bytemuck::pod_read_unaligned(&self.counters.read()[..36]);
+        let c: [u32; 11] =
+            bytemuck::pod_read_unaligned(&self.counters.read()[..COUNTERS_BYTES as usize]);
         RayCounts {
             primary: c[0] as u64,
             secondary: c[1] as u64,
@@ -562,6 +575,7 @@ impl PathTracer {
             steps: [c[3] as u64, c[4] as u64, c[5] as u64],
             max_steps: [c[6] as u64, c[7] as u64],
             capped: c[8] as u64,
+            lane_steps: [c[9] as u64, c[10] as u64],
         }
     }
 

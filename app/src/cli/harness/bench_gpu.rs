@@ -194,7 +194,8 @@ pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
         text += &format!(
             "{label}: median {:.3} ms (p10 {:.3}, p90 {:.3}, {} frames); everything variant {:.3} ms ({:+.1}%)\n  \
              rays: {:.1} M primary, {:.1} M secondary, {:.1} M shadow; {:.0} Mrays/s primary, {:.0} Mrays/s secondary+shadow, {:.0} Mrays/s all\n  \
-             traversal steps per ray: {:.1} primary, {:.1} secondary, {:.1} shadow; most in one ray: {} camera or continuation, {} shadow\n",
+             traversal steps per ray: {:.1} primary, {:.1} secondary, {:.1} shadow; most in one ray: {} camera or continuation, {} shadow\n  \
+             lanes busy in the trace pass's traversals: {:.1} % ({:.1} M lane steps paid for {:.1} M taken)\n",
             median * 1e3,
             p10 * 1e3,
             p90 * 1e3,
@@ -212,6 +213,9 @@ pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
             rays.steps[2] as f64 / rays.shadow.max(1) as f64,
             rays.max_steps[0],
             rays.max_steps[1],
+            rays.lane_steps[0] as f64 / rays.lane_steps[1].max(1) as f64 * 100.0,
+            rays.lane_steps[1] as f64 / 1e6,
+            rays.lane_steps[0] as f64 / 1e6,
         );
     }
     if let Some(e) = failure {
