@@ -545,6 +545,15 @@ mod trace {
         assert_eq!(ctx.validation_errors(), 0);
     }
 
+    /// The rays and their steps, without the lane steps a subgroup paid (they follow which
+    /// rays share a subgroup).
+    fn traced(r: render::vulkan::trace::RayCounts) -> render::vulkan::trace::RayCounts {
+        render::vulkan::trace::RayCounts {
+            lane_steps: [0; 2],
+            ..r
+        }
+    }
+
     /// Two renders of the same samples, summed in another order: equal up to f32 rounding.
     fn assert_same_up_to_rounding(a: &Image, b: &Image, what: &str) {
         for (x, y) in a.pixels.iter().zip(&b.pixels) {
@@ -606,7 +615,7 @@ mod trace {
         };
         let (whole, rays) = render(4, 1);
         let (sliced, sliced_rays) = render(2, 3);
-        assert_eq!(sliced_rays, rays);
+        assert_eq!(traced(sliced_rays), traced(rays));
         assert!(rays.primary == 24 * 16 * 13, "{rays:?}");
         assert_same_up_to_rounding(&sliced, &whole, "sliced");
         // Without a fixed split, a small image is split (the GPU would be mostly idle).
@@ -652,7 +661,7 @@ mod trace {
         assert!(rays.shadow > 300, "{rays:?}");
         for limit in [u64::MAX, 100] {
             let (queued, queued_rays) = render(true, limit);
-            assert_eq!(queued_rays, rays, "queue limit {limit}");
+            assert_eq!(traced(queued_rays), traced(rays), "queue limit {limit}");
             assert_same_up_to_rounding(&queued, &in_place, &format!("queue limit {limit}"));
         }
         tracer.destroy(&ctx);
