@@ -4,7 +4,7 @@
 // plane, normal, material kind and albedo (shaders/guides.comp). Its luminance weight uses the
 // variance of each pixel's mean, estimated from the accumulation's batches (each frame adds
 // one), so the filter narrows as samples accumulate, and the last step gives way to the raw
-// mean between FADE_FROM and FADE_TO samples.
+// mean between pc.fade_from and pc.fade_to samples.
 // Modes (one pass each, `pc.mode`):
 //   0 moments: after a batch, the batch's luminance sum S and size k update the pixel's
 //     moments (previous luminance sum, previous count, Σ S²/k, batches);
@@ -23,7 +23,9 @@ layout(std430, set = 0, binding = 4) writeonly buffer Dst { vec4 dst[]; };
 // flags: bit 0 this batch restarted the accumulation (moments), bit 1 the last step, bit 2
 // the source is a moving camera's temporal history (shaders/temporal.comp): its count is
 // frames blended, not unbiased samples, so the last step does not fade to it.
-layout(push_constant) uniform Push { uvec2 size; uint mode; uint step; uint flags; } pc;
+// fade_from, fade_to: the sample counts between which the last step gives way to the raw mean
+// (linear in log2 of the count; render/src/vulkan/denoise.rs `Fade`); fade_to 0: never.
+layout(push_constant) uniform Push { uvec2 size; uint mode; uint step; uint flags; float fade_from; float fade_to; } pc;
 
 // Luminance edge-stopping: differences are measured in standard deviations of the mean
 // (SVGF's σ_l = 4); albedo differences (L1, linear) stop at about SIGMA_ALBEDO.
@@ -31,11 +33,6 @@ const float SIGMA_LUMINANCE = 4.0;
 const float SIGMA_ALBEDO = 0.25;
 // Batches before the per-pixel variance is trusted; until then the 3 × 3 spatial variance.
 const float MIN_BATCHES = 4.0;
-// The filtered image gives way to the raw mean between these sample counts (linear in
-// log2 spp): measured on the H200 (BENCHMARKS.md), the filter's bias outweighs the noise it
-// removes beyond 16–64 spp; a converged viewport shows the unbiased image.
-const float FADE_FROM = 8.0;
-const float FADE_TO = 64.0;
 
 float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
 
@@ -166,8 +163,9 @@ void filter_step(ivec2 px, uint i) {
     }
     vec3 result = sum / wsum;
     if (last) {
-        float raw = (pc.flags & 4u) != 0u ? 0.0
-            : clamp(log2(max(accum[i].w, 1.0) / FADE_FROM) / log2(FADE_TO / FADE_FROM), 0.0, 1.0);
+        // The raw mean's share: a converged viewport shows the unbiased image.
+        float raw = (pc.flags & 4u) != 0u || pc.fade_to <= 0.0 ? 0.0
+            : clamp(log2(max(accum[i].w, 1.0) / pc.fade_from) / log2(pc.fade_to / pc.fade_from), 0.0, 1.0);
         dst[i] = vec4(mix(result, demodulated(i), raw) * albedo, 1.0);
     } else {
         dst[i] = vec4(result, vsum / (wsum * wsum));

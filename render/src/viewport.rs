@@ -14,7 +14,7 @@ use crate::image::Image;
 use crate::params::SceneParams;
 use crate::vulkan::barrier::{Scope, after_earlier_passes, barrier, between_passes};
 use crate::vulkan::buffer::{Binding, HostBuffer, read_device};
-use crate::vulkan::denoise::Denoiser;
+use crate::vulkan::denoise::{Denoiser, Fade};
 use crate::vulkan::frame::{FRAMES_IN_FLIGHT, FrameSlot};
 use crate::vulkan::pass::{SetCache, run_batch};
 use crate::vulkan::primary::{GpuHit, PrimaryTracer};
@@ -109,6 +109,8 @@ pub struct Viewport {
     held: u32,
     /// The edge-aware denoiser (made when first asked for).
     denoiser: Option<Denoiser>,
+    /// The denoiser's fade to the raw mean when not the picture size's (benchmarks).
+    fade: Option<Fade>,
     /// Its temporal reprojection while the camera moves (made with it).
     temporal: Option<Temporal>,
     /// The last frame's `TraceParams::scene_key` and variant: when a restart keeps it, only
@@ -179,6 +181,7 @@ impl Viewport {
             last_gpu_seconds: None,
             held: 0,
             denoiser: None,
+            fade: None,
             temporal: None,
             scene_key: None,
             filter_input: None,
@@ -457,6 +460,7 @@ impl Viewport {
                 self.denoiser = Some(Denoiser::new(&ctx)?);
             }
             let d = self.denoiser.as_mut().expect("made above");
+            d.set_fade(self.fade.unwrap_or(Fade::for_picture(internal)));
             if !d.has_size(internal) {
                 // The other slot may still read the old size's buffers.
                 for s in &self.frames {

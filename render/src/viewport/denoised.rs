@@ -20,6 +20,13 @@ pub struct DenoisedRender {
 }
 
 impl Viewport {
+    /// The denoiser's fade to the raw mean: `None` for the picture size's
+    /// ([`Fade::for_picture`]), else this one (benchmarks: [`Fade::NEVER`] measures the
+    /// filter's bias).
+    pub fn set_denoise_fade(&mut self, fade: Option<Fade>) {
+        self.fade = fade;
+    }
+
     /// Renders `job` with `variant` as the viewport does with its denoiser on, one batch per
     /// dispatch (the tracer's batch shape), and waits; the filter is timed over `timed`
     /// repetitions (0: not timed).
@@ -79,6 +86,7 @@ impl Viewport {
         };
         let denoiser = self.denoiser.as_mut().expect("made above");
         denoiser.invalidate();
+        denoiser.set_fade(self.fade.unwrap_or(Fade::for_picture(window.picture)));
         let world = &*self.world;
         let result = acc
             .accumulate_with(

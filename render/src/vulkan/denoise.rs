@@ -31,8 +31,33 @@ struct Push {
     mode: u32,
     step: u32,
     flags: u32,
+    fade: [f32; 2],
 }
-const _: () = assert!(std::mem::size_of::<Push>() == 20);
+const _: () = assert!(std::mem::size_of::<Push>() == 28);
+
+/// The sample counts between which the filtered image gives way to the raw mean (linear in
+/// log₂ of the count): the filter's bias outweighs the noise it removes beyond them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fade {
+    /// Samples where the raw mean starts to show.
+    pub from: f32,
+    /// Samples from which only the raw mean shows.
+    pub to: f32,
+}
+
+impl Fade {
+    /// The filter at every sample count (benchmarks: its bias measured).
+    pub const NEVER: Fade = Fade { from: 0.0, to: 0.0 };
+
+    /// The fade for a picture of `size` pixels.
+    pub fn for_picture(size: (u32, u32)) -> Fade {
+        let _ = size;
+        Fade {
+            from: 8.0,
+            to: 64.0,
+        }
+    }
+}
 
 const MOMENTS: u32 = 0;
 const PREPARE: u32 = 1;
@@ -135,6 +160,8 @@ pub struct Denoiser {
     filtered: bool,
     /// The next filter reads a moving camera's temporal history (no fade to the raw mean).
     temporal_input: bool,
+    /// The fade to the raw mean of the next filters.
+    fade: Fade,
 }
 
 impl Denoiser {
@@ -155,7 +182,13 @@ impl Denoiser {
             current: false,
             filtered: false,
             temporal_input: false,
+            fade: Fade::for_picture((0, 0)),
         })
+    }
+
+    /// The fade to the raw mean of the next filters.
+    pub fn set_fade(&mut self, fade: Fade) {
+        self.fade = fade;
     }
 
     /// Forgets the guides and moments: the next [`Denoiser::record_batch`] starts them over
@@ -221,6 +254,7 @@ impl Denoiser {
             mode: MOMENTS,
             step: 0,
             flags: if fresh { RESTART } else { 0 },
+            fade: [self.fade.from, self.fade.to],
         };
         self.record_filter_pass(ctx, cmd, set, push);
         // SAFETY: recording.
@@ -313,6 +347,7 @@ impl Denoiser {
             mode,
             step,
             flags,
+            fade: [self.fade.from, self.fade.to],
         };
         // Prepare writes ping; the steps alternate ping → pong → ping …, ending in pong.
         self.record_filter_pass(ctx, cmd, sets.to_ping, push(PREPARE, 0, 0));

@@ -26,6 +26,7 @@ use render::Sequence;
 use render::convergence::{log_log_fit, reference_noise, rel_mse, time_at_error};
 use render::cpu::RenderJob;
 use render::viewport::{RenderHow, Viewport};
+use render::vulkan::denoise::Fade;
 use render::vulkan::trace::Variant;
 use render::{Image, SceneParams};
 use serde::Serialize;
@@ -60,6 +61,11 @@ pub(crate) struct BenchError {
     /// Presets (complexity-1, complexity-2, complexity-3, physical, lamps; default all).
     #[arg(long, value_delimiter = ',')]
     presets: Vec<String>,
+    /// Choices besides the defaults (per-dispatch-1, per-dispatch-16, slices-1, slices-2,
+    /// in-place-shadows, no-light-sampling, independent, denoised, denoised-no-fade;
+    /// default all).
+    #[arg(long, value_delimiter = ',')]
+    choices: Vec<String>,
     /// Folder for the report.
     #[arg(long, default_value = "error-report")]
     out: PathBuf,
@@ -83,6 +89,8 @@ pub(crate) enum Choice {
     /// The defaults' samples shown through the viewport's denoiser (biased: its error is
     /// measured, not checked against 1/spp).
     Denoised,
+    /// The same without its fade to the raw mean (the filter's bias at every count).
+    DenoisedUnfaded,
 }
 
 impl Choice {
@@ -97,12 +105,32 @@ impl Choice {
             Choice::NoLightSampling => "no light sampling".into(),
             Choice::Independent => "independent numbers".into(),
             Choice::Denoised => "denoised (viewport)".into(),
+            Choice::DenoisedUnfaded => "denoised, no fade".into(),
         }
+    }
+
+    /// The choice's name on the command line (`--choices`).
+    fn key(self) -> String {
+        match self {
+            Choice::Default => "defaults".into(),
+            Choice::SamplesPerDispatch(n) => format!("per-dispatch-{n}"),
+            Choice::Slices(n) => format!("slices-{n}"),
+            Choice::InPlaceShadows => "in-place-shadows".into(),
+            Choice::NoLightSampling => "no-light-sampling".into(),
+            Choice::Independent => "independent".into(),
+            Choice::Denoised => "denoised".into(),
+            Choice::DenoisedUnfaded => "denoised-no-fade".into(),
+        }
+    }
+
+    /// Whether the image is shown through the denoiser.
+    fn denoised(self) -> bool {
+        matches!(self, Choice::Denoised | Choice::DenoisedUnfaded)
     }
 
     /// Whether the estimator is biased (consistent at best): its curve is not checked.
     fn biased(self) -> bool {
-        self == Choice::Denoised
+        self.denoised()
     }
 
     /// Whether the choice changes the estimator (else only how the same samples are
@@ -110,7 +138,11 @@ impl Choice {
     fn changes_estimator(self) -> bool {
         matches!(
             self,
-            Choice::Default | Choice::NoLightSampling | Choice::Independent | Choice::Denoised
+            Choice::Default
+                | Choice::NoLightSampling
+                | Choice::Independent
+                | Choice::Denoised
+                | Choice::DenoisedUnfaded
         )
     }
 
@@ -119,7 +151,8 @@ impl Choice {
         let queue = session.ctx().shadow_queue;
         let tracer = session.tracer();
         match self {
-            Choice::Default | Choice::Independent | Choice::Denoised => true,
+            Choice::Default | Choice::Independent => true,
+            Choice::Denoised | Choice::DenoisedUnfaded => true,
             Choice::SamplesPerDispatch(n) => tracer.samples_per_dispatch_for(pixels, variant) != n,
             Choice::Slices(n) => queue && timed_slices(tracer, variant, pixels) != n,
             Choice::InPlaceShadows => tracer.deferred_shadows() && (variant.sun || variant.lights),
@@ -139,7 +172,7 @@ impl Choice {
             ..variant
         };
         match self {
-            Choice::Default | Choice::Denoised => {}
+            Choice::Default | Choice::Denoised | Choice::DenoisedUnfaded => {}
             Choice::SamplesPerDispatch(n) => tracer.set_samples_per_dispatch(Some(n)),
             Choice::Slices(n) => tracer.set_sample_slices(Some(n)),
             Choice::InPlaceShadows => tracer.set_deferred_shadows(&ctx, false),
@@ -166,7 +199,7 @@ fn dispatch_samples(session: &mut Viewport, variant: Variant, pixels: u64) -> u3
 }
 
 /// Every choice measured, the defaults first.
-const CHOICES: [Choice; 9] = [
+const CHOICES: [Choice; 10] = [
     Choice::Default,
     Choice::SamplesPerDispatch(1),
     Choice::SamplesPerDispatch(16),
@@ -176,6 +209,7 @@ const CHOICES: [Choice; 9] = [
     Choice::NoLightSampling,
     Choice::Independent,
     Choice::Denoised,
+    Choice::DenoisedUnfaded,
 ];
 
 /// One level of one choice: renders of `spp` samples.
@@ -516,6 +550,16 @@ fn bench_error(b: BenchError, workers: usize) -> Result<String> {
         );
     }
     let cases = cases(&b.presets)?;
+    if let Some(unknown) = b
+        .choices
+        .iter()
+        .find(|k| !CHOICES.iter().any(|c| c.key() == **k))
+    {
+        bail!(
+            "--choices: {unknown:?} is not one of {}",
+            CHOICES.map(Choice::key).join(", ")
+        );
+    }
     std::fs::create_dir_all(&b.out).with_context(|| format!("creating {}", b.out.display()))?;
     let ctx = app::gpu::context(&b.device, false)?;
     let (width, height) = b.size;
@@ -580,6 +624,9 @@ fn bench_error(b: BenchError, workers: usize) -> Result<String> {
             app::atomic::write_atomic(&file, |w| reference.write_png(w, exposure))?;
             let choices: Vec<Choice> = CHOICES
                 .into_iter()
+                .filter(|c| {
+                    *c == Choice::Default || b.choices.is_empty() || b.choices.contains(&c.key())
+                })
                 .filter(|c| c.applies(session, scene_variant, pixels))
                 .collect();
             let mut curves: Vec<Curve> = Vec::new();
@@ -587,11 +634,14 @@ fn bench_error(b: BenchError, workers: usize) -> Result<String> {
                 eprintln!("  {}", choice.name());
                 let v = choice.apply(session, scene_variant);
                 if choice.changes_estimator() {
+                    session.set_denoise_fade(
+                        (choice == Choice::DenoisedUnfaded).then_some(Fade::NEVER),
+                    );
                     let levels = measure(
                         session,
                         &view,
                         &params,
-                        (v, choice == Choice::Denoised),
+                        (v, choice.denoised()),
                         (width, height),
                         b.max_spp,
                         (&reference, &reference_srgb, noise),

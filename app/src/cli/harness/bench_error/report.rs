@@ -8,15 +8,24 @@ use super::*;
 /// What the denoiser buys at each level: the defaults' relMSE over the denoised one (> 1: the
 /// denoised image is closer to the reference), and its filter's GPU time.
 fn denoiser_table(md: &mut String, run: &CaseRun) {
-    let Some(k) = run.views[0]
-        .curves
-        .iter()
-        .position(|c| c.choice == Choice::Denoised)
-    else {
-        return;
-    };
+    for k in 0..run.views[0].curves.len() {
+        if run.views[0].curves[k].choice.denoised() {
+            denoiser_rows(md, run, k);
+        }
+    }
+}
+
+/// [`denoiser_table`] of the denoised choice `k`.
+fn denoiser_rows(md: &mut String, run: &CaseRun, k: usize) {
     let levels = &run.views[0].curves[k].levels;
-    *md += "\nDenoised (viewport): the defaults' relMSE over the denoised image's at each spp (> 1: the denoiser's bias costs less than the noise it removes), and the filter's GPU ms:\n\n";
+    *md += &format!(
+        "\nDenoised (viewport){}: the defaults' relMSE over the denoised image's at each spp (> 1: the denoiser's bias costs less than the noise it removes), and the filter's GPU ms:\n\n",
+        if run.views[0].curves[k].choice == Choice::DenoisedUnfaded {
+            ", without its fade to the raw mean"
+        } else {
+            ""
+        }
+    );
     let header: Vec<String> = std::iter::once("view".to_string())
         .chain(levels.iter().map(|l| format!("{} spp", l.spp)))
         .chain(["filter ms".to_string()])
