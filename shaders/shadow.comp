@@ -16,7 +16,6 @@ layout(constant_id = 2) const bool LIGHTS = false;
 #define MEDIUM_POSSIBLE false
 #define COUNT_STEPS COUNT_RAYS
 #define SKIPS_OFF ((EXPERIMENT >> 7) & 15u)
-#define PARALLEL_LOADS ((EXPERIMENT & 8192u) != 0u)
 #include "brickmap.glsl"
 
 // The trace pass's bindings: only the grid size (Params.grid) is read here.

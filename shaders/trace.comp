@@ -31,8 +31,7 @@ layout(constant_id = 7) const bool COUNT_RAYS = false;
 // makes shaders/shadow.comp skip its work, bit 6 starts a subgroup's next samples together,
 // bits 7..10 turn traversal skips off (brickmap.glsl SKIPS_OFF), bit 11 chooses light faces by
 // weight alone (lights.glsl LIGHTS_BY_WEIGHT), bit 12 takes its cheap cosine bounds
-// (LIGHTS_CHEAP), bit 13 loads a cell's brick-index word with its coarse bit (brickmap.glsl
-// PARALLEL_LOADS).
+// (LIGHTS_CHEAP).
 layout(constant_id = 8) const uint EXPERIMENT = 0u;
 // Shadow rays go to a queue that shaders/shadow.comp traces next, one per invocation, instead
 // of being traced here: in a warp only some lanes have a shadow ray at a vertex, and tracing
@@ -67,7 +66,6 @@ layout(constant_id = 15) const bool TRANSPARENT = false;
 #define SKIPS_OFF ((EXPERIMENT >> 7) & 15u)
 #define LIGHTS_BY_WEIGHT ((EXPERIMENT & 2048u) != 0u)
 #define LIGHTS_CHEAP ((EXPERIMENT & 4096u) != 0u)
-#define PARALLEL_LOADS ((EXPERIMENT & 8192u) != 0u)
 #include "brickmap.glsl"
 #include "scene.glsl"
 // Per pixel: the sum of its samples' radiance (rgb) and their count (a).

@@ -460,7 +460,10 @@ impl Viewport {
                 self.denoiser = Some(Denoiser::new(&ctx)?);
             }
             let d = self.denoiser.as_mut().expect("made above");
-            d.set_fade(self.fade.unwrap_or(Fade::for_picture(internal)));
+            d.set_fade(
+                self.fade
+                    .unwrap_or(Fade::for_picture(internal).ending_by(req.target_spp)),
+            );
             if !d.has_size(internal) {
                 // The other slot may still read the old size's buffers.
                 for s in &self.frames {
