@@ -604,3 +604,44 @@ fn bench_viewport_times_the_frames_with_the_denoiser_too() {
         );
     }
 }
+
+#[test]
+fn bench_gpu_times_a_scene_file_per_sample() {
+    let dir = scratch("bench-gpu-scene");
+    let file = dir.join("terrain.ron");
+    ok(&["new", "--terrain", "--size", "32x16x32", s(&file)]);
+    let Some(out) = succeeds_on_gpu(&[
+        "bench-gpu",
+        "--scene",
+        s(&file),
+        "--bounces",
+        "2",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "--frames",
+        "10",
+    ]) else {
+        return;
+    };
+    assert!(out.contains("32x18, 2 bounces"), "{out}");
+    let median: f64 = field(&out, "per sample")
+        .split_whitespace()
+        .nth(3)
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(median > 0.0, "{out}");
+    assert!(field(&out, "per sample").contains("10 dispatches"), "{out}");
+    // 576 camera rays a sample, counted.
+    assert!(field(&out, "rays").contains("0.00 M camera"), "{out}");
+    let busy: f64 = field(&out, "lanes busy")
+        .split_whitespace()
+        .nth(2)
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(busy > 0.0 && busy <= 100.0, "{out}");
+    fails(&["bench-gpu", "--scene", s(&dir.join("missing.ron"))]);
+    fails(&["bench-gpu", "--scene", s(&file), "--bounces", "99"]);
+    fails(&["bench-gpu", "--bounces", "3"]);
+}

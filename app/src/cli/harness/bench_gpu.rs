@@ -47,6 +47,13 @@ pub(crate) struct BenchGpu {
     /// With --lights: write each scene's reference image (tone mapped PNG) into this folder.
     #[arg(long, value_name = "DIR", requires = "lights")]
     images: Option<std::path::PathBuf>,
+    /// Instead of the complexities: steady-state GPU time per sample of this scene file
+    /// (.ron, .vox, .qb, .schem) at 1 spp, its own settings unless --bounces.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["convergence", "lights"])]
+    scene: Option<std::path::PathBuf>,
+    /// With --scene: the most bounces.
+    #[arg(long, requires = "scene")]
+    bounces: Option<u32>,
     /// The complexities' sample numbers: sobol (the default) or independent.
     #[arg(long, value_parser = super::args::sequence)]
     sequence: Option<render::Sequence>,
@@ -68,6 +75,8 @@ pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
         images,
         reference_spp,
         slices,
+        scene,
+        bounces,
     } = bench;
     let frames = frames.max(1);
     let convergence = convergence.then_some(reference_spp);
@@ -82,6 +91,20 @@ pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
             reference_spp,
             images.as_deref(),
             experiment,
+        )?;
+        return emit(&text);
+    }
+    if let Some(path) = scene {
+        let text = super::bench_scene::bench_scene(
+            super::bench_scene::SceneBench {
+                path: &path,
+                bounces,
+                size: (width, height),
+                frames,
+                experiment,
+            },
+            device.as_deref().unwrap_or("gpu"),
+            workers,
         )?;
         return emit(&text);
     }

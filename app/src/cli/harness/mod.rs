@@ -13,6 +13,7 @@ pub mod bench;
 pub mod bench_error;
 pub mod bench_gpu;
 pub mod bench_lights;
+pub mod bench_scene;
 pub mod bench_skips;
 pub mod bench_viewport;
 pub mod light_scenes;
