@@ -270,12 +270,15 @@ const float FAR_ORIGIN = 1024.0;
 // One entry for every ray, so a shader that calls only this has a single copy of the
 // traversal: from anywhere (the camera; finds its first cell in the grid) when `from_origin`,
 // else leaving a surface from the known `cell` at t = 0 (no epsilon offsets).
-bool trace(vec3 o, vec3 d, bool from_origin, ivec3 cell, int medium, float t_max, out ivec3 voxel, out ivec3 normal, out float t_hit) {
+// From the origin the walk may start later, at `t_min`, when the caller knows no voxel lies
+// before it (trace.comp's camera rays: their tile's march through the coarse grid).
+bool trace(vec3 o, vec3 d, bool from_origin, float t_min, ivec3 cell, int medium, float t_max, out ivec3 voxel, out ivec3 normal, out float t_hit) {
     set_ray(o, d);
     float t = 0.0;
     if (from_origin) {
         t = entry_time(o);
         if (isinf(t) || isnan(t)) return false;
+        t = max(t, t_min);
         cell = ivec3(cell_at(0, t, false), cell_at(1, t, false), cell_at(2, t, false));
     }
     return dda(cell, t, entry_axis(cell), medium, t_max, voxel, normal, t_hit);

@@ -43,7 +43,7 @@ void main() {
         ivec3 voxel;
         ivec3 normal;
         float t;
-        if (!trace(o, d, bounce == 0, start, medium, 1.0 / 0.0, voxel, normal, t)) break;
+        if (!trace(o, d, bounce == 0, 0.0, start, medium, 1.0 / 0.0, voxel, normal, t)) break;
         travelled += t;
         vec3 n = vec3(normal);
         int here = material_at(voxel);

@@ -41,7 +41,7 @@ void main() {
     ivec3 voxel;
     ivec3 normal;
     float t;
-    bool blocked = trace(r.origin_t.xyz, r.dir_key.xyz, false, cell, AIR, r.origin_t.w, voxel, normal, t);
+    bool blocked = trace(r.origin_t.xyz, r.dir_key.xyz, false, 0.0, cell, AIR, r.origin_t.w, voxel, normal, t);
     uint light_slot = floatBitsToUint(r.light.w);
     if (LIGHTS && blocked && light_slot != NO_LIGHT) {
         // An emissive face's shadow ray may end in the light's voxel.

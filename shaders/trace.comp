@@ -31,7 +31,7 @@ layout(constant_id = 7) const bool COUNT_RAYS = false;
 // makes shaders/shadow.comp skip its work, bit 6 starts a subgroup's next samples together,
 // bits 7..10 turn traversal skips off (brickmap.glsl SKIPS_OFF), bit 11 chooses light faces by
 // weight alone (lights.glsl LIGHTS_BY_WEIGHT), bit 12 takes its cheap cosine bounds
-// (LIGHTS_CHEAP).
+// (LIGHTS_CHEAP), bit 13 starts camera rays at the camera (TILE_MARCH_OFF).
 layout(constant_id = 8) const uint EXPERIMENT = 0u;
 // Shadow rays go to a queue that shaders/shadow.comp traces next, one per invocation, instead
 // of being traced here: in a warp only some lanes have a shadow ray at a vertex, and tracing
@@ -66,6 +66,10 @@ layout(constant_id = 15) const bool TRANSPARENT = false;
 #define SKIPS_OFF ((EXPERIMENT >> 7) & 15u)
 #define LIGHTS_BY_WEIGHT ((EXPERIMENT & 2048u) != 0u)
 #define LIGHTS_CHEAP ((EXPERIMENT & 4096u) != 0u)
+// Camera rays start where their tile's frustum first meets an occupied coarse cell (off with
+// experiment bit 13, and with the coarse grid's skip off: bit 7).
+// (8320 = bits 13 and 7; one mask test: glslang miscompiles a && of two spec-constant tests.)
+#define TILE_MARCH_OFF ((EXPERIMENT & 8320u) != 0u)
 #include "brickmap.glsl"
 #include "scene.glsl"
 // Per pixel: the sum of its samples' radiance (rgb) and their count (a).
@@ -273,6 +277,7 @@ ivec3 path_start;
 int path_medium;    // material the path is inside (AIR outside dielectrics)
 float path_pdf;     // pdf the BSDF chose path_d with; < 0: delta or camera
 bool path_camera;   // the next ray is the camera ray
+float path_t_min;   // where the camera ray's walk may start (no voxel lies before it)
 float path_dim;     // DIM: the weight the camera hit gave the path
 uint path_vertex;   // index of the vertex the next ray finds (1: the camera ray's hit)
 // LIGHTS: what the vertex path_d left sampled (MIS on a hit of the sun or a light face): the
@@ -328,13 +333,90 @@ float sun_share(float sun, float faces) {
     return 0.1 + 0.8 * sun / (sun + faces);
 }
 
+// The depth (along the camera's forward axis, in units of its unnormalized film directions)
+// before which no ray of this workgroup's tile meets an occupied coarse cell: the subgroup's
+// lanes test consecutive slabs of the tile's frustum at once, each the box of its eight
+// corners (a film direction is affine in the film position and a point linear in the depth,
+// so the box holds every ray of the tile within the slab), widened by a voxel. Perspective
+// cameras only (0 otherwise). The same for every lane of the subgroup.
+const float SLAB = 32.0;
+const int SLAB_ROUNDS = 4;
+const int SLAB_CELLS = 64; // coarse cells a lane tests at most (more: taken as occupied)
+
+vec3 film_direction(vec2 f) {
+    float u = 2.0 * f.x / float(p.window.z) - 1.0;
+    float v = 1.0 - 2.0 * f.y / float(p.window.w);
+    return p.cam_forward.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v;
+}
+
+uint ballot_word(uvec4 m, uint w) { return w == 0u ? m.x : (w == 1u ? m.y : (w == 2u ? m.z : m.w)); }
+
+// Set bits of `m` below lane `lane`.
+uint bits_below(uvec4 m, uint lane) {
+    uint c = 0u;
+    for (uint w = 0u; w < 4u; w++) {
+        uint lo = 32u * w;
+        if (lane >= lo + 32u) c += uint(bitCount(ballot_word(m, w)));
+        else if (lane > lo) c += uint(bitCount(ballot_word(m, w) & ((1u << (lane - lo)) - 1u)));
+    }
+    return c;
+}
+
+float tile_start() {
+    if (TILE_MARCH_OFF || p.cam_pos.w > 0.5) return 0.0;
+    vec2 f0 = vec2(picture_pixel(gl_WorkGroupID.xy * gl_WorkGroupSize.xy));
+    vec2 f1 = f0 + vec2(gl_WorkGroupSize.xy);
+    vec3 c0 = film_direction(f0);
+    vec3 c1 = film_direction(vec2(f1.x, f0.y));
+    vec3 c2 = film_direction(vec2(f0.x, f1.y));
+    vec3 c3 = film_direction(f1);
+    vec3 dlo = min(min(c0, c1), min(c2, c3));
+    vec3 dhi = max(max(c0, c1), max(c2, c3));
+    uvec4 lanes = subgroupBallot(true);
+    uint n = subgroupBallotBitCount(lanes);
+    uint rank = subgroupBallotExclusiveBitCount(lanes);
+    ivec3 last = ivec3((g_dims + 3u) / 4u) - 1;
+    vec3 size = vec3(g_dims * 8u);
+    vec3 o = p.cam_pos.xyz;
+    for (int round = 0; round < SLAB_ROUNDS; round++) {
+        float s0 = float(uint(round) * n + rank) * SLAB;
+        float s1 = s0 + SLAB;
+        vec3 lo = clamp(o + min(s0 * dlo, s1 * dlo) - 1.0, vec3(-64.0), size + 64.0);
+        vec3 hi = clamp(o + max(s0 * dhi, s1 * dhi) + 1.0, vec3(-64.0), size + 64.0);
+        ivec3 a = max(ivec3(floor(lo)) >> 5, ivec3(0));
+        ivec3 b = min(ivec3(floor(hi)) >> 5, last);
+        bool occupied = false;
+        if (all(lessThanEqual(a, b))) {
+            ivec3 e = b - a + 1;
+            if (e.x * e.y * e.z > SLAB_CELLS) {
+                occupied = true;
+            } else {
+                for (int z = a.z; z <= b.z && !occupied; z++)
+                    for (int y = a.y; y <= b.y && !occupied; y++)
+                        for (int x = a.x; x <= b.x && !occupied; x++)
+                            occupied = coarse_occupied(ivec3(x, y, z));
+            }
+        }
+        uvec4 hit = subgroupBallot(occupied);
+        if (subgroupAny(occupied)) {
+            uint below = bits_below(lanes, subgroupBallotFindLSB(hit));
+            return float(uint(round) * n + below) * SLAB;
+        }
+    }
+    return float(uint(SLAB_ROUNDS) * n) * SLAB;
+}
+float g_tile_start;
+
 void begin_path(uvec2 px, uint s) {
     uint index = picture_index(px);
     rng = hash(p.seed.x ^ hash(index * 9781u + (p.seed.z + s) * 6271u + 1u));
     sob_index = p.seed.z + s;
     dims(0u);
     float jx = rand();
-    camera_ray(vec2(picture_pixel(px)) + vec2(jx, rand()), path_o, path_d);
+    vec2 f = vec2(picture_pixel(px)) + vec2(jx, rand());
+    camera_ray(f, path_o, path_d);
+    // Where the walk may start: a voxel back from the tile's start depth on this ray.
+    path_t_min = g_tile_start > 0.0 ? max(g_tile_start * length(film_direction(f)) - 1.0, 0.0) : 0.0;
     path_beta = vec3(1.0);
     path_start = ivec3(0);
     path_medium = HAS_DIELECTRIC ? camera_medium(path_o) : AIR;
@@ -544,6 +626,7 @@ void main() {
     for (int k = 0; k < 6; k++) g_rays[k] = 0u;
     g_capped = 0u;
     pixel_sum = vec3(0.0);
+    g_tile_start = tile_start();
     uint next_sample = gl_WorkGroupID.z * p.image.z; // this slice's first sample
     uint end_sample = next_sample + p.image.z;
     bool more = p.image.z > 0u; // samples left (the current path's included)
@@ -561,7 +644,7 @@ void main() {
             ivec3 voxel;
             ivec3 normal;
             float t;
-            bool hit = trace(path_o, shadow ? shadow_d : path_d, camera, path_start,
+            bool hit = trace(path_o, shadow ? shadow_d : path_d, camera, path_t_min, path_start,
                              shadow ? AIR : path_medium, shadow ? shadow_t : 1.0 / 0.0, voxel, normal, t);
             if (COUNT_RAYS) {
                 g_rays[kind + 3u] += g_steps;
