@@ -83,6 +83,10 @@ layout(std430, set = 0, binding = 7) buffer Counters { uint counters[11]; };
 #include "shadow_queue.glsl"
 #include "lights.glsl"
 uint g_rays[6];
+uint g_most;        // COUNT_RAYS: the most steps one camera or continuation ray took, one shadow ray
+uint g_most_shadow;
+uint g_taken;       // COUNT_RAYS: lane steps this lane took, and (as the subgroup's elected lane)
+uint g_paid;        // the lane steps its subgroup paid for
 
 uint rng;
 uint hash(uint x) {
@@ -624,6 +628,10 @@ void main() {
     g_words_per_column = p.grid.w;
     uint index = px.y * p.image.x + px.x;
     for (int k = 0; k < 6; k++) g_rays[k] = 0u;
+    g_most = 0u;
+    g_most_shadow = 0u;
+    g_taken = 0u;
+    g_paid = 0u;
     g_capped = 0u;
     pixel_sum = vec3(0.0);
     g_tile_start = tile_start();
@@ -648,15 +656,18 @@ void main() {
                              shadow ? AIR : path_medium, shadow ? shadow_t : 1.0 / 0.0, voxel, normal, t);
             if (COUNT_RAYS) {
                 g_rays[kind + 3u] += g_steps;
-                atomicMax(counters[shadow ? 7 : 6], g_steps);
+                // The most steps one ray took: kept per invocation, one atomic at the end (an
+                // atomic per ray on one address slowed counted renders down several times).
+                if (shadow) g_most_shadow = max(g_most_shadow, g_steps);
+                else g_most = max(g_most, g_steps);
                 // The subgroup's most steps, bit by bit with votes (arithmetic subgroup
                 // operations are not among the ones the renderer requires).
                 uint most = 0u;
                 for (int b = 15; b >= 0; b--) {
                     if (subgroupAny(g_steps >= (most | (1u << b)))) most |= 1u << b;
                 }
-                atomicAdd(counters[9], g_steps);
-                if (subgroupElect()) atomicAdd(counters[10], most * gl_SubgroupSize);
+                g_taken += g_steps;
+                if (subgroupElect()) g_paid += most * gl_SubgroupSize;
             }
             if (shadow) {
                 if (LIGHTS && hit && shadow_slot != NO_LIGHT) {
@@ -715,6 +726,10 @@ void main() {
 #endif
     if (COUNT_RAYS) {
         for (int k = 0; k < 6; k++) atomicAdd(counters[k], g_rays[k]);
+        atomicMax(counters[6], g_most);
+        if (g_most_shadow != 0u) atomicMax(counters[7], g_most_shadow);
         if (g_capped != 0u) atomicAdd(counters[8], g_capped);
+        atomicAdd(counters[9], g_taken);
+        if (g_paid != 0u) atomicAdd(counters[10], g_paid);
     }
 }
