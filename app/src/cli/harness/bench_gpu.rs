@@ -201,12 +201,7 @@ pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
             }
         };
         let n = times[0].len();
-        let stats = session
-            .statistics(scene_variant)
-            .into_iter()
-            .map(|(k, v)| format!("{k}={v}"))
-            .collect::<Vec<_>>()
-            .join(", ");
+        let stats = statistics(&mut session, scene_variant);
         if !stats.is_empty() {
             text += &format!("{label}: pipeline statistics: {stats}\n");
         }
@@ -245,6 +240,19 @@ pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
         return Err(e.into());
     }
     emit(&text)
+}
+
+/// The pipeline statistics of `variant` as `key=value, …` (empty where the driver has none).
+pub(crate) fn statistics(
+    session: &mut render::viewport::Viewport,
+    variant: render::vulkan::trace::Variant,
+) -> String {
+    session
+        .statistics(variant)
+        .into_iter()
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Image error against GPU time (render::convergence): a reference of `reference_spp` samples,

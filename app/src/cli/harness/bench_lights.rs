@@ -96,12 +96,8 @@ pub(crate) fn bench_lights(
             .iter()
             .zip(variants)
         {
-            let stats = session.statistics(v);
-            let stats: Vec<String> = stats.iter().map(|(k, v)| format!("{k}={v}")).collect();
-            text += &format!(
-                "{name}, {label}: pipeline statistics: {}\n",
-                stats.join(", ")
-            );
+            let stats = super::bench_gpu::statistics(&mut session, v);
+            text += &format!("{name}, {label}: pipeline statistics: {stats}\n");
         }
         text += &format!(
             "{name}: {} light faces, {width}x{height}, reference {reference_spp} spp with light sampling\n  \

@@ -58,12 +58,7 @@ pub(crate) fn bench_scene(b: SceneBench<'_>, device: &str, workers: usize) -> Re
         .render(&view, &params, &job, RenderHow::variant(variant).counted())?
         .rays
         .context("the counted render reported no rays")?;
-    let stats = session
-        .statistics(variant)
-        .into_iter()
-        .map(|(k, v)| format!("{k}={v}"))
-        .collect::<Vec<_>>()
-        .join(", ");
+    let stats = super::bench_gpu::statistics(&mut session, variant);
     let median = at(50);
     Ok(format!(
         "device       {} ({})\nscene        {} ({}x{}x{} voxels, {} solid), {width}x{height}, {} bounces, sun {}\n\
