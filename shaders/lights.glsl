@@ -14,26 +14,10 @@ float light_total() { return light_node(1u); }
 float light_weight(int material) { return uintBitsToFloat(light_words[LIGHT_WEIGHTS + uint(material)]); }
 uint light_faces_at() { return LIGHT_NODES + 10u * light_capacity(); }
 
-// cos(max(0, θ − β)) for cos θ = cos_t and the half-angle β of a sphere of radius² r2 at
-// distance² d2 (tree.rs `cone_bound`).
-float light_cone_bound(float cos_t, float r2, float d2) {
-    if (d2 <= r2) return 1.0;
-    float sin_b2 = r2 / d2;
-    float cos_b = sqrt(1.0 - sin_b2);
-    if (cos_t >= cos_b) return 1.0;
-    float sin_t = sqrt(max(1.0 - cos_t * cos_t, 0.0));
-    return max(cos_t * cos_b + sin_t * sqrt(sin_b2), 1e-4);
-}
-
 // Benchmark only (trace.comp's EXPERIMENT bit 11): faces chosen by weight alone, the tree's
 // bounds ignored (and the sun and the faces half each), as before the light tree.
 #ifndef LIGHTS_BY_WEIGHT
 #define LIGHTS_BY_WEIGHT false
-#endif
-// Benchmark only (EXPERIMENT bit 12): cosine bounds by a linear widening (two special
-// functions per node instead of seven).
-#ifndef LIGHTS_CHEAP
-#define LIGHTS_CHEAP false
 #endif
 
 // Node i's importance from point p with axis normal n (tree.rs `importance`): 0 exactly when
@@ -63,21 +47,12 @@ float light_importance(uint i, vec3 p, ivec3 n) {
     vec3 e = hi - lo;
     float r2 = dot(e, e) * 0.25;
     float d2 = dot(v, v);
-    if (LIGHTS_CHEAP) {
-        float inv_d = inversesqrt(max(d2, 1e-20));
-        float rd = 0.5 * length(e) * inv_d;
-        float cl = clamp(best * inv_d + rd, 1e-4, 1.0);
-        float cr = clamp(-dot(v, nf) * inv_d + rd, 1e-4, 1.0);
-        return w * cl * cr / max(d2, r2);
-    }
-    float d = sqrt(d2);
-    float cos_l = 1.0;
-    float cos_r = 1.0;
-    if (d > 0.0) {
-        cos_l = light_cone_bound(best / d, r2, d2);
-        cos_r = light_cone_bound(-dot(v, nf) / d, r2, d2);
-    }
-    return w * cos_l * cos_r / max(d2, r2);
+    // The cosines towards the centre widened by r / d (tree.rs `widened`).
+    float inv_d = inversesqrt(max(d2, 1e-20));
+    float rd = 0.5 * length(e) * inv_d;
+    float cl = clamp(best * inv_d + rd, 1e-4, 1.0);
+    float cr = clamp(-dot(v, nf) * inv_d + rd, 1e-4, 1.0);
+    return w * cl * cr / max(d2, r2);
 }
 
 // The slot chosen for p with normal n from u ∈ [0, 1) (rescaled at each level) and its

@@ -30,8 +30,8 @@ layout(constant_id = 7) const bool COUNT_RAYS = false;
 // every shadow ray as unblocked without tracing it, bit 3 skips light sampling (NEE), bit 4
 // makes shaders/shadow.comp skip its work, bit 6 starts a subgroup's next samples together,
 // bits 7..10 turn traversal skips off (brickmap.glsl SKIPS_OFF), bit 11 chooses light faces by
-// weight alone (lights.glsl LIGHTS_BY_WEIGHT), bit 12 takes its cheap cosine bounds
-// (LIGHTS_CHEAP), bit 13 starts camera rays at the camera (TILE_MARCH_OFF).
+// weight alone (lights.glsl LIGHTS_BY_WEIGHT), bit 13 starts camera rays at the camera
+// (TILE_MARCH_OFF).
 layout(constant_id = 8) const uint EXPERIMENT = 0u;
 // Shadow rays go to a queue that shaders/shadow.comp traces next, one per invocation, instead
 // of being traced here: in a warp only some lanes have a shadow ray at a vertex, and tracing
@@ -65,7 +65,6 @@ layout(constant_id = 15) const bool TRANSPARENT = false;
 #define COUNT_STEPS COUNT_RAYS
 #define SKIPS_OFF ((EXPERIMENT >> 7) & 15u)
 #define LIGHTS_BY_WEIGHT ((EXPERIMENT & 2048u) != 0u)
-#define LIGHTS_CHEAP ((EXPERIMENT & 4096u) != 0u)
 // Camera rays start where their tile's frustum first meets an occupied coarse cell (off with
 // experiment bit 13, and with the coarse grid's skip off: bit 7).
 // (8320 = bits 13 and 7; one mask test: glslang miscompiles a && of two spec-constant tests.)
