@@ -20,11 +20,10 @@ layout(std430, set = 0, binding = 1) readonly buffer Guides { vec4 guides[]; }; 
 layout(std430, set = 0, binding = 2) buffer Moments { vec4 moments[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Src { vec4 src[]; };        // rgb, variance
 layout(std430, set = 0, binding = 4) writeonly buffer Dst { vec4 dst[]; };
-// flags: bit 0 this batch restarted the accumulation (moments), bit 1 the last step, bit 2
-// the source is a moving camera's temporal history (shaders/temporal.comp): its count is
-// frames blended, not unbiased samples, so the last step does not fade to it.
+// flags: bit 0 this batch restarted the accumulation (moments), bit 1 the last step.
 // fade_from, fade_to: the sample counts between which the last step gives way to the raw mean
-// (linear in log2 of the count; render/src/vulkan/denoise.rs `Fade`); fade_to 0: never.
+// (linear in log2 of the count; render/src/vulkan/denoise.rs `Fade`); fade_to 0: never (also
+// when the source is a moving camera's temporal history, whose count is frames blended).
 layout(push_constant) uniform Push { uvec2 size; uint mode; uint step; uint flags; float fade_from; float fade_to; } pc;
 
 // Luminance edge-stopping: differences are measured in standard deviations of the mean
@@ -164,7 +163,7 @@ void filter_step(ivec2 px, uint i) {
     vec3 result = sum / wsum;
     if (last) {
         // The raw mean's share: a converged viewport shows the unbiased image.
-        float raw = (pc.flags & 4u) != 0u || pc.fade_to <= 0.0 ? 0.0
+        float raw = pc.fade_to <= 0.0 ? 0.0
             : clamp(log2(max(accum[i].w, 1.0) / pc.fade_from) / log2(pc.fade_to / pc.fade_from), 0.0, 1.0);
         dst[i] = vec4(mix(result, demodulated(i), raw) * albedo, 1.0);
     } else {

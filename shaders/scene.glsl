@@ -78,18 +78,29 @@ uvec2 picture_pixel(uvec2 px) {
     return px + p.window.xy;
 }
 
-// The camera ray through film position `f` (pixels from the picture's top left corner; a
-// pixel's samples jitter it within [x, x + 1) × [y, y + 1)).
+// Film position `f` (pixels from the picture's top left corner) as the camera's (u, v) in
+// [−1, 1]², v up.
+vec2 film_uv(vec2 f) {
+    return vec2(2.0 * f.x / float(p.window.z) - 1.0, 1.0 - 2.0 * f.y / float(p.window.w));
+}
+
+// The perspective camera's unnormalized direction through film position `f` (affine in `f`).
+vec3 film_direction(vec2 f) {
+    vec2 uv = film_uv(f);
+    return p.cam_forward.xyz + p.cam_right.xyz * uv.x + p.cam_up.xyz * uv.y;
+}
+
+// The camera ray through film position `f` (a pixel's samples jitter it within
+// [x, x + 1) × [y, y + 1)).
 void camera_ray(vec2 f, out vec3 o, out vec3 d) {
-    float u = 2.0 * f.x / float(p.window.z) - 1.0;
-    float v = 1.0 - 2.0 * f.y / float(p.window.w);
     if (p.cam_pos.w > 0.5) {
         // Orthographic: parallel rays from the image plane through the camera's position.
-        o = p.cam_pos.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v;
+        vec2 uv = film_uv(f);
+        o = p.cam_pos.xyz + p.cam_right.xyz * uv.x + p.cam_up.xyz * uv.y;
         d = p.cam_forward.xyz;
     } else {
         o = p.cam_pos.xyz;
-        d = normalize(p.cam_forward.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v);
+        d = normalize(film_direction(f));
     }
 }
 

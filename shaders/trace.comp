@@ -346,12 +346,6 @@ const float SLAB = 32.0;
 const int SLAB_ROUNDS = 4;
 const int SLAB_CELLS = 64; // coarse cells a lane tests at most (more: taken as occupied)
 
-vec3 film_direction(vec2 f) {
-    float u = 2.0 * f.x / float(p.window.z) - 1.0;
-    float v = 1.0 - 2.0 * f.y / float(p.window.w);
-    return p.cam_forward.xyz + p.cam_right.xyz * u + p.cam_up.xyz * v;
-}
-
 uint ballot_word(uvec4 m, uint w) { return w == 0u ? m.x : (w == 1u ? m.y : (w == 2u ? m.z : m.w)); }
 
 // Set bits of `m` below lane `lane`.
@@ -419,7 +413,7 @@ void begin_path(uvec2 px, uint s) {
     vec2 f = vec2(picture_pixel(px)) + vec2(jx, rand());
     camera_ray(f, path_o, path_d);
     // Where the walk may start: a voxel back from the tile's start depth on this ray.
-    path_t_min = g_tile_start > 0.0 ? max(g_tile_start * length(film_direction(f)) - 1.0, 0.0) : 0.0;
+    path_t_min = max(g_tile_start * length(film_direction(f)) - 1.0, 0.0);
     path_beta = vec3(1.0);
     path_start = ivec3(0);
     path_medium = HAS_DIELECTRIC ? camera_medium(path_o) : AIR;

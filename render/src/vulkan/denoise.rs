@@ -83,7 +83,6 @@ const PREPARE: u32 = 1;
 const FILTER_STEP: u32 = 2;
 const RESTART: u32 = 1;
 const LAST: u32 = 2;
-const NO_FADE: u32 = 4;
 
 /// The buffers of one image size.
 struct Buffers {
@@ -361,12 +360,18 @@ impl Denoiser {
         sets: FilterSets,
     ) -> Binding {
         let b = self.buffers.as_ref().expect("recorded after a batch");
+        // A moving camera's history counts frames blended, not unbiased samples: no fade.
+        let fade = if self.temporal_input {
+            Fade::NEVER
+        } else {
+            self.fade
+        };
         let push = |mode, step, flags| Push {
             size: [b.size.0, b.size.1],
             mode,
             step,
             flags,
-            fade: [self.fade.from, self.fade.to],
+            fade: [fade.from, fade.to],
         };
         // Prepare writes ping; the steps alternate ping → pong → ping …, ending in pong.
         self.record_filter_pass(ctx, cmd, sets.to_ping, push(PREPARE, 0, 0));
@@ -383,15 +388,7 @@ impl Denoiser {
                 ctx,
                 cmd,
                 set,
-                push(
-                    FILTER_STEP,
-                    step,
-                    match (last, self.temporal_input) {
-                        (true, true) => LAST | NO_FADE,
-                        (true, false) => LAST,
-                        _ => 0,
-                    },
-                ),
+                push(FILTER_STEP, step, if last { LAST } else { 0 }),
             );
         }
         // SAFETY: recording.

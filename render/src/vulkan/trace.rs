@@ -112,8 +112,9 @@ pub const MAX_SLICES: u32 = 8;
 /// Samples per invocation when a pixel's samples are split.
 pub const SLICED_SAMPLES: u32 = 4;
 
-/// Bytes of the ray counters (trace.comp's `counters`).
-const COUNTERS_BYTES: u64 = 44;
+/// The ray counters (trace.comp's `counters`), and their bytes.
+const COUNTERS: usize = 11;
+const COUNTERS_BYTES: u64 = 4 * COUNTERS as u64;
 
 /// Rays a render traced, by kind.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -566,7 +567,7 @@ impl PathTracer {
 
     /// The ray counters after a counted render.
     pub(crate) fn read_counters(&self) -> RayCounts {
-        let c: [u32; 11] =
+        let c: [u32; COUNTERS] =
             bytemuck::pod_read_unaligned(&self.counters.read()[..COUNTERS_BYTES as usize]);
         RayCounts {
             primary: c[0] as u64,

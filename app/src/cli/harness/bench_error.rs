@@ -676,6 +676,7 @@ fn bench_error(b: BenchError, workers: usize) -> Result<String> {
                 curve.same_image_rel_mse = Some(same);
                 curves.push(curve);
             }
+            session.set_denoise_fade(None);
             eprintln!("  steady-state timing");
             let per_sample = steady_times(
                 session,
