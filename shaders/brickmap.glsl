@@ -38,6 +38,19 @@ uint g_steps;
 #ifndef SKIPS_OFF
 #define SKIPS_OFF 0u
 #endif
+// Benchmark only: crossing times as (b − o) · (1 / d) with the reciprocal made once per ray
+// (RECIPROCAL_D), and 64 extra multiply-adds per traversal step (PAD_STEPS) or one extra
+// load the step's end waits for (PAD_LOAD: is a step's time set by its instructions or by
+// its loads?). trace.comp and shadow.comp define them from their EXPERIMENT bits 12, 5, 15.
+#ifndef RECIPROCAL_D
+#define RECIPROCAL_D false
+#endif
+#ifndef PAD_STEPS
+#define PAD_STEPS false
+#endif
+#ifndef PAD_LOAD
+#define PAD_LOAD false
+#endif
 // COUNT_STEPS shaders only: iteration caps hit (a traversal that ran out of its step budget,
 // a cell_at that ran out of its corrections); every one is a bug (`voxbrick stress`).
 uint g_capped;
@@ -51,6 +64,7 @@ uvec3 g_dims;            // grid size in bricks
 uint g_words_per_column; // coarse words per coarse x-column
 vec3 g_o;                // current ray
 vec3 g_d;
+vec3 g_inv; // RECIPROCAL_D: 1 / g_d
 ivec3 g_sgn;
 ivec3 g_size;
 
@@ -60,7 +74,9 @@ ivec3 g_size;
 float comp(vec3 v, int a) { return a == 0 ? v.x : (a == 1 ? v.y : v.z); }
 int comp(ivec3 v, int a) { return a == 0 ? v.x : (a == 1 ? v.y : v.z); }
 
-float plane_time(int axis, float b) { return (b - comp(g_o, axis)) / comp(g_d, axis); }
+float plane_time(int axis, float b) {
+    return RECIPROCAL_D ? (b - comp(g_o, axis)) * comp(g_inv, axis) : (b - comp(g_o, axis)) / comp(g_d, axis);
+}
 
 uint cell_word(ivec3 b) { return brick_index[(uint(b.x) * g_dims.z + uint(b.z)) * g_dims.y + uint(b.y)]; }
 
@@ -151,6 +167,7 @@ int cell_at(int axis, float t, bool after) {
 void set_ray(vec3 o, vec3 d) {
     g_o = o;
     g_d = d;
+    if (RECIPROCAL_D) g_inv = 1.0 / d;
     g_sgn = ivec3(sign(d));
     g_size = ivec3(g_dims) * 8;
 }
@@ -213,8 +230,20 @@ bool dda(ivec3 cell, float t, int axis, int medium, float t_max, out ivec3 voxel
         // Next planes of the current block (1, 2, 4, 8 or 32 voxels; shifts floor negatives too).
         ivec3 base = (cell >> shift) << shift;
         ivec3 bound = base + forward * (1 << shift);
-        vec3 times = mix(vec3(1.0 / 0.0), (vec3(bound) - g_o) / g_d, moving);
+        vec3 times = mix(vec3(1.0 / 0.0), RECIPROCAL_D ? (vec3(bound) - g_o) * g_inv : (vec3(bound) - g_o) / g_d, moving);
         float t_next = min(times.x, min(times.y, times.z));
+        if (PAD_STEPS) {
+            vec4 a = vec4(t_next, t, times.x, times.y);
+            for (int i = 0; i < 16; i++) a = a * 1.0000001 + 1e-7;
+            if (a.x + a.y + a.z + a.w == -1.0) t_next = t;
+        }
+        if (PAD_LOAD) {
+            // The brick-index word after this cell's (cached with it), at an address that
+            // depends on the step's time so it cannot be loaded early.
+            ivec3 b = cell >> 3;
+            uint at = (uint(b.x) * g_dims.z + uint(b.z)) * g_dims.y + uint(b.y) + (t_next > -1.0 ? 1u : 2u);
+            if (brick_index[at % uint(brick_index.length())] == 0xFFFFFFFEu) t_next = t;
+        }
         if (isinf(t_next)) return false;
         bvec3 at_t = equal(times, vec3(t_next));
         bool positive_tie = any(bvec3(ivec3(at_t) * forward));

@@ -62,8 +62,8 @@ pub(crate) struct BenchError {
     #[arg(long, value_delimiter = ',')]
     presets: Vec<String>,
     /// Choices besides the defaults (per-dispatch-1, per-dispatch-16, slices-1, slices-2,
-    /// in-place-shadows, no-light-sampling, independent, denoised, denoised-no-fade;
-    /// default all).
+    /// in-place-shadows, no-light-sampling, independent, denoised, denoised-no-fade,
+    /// denoised-fade-F-T for a fade from F to T spp at any size; default all but the last).
     #[arg(long, value_delimiter = ',')]
     choices: Vec<String>,
     /// Folder for the report.
@@ -91,6 +91,9 @@ pub(crate) enum Choice {
     Denoised,
     /// The same without its fade to the raw mean (the filter's bias at every count).
     DenoisedUnfaded,
+    /// The same with the fade from and to these sample counts at any picture size
+    /// (`denoised-fade-F-T` on the command line).
+    DenoisedFade(u32, u32),
 }
 
 impl Choice {
@@ -106,6 +109,7 @@ impl Choice {
             Choice::Independent => "independent numbers".into(),
             Choice::Denoised => "denoised (viewport)".into(),
             Choice::DenoisedUnfaded => "denoised, no fade".into(),
+            Choice::DenoisedFade(from, to) => format!("denoised, fade {from} to {to} spp"),
         }
     }
 
@@ -120,12 +124,38 @@ impl Choice {
             Choice::Independent => "independent".into(),
             Choice::Denoised => "denoised".into(),
             Choice::DenoisedUnfaded => "denoised-no-fade".into(),
+            Choice::DenoisedFade(from, to) => format!("denoised-fade-{from}-{to}"),
         }
     }
 
     /// Whether the image is shown through the denoiser.
     fn denoised(self) -> bool {
-        matches!(self, Choice::Denoised | Choice::DenoisedUnfaded)
+        matches!(
+            self,
+            Choice::Denoised | Choice::DenoisedUnfaded | Choice::DenoisedFade(..)
+        )
+    }
+
+    /// The choice a `--choices` key names, if any.
+    fn from_key(key: &str) -> Option<Choice> {
+        if let Some(c) = CHOICES.into_iter().find(|c| c.key() == key) {
+            return Some(c);
+        }
+        let (from, to) = key.strip_prefix("denoised-fade-")?.split_once('-')?;
+        let (from, to) = (from.parse().ok()?, to.parse().ok()?);
+        (0 < from && from < to).then_some(Choice::DenoisedFade(from, to))
+    }
+
+    /// The denoiser's fade the choice asks for (None: the viewport's own).
+    fn fade(self) -> Option<Fade> {
+        match self {
+            Choice::DenoisedUnfaded => Some(Fade::NEVER),
+            Choice::DenoisedFade(from, to) => Some(Fade {
+                from: from as f32,
+                to: to as f32,
+            }),
+            _ => None,
+        }
     }
 
     /// Whether the estimator is biased (consistent at best): its curve is not checked.
@@ -143,6 +173,7 @@ impl Choice {
                 | Choice::Independent
                 | Choice::Denoised
                 | Choice::DenoisedUnfaded
+                | Choice::DenoisedFade(..)
         )
     }
 
@@ -152,7 +183,7 @@ impl Choice {
         let tracer = session.tracer();
         match self {
             Choice::Default | Choice::Independent => true,
-            Choice::Denoised | Choice::DenoisedUnfaded => true,
+            Choice::Denoised | Choice::DenoisedUnfaded | Choice::DenoisedFade(..) => true,
             Choice::SamplesPerDispatch(n) => tracer.samples_per_dispatch_for(pixels, variant) != n,
             Choice::Slices(n) => queue && timed_slices(tracer, variant, pixels) != n,
             Choice::InPlaceShadows => tracer.deferred_shadows() && (variant.sun || variant.lights),
@@ -172,7 +203,10 @@ impl Choice {
             ..variant
         };
         match self {
-            Choice::Default | Choice::Denoised | Choice::DenoisedUnfaded => {}
+            Choice::Default
+            | Choice::Denoised
+            | Choice::DenoisedUnfaded
+            | Choice::DenoisedFade(..) => {}
             Choice::SamplesPerDispatch(n) => tracer.set_samples_per_dispatch(Some(n)),
             Choice::Slices(n) => tracer.set_sample_slices(Some(n)),
             Choice::InPlaceShadows => tracer.set_deferred_shadows(&ctx, false),
@@ -550,13 +584,9 @@ fn bench_error(b: BenchError, workers: usize) -> Result<String> {
         );
     }
     let cases = cases(&b.presets)?;
-    if let Some(unknown) = b
-        .choices
-        .iter()
-        .find(|k| !CHOICES.iter().any(|c| c.key() == **k))
-    {
+    if let Some(unknown) = b.choices.iter().find(|k| Choice::from_key(k).is_none()) {
         bail!(
-            "--choices: {unknown:?} is not one of {}",
+            "--choices: {unknown:?} is not one of {} or denoised-fade-F-T (0 < F < T)",
             CHOICES.map(Choice::key).join(", ")
         );
     }
@@ -622,11 +652,16 @@ fn bench_error(b: BenchError, workers: usize) -> Result<String> {
                 name.replace([' ', '+'], "_")
             ));
             app::atomic::write_atomic(&file, |w| reference.write_png(w, exposure))?;
+            let fades = b.choices.iter().filter_map(|k| match Choice::from_key(k) {
+                Some(c @ Choice::DenoisedFade(..)) => Some(c),
+                _ => None,
+            });
             let choices: Vec<Choice> = CHOICES
                 .into_iter()
                 .filter(|c| {
                     *c == Choice::Default || b.choices.is_empty() || b.choices.contains(&c.key())
                 })
+                .chain(fades)
                 .filter(|c| c.applies(session, scene_variant, pixels))
                 .collect();
             let mut curves: Vec<Curve> = Vec::new();
@@ -634,9 +669,7 @@ fn bench_error(b: BenchError, workers: usize) -> Result<String> {
                 eprintln!("  {}", choice.name());
                 let v = choice.apply(session, scene_variant);
                 if choice.changes_estimator() {
-                    session.set_denoise_fade(
-                        (choice == Choice::DenoisedUnfaded).then_some(Fade::NEVER),
-                    );
+                    session.set_denoise_fade(choice.fade());
                     let levels = measure(
                         session,
                         &view,

@@ -54,6 +54,9 @@ pub(crate) struct BenchGpu {
     /// With --scene: the most bounces.
     #[arg(long, requires = "scene")]
     bounces: Option<u32>,
+    /// With --scene: samples per pixel in each dispatch, 1..=16 (times are per sample).
+    #[arg(long, requires = "scene", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=16))]
+    spp: u32,
     /// The complexities' sample numbers: sobol (the default) or independent.
     #[arg(long, value_parser = super::args::sequence)]
     sequence: Option<render::Sequence>,
@@ -77,6 +80,7 @@ pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
         slices,
         scene,
         bounces,
+        spp,
     } = bench;
     let frames = frames.max(1);
     let convergence = convergence.then_some(reference_spp);
@@ -99,6 +103,7 @@ pub(crate) fn run(bench: BenchGpu, workers: usize) -> Result<()> {
             super::bench_scene::SceneBench {
                 path: &path,
                 bounces,
+                spp,
                 size: (width, height),
                 frames,
                 experiment,

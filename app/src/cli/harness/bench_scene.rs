@@ -1,6 +1,7 @@
 //! `voxbrick bench-gpu --scene FILE`: steady-state GPU time per sample of any scene file at its
 //! own settings (or `--bounces`), timed as the complexities are: rounds of back-to-back
-//! dispatches after two warm-up rounds, medians; then one counted render for the rays.
+//! dispatches of `--spp` samples per pixel after two warm-up rounds, medians per sample; then
+//! one counted 1-spp render for the rays.
 
 use anyhow::{Context, Result, bail};
 use render::cpu::RenderJob;
@@ -12,6 +13,8 @@ use std::path::Path;
 pub(crate) struct SceneBench<'a> {
     pub path: &'a Path,
     pub bounces: Option<u32>,
+    /// Samples per pixel in each dispatch.
+    pub spp: u32,
     pub size: (u32, u32),
     pub frames: usize,
     pub experiment: u32,
@@ -38,12 +41,12 @@ pub(crate) fn bench_scene(b: SceneBench<'_>, device: &str, workers: usize) -> Re
     const ROUND: u32 = 10;
     let mut times = Vec::with_capacity(b.frames);
     for round in 0..b.frames.div_ceil(ROUND as usize) + 2 {
-        let t = session.time_repeated(&view, &params, variant, b.size, 1, ROUND)?;
+        let t = session.time_repeated(&view, &params, variant, b.size, b.spp, ROUND)?;
         if t.is_empty() {
             bail!("this queue cannot take timestamps");
         }
         if round >= 2 {
-            times.extend(t);
+            times.extend(t.iter().map(|t| t / b.spp as f64));
         }
     }
     times.sort_by(f64::total_cmp);
@@ -62,7 +65,7 @@ pub(crate) fn bench_scene(b: SceneBench<'_>, device: &str, workers: usize) -> Re
     let median = at(50);
     Ok(format!(
         "device       {} ({})\nscene        {} ({}x{}x{} voxels, {} solid), {width}x{height}, {} bounces, sun {}\n\
-         per sample   median {median:.3} ms (p10 {:.3}, p90 {:.3}, {} dispatches of 1 spp)\n\
+         per sample   median {median:.3} ms (p10 {:.3}, p90 {:.3}, {} dispatches of {} spp)\n\
          rays         {:.2} M camera, {:.2} M continuation, {:.2} M shadow per sample ({:.0} Mrays/s)\n\
          lanes busy   {:.1} % of the trace pass's lane steps\n\
          statistics   {stats}\n",
@@ -78,6 +81,7 @@ pub(crate) fn bench_scene(b: SceneBench<'_>, device: &str, workers: usize) -> Re
         at(10),
         at(90),
         times.len(),
+        b.spp,
         rays.primary as f64 / 1e6,
         rays.secondary as f64 / 1e6,
         rays.shadow as f64 / 1e6,
