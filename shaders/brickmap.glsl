@@ -38,13 +38,11 @@ uint g_steps;
 #ifndef SKIPS_OFF
 #define SKIPS_OFF 0u
 #endif
-// Benchmark only: crossing times as (b − o) · (1 / d) with the reciprocal made once per ray
-// (RECIPROCAL_D), and 64 extra multiply-adds per traversal step (PAD_STEPS) or one extra
-// load the step's end waits for (PAD_LOAD: is a step's time set by its instructions or by
-// its loads?). trace.comp and shadow.comp define them from their EXPERIMENT bits 12, 5, 15.
-#ifndef RECIPROCAL_D
-#define RECIPROCAL_D false
-#endif
+// Benchmark only (`bench-gpu --experiment`): 64 extra multiply-adds per traversal step
+// (PAD_STEPS) or one extra load the step's end waits for (PAD_LOAD): is a step's time set by
+// its instructions or by its loads? Measured on the H100 (BENCHMARKS.md "The renderer, round
+// 5"): the multiply-adds cost complexities 1 / 2 / 3 +1 / +5 / +5 %, the load +12 / +17 /
+// +19 %. trace.comp and shadow.comp define them from their EXPERIMENT bits 5 and 15.
 #ifndef PAD_STEPS
 #define PAD_STEPS false
 #endif
@@ -64,7 +62,6 @@ uvec3 g_dims;            // grid size in bricks
 uint g_words_per_column; // coarse words per coarse x-column
 vec3 g_o;                // current ray
 vec3 g_d;
-vec3 g_inv; // RECIPROCAL_D: 1 / g_d
 ivec3 g_sgn;
 ivec3 g_size;
 
@@ -74,9 +71,7 @@ ivec3 g_size;
 float comp(vec3 v, int a) { return a == 0 ? v.x : (a == 1 ? v.y : v.z); }
 int comp(ivec3 v, int a) { return a == 0 ? v.x : (a == 1 ? v.y : v.z); }
 
-float plane_time(int axis, float b) {
-    return RECIPROCAL_D ? (b - comp(g_o, axis)) * comp(g_inv, axis) : (b - comp(g_o, axis)) / comp(g_d, axis);
-}
+float plane_time(int axis, float b) { return (b - comp(g_o, axis)) / comp(g_d, axis); }
 
 uint cell_word(ivec3 b) { return brick_index[(uint(b.x) * g_dims.z + uint(b.z)) * g_dims.y + uint(b.y)]; }
 
@@ -167,7 +162,6 @@ int cell_at(int axis, float t, bool after) {
 void set_ray(vec3 o, vec3 d) {
     g_o = o;
     g_d = d;
-    if (RECIPROCAL_D) g_inv = 1.0 / d;
     g_sgn = ivec3(sign(d));
     g_size = ivec3(g_dims) * 8;
 }
@@ -230,7 +224,7 @@ bool dda(ivec3 cell, float t, int axis, int medium, float t_max, out ivec3 voxel
         // Next planes of the current block (1, 2, 4, 8 or 32 voxels; shifts floor negatives too).
         ivec3 base = (cell >> shift) << shift;
         ivec3 bound = base + forward * (1 << shift);
-        vec3 times = mix(vec3(1.0 / 0.0), RECIPROCAL_D ? (vec3(bound) - g_o) * g_inv : (vec3(bound) - g_o) / g_d, moving);
+        vec3 times = mix(vec3(1.0 / 0.0), (vec3(bound) - g_o) / g_d, moving);
         float t_next = min(times.x, min(times.y, times.z));
         if (PAD_STEPS) {
             vec4 a = vec4(t_next, t, times.x, times.y);

@@ -16,7 +16,6 @@ layout(constant_id = 2) const bool LIGHTS = false;
 #define MEDIUM_POSSIBLE false
 #define COUNT_STEPS COUNT_RAYS
 #define SKIPS_OFF ((EXPERIMENT >> 7) & 15u)
-#define RECIPROCAL_D ((EXPERIMENT & 4096u) != 0u)
 #define PAD_STEPS ((EXPERIMENT & 32u) != 0u)
 #define PAD_LOAD ((EXPERIMENT & 32768u) != 0u)
 #include "brickmap.glsl"

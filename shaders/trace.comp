@@ -31,8 +31,7 @@ layout(constant_id = 7) const bool COUNT_RAYS = false;
 // makes shaders/shadow.comp skip its work, bit 5 pads each traversal step with 64 multiply-adds
 // (brickmap.glsl PAD_STEPS), bit 6 starts a subgroup's next samples together,
 // bits 7..10 turn traversal skips off (brickmap.glsl SKIPS_OFF), bit 11 chooses light faces by
-// weight alone (lights.glsl LIGHTS_BY_WEIGHT), bit 12 makes crossing times with the
-// ray's reciprocal direction (RECIPROCAL_D), bit 13 starts camera rays at the camera
+// weight alone (lights.glsl LIGHTS_BY_WEIGHT), bit 13 starts camera rays at the camera
 // (TILE_MARCH_OFF), bit 15 adds a load each traversal step waits for (PAD_LOAD).
 layout(constant_id = 8) const uint EXPERIMENT = 0u;
 // Shadow rays go to a queue that shaders/shadow.comp traces next, one per invocation, instead
@@ -66,7 +65,6 @@ layout(constant_id = 15) const bool TRANSPARENT = false;
 #define MEDIUM_POSSIBLE HAS_DIELECTRIC
 #define COUNT_STEPS COUNT_RAYS
 #define SKIPS_OFF ((EXPERIMENT >> 7) & 15u)
-#define RECIPROCAL_D ((EXPERIMENT & 4096u) != 0u)
 #define PAD_STEPS ((EXPERIMENT & 32u) != 0u)
 #define PAD_LOAD ((EXPERIMENT & 32768u) != 0u)
 #define LIGHTS_BY_WEIGHT ((EXPERIMENT & 2048u) != 0u)

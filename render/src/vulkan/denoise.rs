@@ -458,12 +458,18 @@ mod tests {
         for (w, h) in [(1024, 576), (1920, 1080), (3840, 2160)] {
             let f = Fade::for_picture((w, h));
             let k = h as f32 / 288.0;
-            assert!((f.from / small.from - k.sqrt()).abs() < 1e-3 * k, "{w}x{h}: {f:?}");
+            assert!(
+                (f.from / small.from - k.sqrt()).abs() < 1e-3 * k,
+                "{w}x{h}: {f:?}"
+            );
             assert!((f.to / small.to - k).abs() < 1e-3 * k, "{w}x{h}: {f:?}");
             // A viewport converging at 256 spp shows the unbiased mean there, the fade's
             // shape (the ratio of its ends) kept.
             let v = f.ending_by(256);
-            assert!(v.to <= 256.0 && (v.to / v.from - f.to / f.from).abs() < 1e-3, "{v:?}");
+            assert!(
+                v.to <= 256.0 && (v.to / v.from - f.to / f.from).abs() < 1e-3,
+                "{v:?}"
+            );
             assert_eq!(f.ending_by(100_000), f);
         }
         assert_eq!(small.ending_by(16), small);
