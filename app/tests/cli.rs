@@ -622,10 +622,13 @@ fn bench_gpu_times_a_scene_file_per_sample() {
         "18",
         "--frames",
         "10",
+        "--spp",
+        "2",
     ]) else {
         return;
     };
     assert!(out.contains("32x18, 2 bounces"), "{out}");
+    assert!(out.contains("dispatches of 2 spp"), "{out}");
     let median: f64 = field(&out, "per sample")
         .split_whitespace()
         .nth(3)
@@ -644,4 +647,8 @@ fn bench_gpu_times_a_scene_file_per_sample() {
     fails(&["bench-gpu", "--scene", s(&dir.join("missing.ron"))]);
     fails(&["bench-gpu", "--scene", s(&file), "--bounces", "99"]);
     fails(&["bench-gpu", "--bounces", "3"]);
+    fails(&["bench-gpu", "--spp", "2"]);
+    fails(&["bench-gpu", "--scene", s(&file), "--spp", "0"]);
+    fails(&["bench-gpu", "--scene", s(&file), "--spp", "17"]);
+    fails(&["bench-error", "--choices", "denoised-fade-64-8"]);
 }
