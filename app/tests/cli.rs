@@ -476,6 +476,11 @@ fn bench_error_measures_every_choice_against_a_checked_reference() {
     assert_eq!(csv.lines().count(), 1 + 4 * curves.len());
     let md = std::fs::read_to_string(dir.join("error.md")).unwrap();
     assert!(md.contains("Denoised (viewport)"), "{md}");
+    // Each denoised choice's table is headed by its own name.
+    assert!(
+        md.contains("\nDenoised, no fade: the defaults' relMSE"),
+        "{md}"
+    );
     for f in [
         "error.md",
         "relmse_spp_physical___lamps.png",

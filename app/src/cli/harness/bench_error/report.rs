@@ -18,13 +18,17 @@ fn denoiser_table(md: &mut String, run: &CaseRun) {
 /// [`denoiser_table`] of the denoised choice `k`.
 fn denoiser_rows(md: &mut String, run: &CaseRun, k: usize) {
     let levels = &run.views[0].curves[k].levels;
+    // The choice's name heads its table ("Denoised (viewport)", "Denoised, no fade", …).
+    let name = run.views[0].curves[k].choice.name();
+    let mut head = name.chars();
+    let name: String = head
+        .next()
+        .into_iter()
+        .flat_map(char::to_uppercase)
+        .chain(head)
+        .collect();
     *md += &format!(
-        "\nDenoised (viewport){}: the defaults' relMSE over the denoised image's at each spp (> 1: the denoiser's bias costs less than the noise it removes), and the filter's GPU ms:\n\n",
-        if run.views[0].curves[k].choice == Choice::DenoisedUnfaded {
-            ", without its fade to the raw mean"
-        } else {
-            ""
-        }
+        "\n{name}: the defaults' relMSE over the denoised image's at each spp (> 1: the denoiser's bias costs less than the noise it removes), and the filter's GPU ms:\n\n",
     );
     let header: Vec<String> = std::iter::once("view".to_string())
         .chain(levels.iter().map(|l| format!("{} spp", l.spp)))
