@@ -21,6 +21,8 @@ fn the_window_handlers_take_input_as_the_user_saw_the_ui() {
         return;
     };
     a_press_right_after_leaving_a_window_draws(&mut s);
+    a_drag_pressed_on_the_sky_draws_from_where_it_meets_the_ground(&mut s);
+    a_short_window_is_as_tall_as_what_it_holds(&mut s);
     a_drag_from_a_window_into_the_viewport_edits_nothing(&mut s);
     a_held_fly_key_moves_by_the_time_held(&mut s);
     a_stored_view_comes_back(&mut s);

@@ -15,6 +15,7 @@
 //! ```
 
 pub mod brick;
+pub mod census;
 pub mod dirty;
 pub mod edit;
 pub mod error;

@@ -244,6 +244,10 @@ impl Slab {
             }
         }
     }
+    /// The global cells this slab holds.
+    pub(crate) fn cell_range(&self) -> std::ops::Range<usize> {
+        self.cell_base..self.cell_base + self.slots.len()
+    }
     /// The brick-index words of this slab's cells as the GPU reads them.
     pub(crate) fn gpu_index_words(&self) -> impl Iterator<Item = u32> + '_ {
         (0..self.slots.len()).map(|i| self.gpu_index_word(i + self.cell_base))

@@ -199,7 +199,19 @@ fn the_loop_finder_finds_a_loop() {
 fn long_files_say_why_at_their_top() {
     let r = root();
     let mut files = Vec::new();
-    for dir in ["app/src", "brickmap/src", "render/src"] {
+    // The product's sources and the tests' and benchmarks' own.
+    for dir in [
+        "app/src",
+        "brickmap/src",
+        "render/src",
+        "app/tests",
+        "brickmap/tests",
+        "render/tests",
+        "tests/src",
+        "tests/tests",
+        "app/benches",
+        "brickmap/benches",
+    ] {
         rust_files(&r.join(dir), &mut files);
     }
     let long: Vec<String> = files

@@ -92,9 +92,17 @@ pub(crate) fn new(a: NewArgs, workers: usize) -> Result<()> {
         ))
     })?;
     let generated = started.elapsed().as_secs_f64();
+    // How the bulk work ran: a generator that stops using every worker, or per-voxel work
+    // on the path, shows here (and fails the CLI test).
+    let work = brickmap::census::read();
     save(&scene, &a.output)?;
     eprintln!(
-        "generated in {generated:.2} s, wrote {} in {:.2} s total",
+        "generated in {generated:.2} s on {} workers (adopted as one object on {} threads; \
+         {} bricks rewritten voxel by voxel, {} composited), wrote {} in {:.2} s total",
+        scene.world.workers(),
+        work.adopted_on,
+        work.voxel_bricks,
+        work.composited,
         a.output.display(),
         started.elapsed().as_secs_f64()
     );
@@ -379,8 +387,17 @@ pub(crate) fn info(a: InfoArgs, workers: usize) -> Result<()> {
     let scene = with_progress(format!("reading {}", file.display()), || {
         Ok(app::formats::load(&file, workers)?)
     })?;
+    let loaded = started.elapsed().as_secs_f64();
+    let work = brickmap::census::read();
     let p = &scene.params;
     let mut text = format!("file         {}\n", file.display());
+    text += &format!(
+        "loaded       in {loaded:.2} s on {} workers (adopted as one object on {} threads; {} bricks rewritten voxel by voxel, {} composited)\n",
+        scene.world.workers(),
+        work.adopted_on,
+        work.voxel_bricks,
+        work.composited
+    );
     text += &stats_text(&scene.world, started.elapsed().as_secs_f64());
     text += &objects_text(&scene.objects());
     text += &tree_text(

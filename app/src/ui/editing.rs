@@ -584,10 +584,26 @@ fn terrain(ui: &mut egui::Ui, spec: &mut TerrainSpec, height: u32, out: &mut Vec
     }
 }
 
-/// A window kept inside `area` (the viewport between the panels), scrolling when taller.
+/// The egui id of the panel window titled `title` (where it is, as last drawn, is kept under
+/// it).
+pub(super) fn window_id(title: &str) -> egui::Id {
+    egui::Id::new(("panel window", title))
+}
+
+/// The width a panel window opens with (the user may widen or narrow it).
+pub(super) const WINDOW_WIDTH: f32 = 340.0;
+
+/// A window kept inside `area` (the viewport between the panels): as tall as what it holds,
+/// scrolling past the area's height, as wide as [`WINDOW_WIDTH`] until the user drags its
+/// side. (egui's default window is resizable both ways with a scroll area that never
+/// shrinks: 420 points tall whatever it holds.)
 pub(super) fn window(area: egui::Rect, title: &str) -> egui::Window<'_> {
     egui::Window::new(title)
+        .id(window_id(title))
         .constrain_to(area)
-        .max_height(area.height() - 40.0)
+        .auto_sized()
         .vscroll(true)
+        .default_width(WINDOW_WIDTH)
+        .resizable([true, false])
+        .max_height(area.height() - 40.0)
 }

@@ -119,6 +119,9 @@ impl Editor {
         if consumed || self.egui.egui_wants_keyboard_input() {
             return;
         }
+        if code == KeyCode::Escape {
+            self.pointer.sky_held = false;
+        }
         if code == KeyCode::Escape && self.pointer.drawing.take().is_some() {
             self.edits.submit(&self.doc, Edit::StrokeAbort);
             return;
@@ -163,6 +166,9 @@ impl Editor {
     fn button(&mut self, button: MouseButton, pressed: bool) {
         self.request_redraw();
         let free = !self.on_ui(self.pointer.cursor);
+        if !pressed && button == MouseButton::Left {
+            self.pointer.sky_held = false;
+        }
         match (pressed, button) {
             (true, MouseButton::Left) if free => self.press(),
             (false, MouseButton::Left) if self.pointer.drawing.is_some() => {
@@ -225,7 +231,11 @@ impl Editor {
             }
             self.moved();
         }
-        self.stroke_to_cursor();
+        if self.pointer.sky_held && self.pointer.drawing.is_none() {
+            self.stroke_from_sky(previous);
+        } else {
+            self.stroke_to_cursor();
+        }
         self.select_to_cursor();
         self.arrange_to_cursor();
         self.extrude_to_cursor();
@@ -302,11 +312,19 @@ impl Editor {
         }
         let brush = &self.settings.brush;
         let Some((v, layer)) = tools::start(&view, brush.mode, origin, dir) else {
+            // On the sky: the stroke waits for the drag to reach the scene.
+            self.pointer.sky_held = true;
             return;
         };
-        let stroke = brush.stroke(vec![tools::centre(v)], view.dims().voxels());
         drop(view);
         drop(doc);
+        self.begin_stroke(v, layer);
+    }
+
+    /// A stroke's first voxel `v` (in `layer`), at the cursor.
+    fn begin_stroke(&mut self, v: glam::IVec3, layer: tools::Layer) {
+        let dims = self.read().scene.world.dims().voxels();
+        let stroke = self.settings.brush.stroke(vec![tools::centre(v)], dims);
         self.report.line(format_args!(
             "stroke begin {} {} voxel {} {} {}",
             self.pointer.cursor.0, self.pointer.cursor.1, v.x, v.y, v.z
@@ -318,6 +336,38 @@ impl Editor {
             points: vec![v],
         });
         self.edits.submit(&self.doc, Edit::StrokeBegin(stroke));
+    }
+
+    /// A brush press held since it hit nothing: the cursor's path from `from` to where it is
+    /// now, walked every [`PATH_STEP`] pixels; the stroke begins at the first point whose ray
+    /// meets the scene and follows the rest of the path (so a fast drag off the sky draws
+    /// from where it crossed onto the ground, not from where the next event landed).
+    fn stroke_from_sky(&mut self, from: (f64, f64)) {
+        let to = self.pointer.cursor;
+        let length = (to.0 - from.0).hypot(to.1 - from.1);
+        let steps = ((length / PATH_STEP).ceil() as usize).clamp(1, MAX_PATH_STEPS);
+        let at = |i: usize| {
+            let f = i as f64 / steps as f64;
+            (from.0 + (to.0 - from.0) * f, from.1 + (to.1 - from.1) * f)
+        };
+        for i in 1..=steps {
+            self.pointer.cursor = at(i);
+            if self.pointer.drawing.is_some() {
+                self.stroke_to_cursor();
+                continue;
+            }
+            let (origin, dir) = self.cursor_ray();
+            let first = {
+                let doc = self.read();
+                let view = doc.scene.world.read();
+                tools::start(&view, self.settings.brush.mode, origin, dir)
+            };
+            if let Some((v, layer)) = first {
+                self.pointer.sky_held = false;
+                self.begin_stroke(v, layer);
+            }
+        }
+        self.pointer.cursor = to;
     }
 
     /// While drawing: the stroke's next point, when the cursor reached another voxel.
@@ -412,3 +462,8 @@ impl Editor {
         }
     }
 }
+
+/// Pixels between the points of a cursor path walked for the scene (a press held on the sky).
+const PATH_STEP: f64 = 2.0;
+/// The most points walked along one cursor move.
+const MAX_PATH_STEPS: usize = 1024;

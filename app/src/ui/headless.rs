@@ -178,14 +178,18 @@ impl Editor {
     /// Where the palette's 16 × 16 colours show (x, y, width, height in pixels, as last
     /// drawn; None while its dock is collapsed).
     pub fn palette_grid(&self) -> Option<(f64, f64, f64, f64)> {
-        let r = self.panels.editing.palette_grid?;
+        Some(self.pixel_rect(self.panels.editing.palette_grid?))
+    }
+
+    /// A rectangle in points as (x, y, width, height) in window pixels.
+    fn pixel_rect(&self, r: egui::Rect) -> (f64, f64, f64, f64) {
         let ppp = f64::from(self.egui.pixels_per_point());
-        Some((
+        (
             f64::from(r.min.x) * ppp,
             f64::from(r.min.y) * ppp,
             f64::from(r.width()) * ppp,
             f64::from(r.height()) * ppp,
-        ))
+        )
     }
 
     /// Where the last frame drew a widget whose text is `label` (a button's, a label's, a
@@ -203,6 +207,22 @@ impl Editor {
             let c = r.center();
             (f64::from(c.x) * ppp, f64::from(c.y) * ppp)
         })
+    }
+
+    /// Where the panel window titled `title` was last drawn (x, y, width, height in window
+    /// pixels); None when it is not open.
+    pub fn window_rect(&self, title: &str) -> Option<(f64, f64, f64, f64)> {
+        let id = super::editing::window_id(title);
+        let layer = egui::LayerId::new(egui::Order::Middle, id);
+        let r = self
+            .egui
+            .memory(|m| {
+                m.areas()
+                    .visible_last_frame(&layer)
+                    .then(|| m.area_rect(id))
+            })
+            .flatten()?;
+        Some(self.pixel_rect(r))
     }
 
     /// How many voxel faces tint a selection made as a set (0: none, or a box selection).

@@ -37,6 +37,9 @@ pub(super) struct Pointer {
     pub(super) drag: Option<(Drag, (f64, f64))>,
     /// The stroke being drawn with the left button.
     pub(super) drawing: Option<Drawing>,
+    /// A brush press on nothing (the sky), still held: the stroke begins where the
+    /// cursor's path first meets the scene.
+    pub(super) sky_held: bool,
     /// The selection box being dragged.
     pub(super) selecting: Option<SelectDrag>,
     /// A paste follows the cursor until a click.

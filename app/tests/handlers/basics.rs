@@ -29,6 +29,59 @@ pub fn a_press_right_after_leaving_a_window_draws(s: &mut Session) {
     assert_ne!(after.0, before.0, "the stroke changed nothing");
 }
 
+/// A brush drag pressed on the sky draws from where its path first meets the scene: one fast
+/// move from the sky onto the terrain (a single event, as a quick flick gives) begins the
+/// stroke at the first point of the path with terrain behind it, one undo step.
+pub fn a_drag_pressed_on_the_sky_draws_from_where_it_meets_the_ground(s: &mut Session) {
+    let (sky, terrain) = (s.on_the_sky(), s.on_the_terrain());
+    s.key(KeyCode::KeyT, true); // attach
+    s.key(KeyCode::KeyT, false);
+    s.to(sky);
+    s.quiet();
+    let before = s.state();
+    // The first point of the path whose ray meets the scene, and the voxel attach fills there.
+    let first = (1..=2000)
+        .map(|i| {
+            let f = f64::from(i) / 2000.0;
+            (
+                sky.0 + (terrain.0 - sky.0) * f,
+                sky.1 + (terrain.1 - sky.1) * f,
+            )
+        })
+        .find(|p| s.terrain_behind(*p))
+        .expect("the path reaches the terrain");
+    let target = {
+        let h = s.hit_at(first).expect("terrain behind");
+        h.voxel + h.normal
+    };
+    let filled = |s: &Session| {
+        let doc = s.ed.document();
+        let d = doc.read().unwrap();
+        matches!(d.scene.world.read().voxel(target), Ok(Some(_)))
+    };
+    assert!(
+        !filled(s),
+        "the voxel in front of the crossing starts empty"
+    );
+    s.left(true);
+    s.to(terrain);
+    s.left(false);
+    s.quiet();
+    let after = s.state();
+    assert_eq!(
+        after.1,
+        before.1 + 1,
+        "the drag off the sky drew one stroke"
+    );
+    assert!(
+        filled(s),
+        "the stroke begins where the path crossed onto the scene ({first:?}), not at the event"
+    );
+    s.ctrl(KeyCode::KeyZ);
+    s.quiet();
+    assert_eq!(s.state().0, before.0, "undone exactly");
+}
+
 /// A drag that starts on a window belongs to it until the release, even when egui
 /// still thinks the pointer is over the viewport and the drag ends there.
 pub fn a_drag_from_a_window_into_the_viewport_edits_nothing(s: &mut Session) {
@@ -326,4 +379,22 @@ pub fn a_small_window_folds_the_docks_and_a_large_one_brings_them_back(s: &mut S
     s.quiet();
     assert_eq!(s.ed.view_area(), wide, "the docks came back as they were");
     assert!(s.ed.palette_grid().is_some());
+}
+
+/// The panel windows are as tall as what they hold: Scene statistics, a few lines, opens
+/// far shorter than egui's 420-point default, and as wide as it opens.
+pub fn a_short_window_is_as_tall_as_what_it_holds(s: &mut Session) {
+    s.click_on("View", MouseButton::Left);
+    s.click_on("Scene statistics", MouseButton::Left);
+    s.quiet();
+    let (_, _, w, h) =
+        s.ed.window_rect("Scene statistics")
+            .expect("the statistics window opened");
+    assert!(h < 300.0, "a window of a few lines is {h} pixels tall");
+    assert!(w < 600.0, "it opens {w} pixels wide");
+    // Closed again from the menu.
+    s.click_on("View", MouseButton::Left);
+    s.click_on("Scene statistics", MouseButton::Left);
+    s.quiet();
+    assert!(s.ed.window_rect("Scene statistics").is_none(), "closed");
 }

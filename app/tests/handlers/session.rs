@@ -206,7 +206,12 @@ impl Session {
     }
 
     /// Whether the view's ray through the window point hits the scene.
-    pub fn terrain_behind(&self, (x, y): (f64, f64)) -> bool {
+    pub fn terrain_behind(&self, at: (f64, f64)) -> bool {
+        self.hit_at(at).is_some()
+    }
+
+    /// What the view's ray through the window point hits first (the exact CPU cast).
+    pub fn hit_at(&self, (x, y): (f64, f64)) -> Option<brickmap::RayHit> {
         let (origin, dir) = self.ed.ray_at(x, y);
         let doc = self.ed.document();
         let d = doc.read().unwrap();
@@ -215,7 +220,7 @@ impl Session {
             .world
             .read()
             .ray_cast(&brickmap::Ray { origin, dir }, f64::INFINITY);
-        matches!(hit, Ok(Some(_)))
+        hit.ok().flatten().map(|(h, _)| h)
     }
 
     /// A point of the viewport, free of every panel, with nothing of the scene behind it.

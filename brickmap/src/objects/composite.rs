@@ -314,6 +314,7 @@ impl Composite {
         models: &(impl ModelSource + Sync),
     ) -> WorldResult<EditInverse> {
         let list: Vec<UVec3> = bricks.iter().map(|k| UVec3::from_array(*k)).collect();
+        crate::census::composited(list.len() as u64);
         // Bricks are independent: computed on as many threads as the world has workers, in
         // contiguous chunks joined in order (the same result whatever the count).
         let threads = world.workers().clamp(1, list.len().max(1));
@@ -342,6 +343,22 @@ impl Composite {
             return Ok(EditInverse::default());
         }
         Ok(world.apply(crate::terrain::set_bricks(contents))?.inverse)
+    }
+
+    /// The model drawn where it is the whole world: one drawn object, unturned, whose model
+    /// fills the grid exactly, so the world is that model's voxels brick for brick (what
+    /// [`super::Objects::of_world`] makes).
+    pub fn sole_cover(&self) -> Option<ModelId> {
+        match self.entries.as_slice() {
+            [e] if e.drawn.placement.rot == Orientation::IDENTITY
+                && e.lo == IVec3::ZERO
+                && e.hi == self.grid
+                && e.size == self.grid =>
+            {
+                Some(e.drawn.model)
+            }
+            _ => None,
+        }
     }
 
     /// Every world brick the composite covers (for a first write into an empty world).

@@ -16,6 +16,7 @@ use crate::material::MaterialTable;
 use crate::voxel_set::box_mask;
 use glam::{IVec3, UVec3};
 use std::collections::BTreeMap;
+use store::BrickStore;
 
 /// The largest model side on each axis (the world's own limits, so a model placed at
 /// identity fits the largest grid).
@@ -38,6 +39,22 @@ enum BrickMaterials {
 }
 
 impl ModelBrick {
+    /// Every voxel solid with material `m`.
+    pub const fn full(m: u8) -> Self {
+        Self {
+            mask: Mask::FULL,
+            materials: BrickMaterials::Uniform(m),
+        }
+    }
+
+    /// No voxel solid.
+    pub const fn empty() -> Self {
+        Self {
+            mask: Mask::EMPTY,
+            materials: BrickMaterials::Uniform(0),
+        }
+    }
+
     /// The material of voxel `bit` (meaningful where the mask is set).
     #[inline]
     pub fn material(&self, bit: usize) -> u8 {
@@ -94,8 +111,19 @@ impl ModelBrick {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Model {
     size: IVec3,
-    /// Non-empty bricks by brick coordinate (x, y, z), in that order.
-    bricks: BTreeMap<[u32; 3], ModelBrick>,
+    /// Non-empty bricks by brick coordinate.
+    bricks: BrickStore,
+}
+
+/// A model's size refused unless each side is 1..=[`MAX_MODEL_VOXELS`].
+fn check_size(size: IVec3) -> Result<()> {
+    if size.cmplt(IVec3::ONE).any() || size.cmpgt(MAX_MODEL_VOXELS).any() {
+        return Err(BrickmapError::Config(format!(
+            "a model of {}×{}×{} voxels: each side is 1..={} × 1..={} × 1..={}",
+            size.x, size.y, size.z, MAX_MODEL_VOXELS.x, MAX_MODEL_VOXELS.y, MAX_MODEL_VOXELS.z
+        )));
+    }
+    Ok(())
 }
 
 fn key(b: UVec3) -> [u32; 3] {
@@ -105,76 +133,11 @@ fn key(b: UVec3) -> [u32; 3] {
 impl Model {
     /// An empty model of `size` voxels (each axis 1..=[`MAX_MODEL_VOXELS`]).
     pub fn new(size: IVec3) -> Result<Self> {
-        if size.cmplt(IVec3::ONE).any() || size.cmpgt(MAX_MODEL_VOXELS).any() {
-            return Err(BrickmapError::Config(format!(
-                "a model of {}×{}×{} voxels: each side is 1..={} × 1..={} × 1..={}",
-                size.x, size.y, size.z, MAX_MODEL_VOXELS.x, MAX_MODEL_VOXELS.y, MAX_MODEL_VOXELS.z
-            )));
-        }
+        check_size(size)?;
         Ok(Self {
             size,
-            bricks: BTreeMap::new(),
+            bricks: BrickStore::new(((size + 7) / 8).as_uvec3()),
         })
-    }
-
-    /// A model of `size` holding these bricks (solid voxels with their materials in popcount
-    /// order), checked against the model's box and `table` like any edit.
-    pub fn from_bricks(
-        size: IVec3,
-        bricks: impl IntoIterator<Item = (UVec3, Mask, PriorMaterials)>,
-        table: &MaterialTable,
-    ) -> Result<Self> {
-        let mut model = Self::new(size)?;
-        // Each brick restored over exactly its solid voxels (a whole-brick restore would reach
-        // past a model whose size is not a multiple of 8).
-        let list = bricks
-            .into_iter()
-            .map(|(brick, mask, prior)| BrickUndo {
-                brick,
-                prior_mask: mask,
-                touched: mask,
-                prior,
-            })
-            .collect();
-        model.apply(&EditOp::Restore(EditInverse { bricks: list }), table)?;
-        Ok(model)
-    }
-
-    /// A model of `size` holding these solid voxels (position in the model, material; a
-    /// later one at the same position wins).
-    pub fn from_voxels(
-        size: IVec3,
-        voxels: impl IntoIterator<Item = (IVec3, u8)>,
-        table: &MaterialTable,
-    ) -> Result<Self> {
-        let mut bricks: BTreeMap<[u32; 3], (Mask, Box<[u8; 512]>)> = BTreeMap::new();
-        for (v, m) in voxels {
-            if v.cmplt(IVec3::ZERO).any() || v.cmpge(size).any() {
-                return Err(BrickmapError::OutOfRange(v, size));
-            }
-            let bit = voxel_bit(v.x & 7, v.y & 7, v.z & 7);
-            let (mask, mats) = bricks
-                .entry(key((v / 8).as_uvec3()))
-                .or_insert_with(|| (Mask::EMPTY, Box::new([0; 512])));
-            mask.set(bit);
-            mats[bit] = m;
-        }
-        let bricks = bricks.into_iter().map(|(k, (mask, mats))| {
-            let held = mask.ones().map(|bit| mats[bit]).collect();
-            (UVec3::from_array(k), mask, PriorMaterials::PerVoxel(held))
-        });
-        Self::from_bricks(size, bricks, table)
-    }
-
-    /// A world's voxels as one model of the world's size (a grid becoming one object).
-    pub fn from_world(world: &crate::World) -> Result<Self> {
-        let view = world.read();
-        let mut bricks = Vec::new();
-        view.for_each_brick(|b, mask, mats| {
-            let held = (0..mask.count() as usize).map(|k| mats.at(k)).collect();
-            bricks.push((b, *mask, PriorMaterials::packed(held)));
-        });
-        Self::from_bricks(view.dims().voxels(), bricks, view.materials())
     }
 
     /// Its size in voxels.
@@ -192,29 +155,31 @@ impl Model {
         if v.cmplt(IVec3::ZERO).any() || v.cmpge(self.size).any() {
             return None;
         }
-        let b = self.bricks.get(&key((v / 8).as_uvec3()))?;
+        let b = self.bricks.get((v / 8).as_uvec3())?;
         let bit = voxel_bit(v.x & 7, v.y & 7, v.z & 7);
         b.mask.get(bit).then(|| b.material(bit))
     }
 
     /// A brick (`None` where empty).
     pub fn brick(&self, b: UVec3) -> Option<&ModelBrick> {
-        self.bricks.get(&key(b))
+        self.bricks.get(b)
     }
 
-    /// The non-empty bricks in (x, y, z) order.
+    /// The non-empty bricks in the world's cell order (`GridDims::cell_index` over the
+    /// model's bricks: x, then z, then y fastest).
     pub fn bricks(&self) -> impl Iterator<Item = (UVec3, &ModelBrick)> + '_ {
-        self.bricks.iter().map(|(k, b)| (UVec3::from_array(*k), b))
+        self.bricks.iter()
     }
 
-    /// Bytes its bricks take (masks, materials, the map's keys), without the map's own nodes.
+    /// Bytes its bricks take: the brick index (4 bytes a brick cell), the partly filled or
+    /// many-material bricks' masks and materials.
     pub fn brick_bytes(&self) -> usize {
-        self.bricks.values().map(|b| b.bytes() + 12).sum()
+        self.bricks.bytes()
     }
 
     /// Solid voxels.
     pub fn solid_count(&self) -> u64 {
-        self.bricks.values().map(|b| b.mask.count() as u64).sum()
+        self.bricks.iter().map(|(_, b)| b.mask.count() as u64).sum()
     }
 
     /// A hash of the size and every solid voxel with its material (equal content, equal
@@ -222,8 +187,8 @@ impl Model {
     pub fn content_hash(&self) -> u64 {
         let mut h = xxhash_rust::xxh3::Xxh3::new();
         h.update(bytemuck::bytes_of(&self.size.to_array()));
-        for (k, b) in &self.bricks {
-            h.update(bytemuck::bytes_of(k));
+        for (k, b) in self.bricks.iter() {
+            h.update(bytemuck::bytes_of(&k.to_array()));
             h.update(bytemuck::bytes_of(&b.mask.0));
             for bit in b.mask.ones() {
                 h.update(&[b.material(bit)]);
@@ -331,7 +296,7 @@ impl Model {
                             let (full, mats) = emitted
                                 .remove(&by)
                                 .unwrap_or((Mask::EMPTY, PriorMaterials::Uniform(0)));
-                            if full.is_empty() && !self.bricks.contains_key(&key(b)) {
+                            if full.is_empty() && !self.bricks.contains(b) {
                                 return None;
                             }
                             let inside = self.inside(b);
@@ -451,11 +416,12 @@ impl Model {
         if touched.is_empty() {
             return None;
         }
+        crate::census::voxel_brick();
         let empty = ModelBrick {
             mask: Mask::EMPTY,
             materials: BrickMaterials::Uniform(0),
         };
-        let old = self.bricks.get(&key(b)).unwrap_or(&empty);
+        let old = self.bricks.get(b).unwrap_or(&empty);
         let mut mask = old.mask;
         let mut mats = old.per_voxel();
         let mut changed = 0;
@@ -504,7 +470,7 @@ impl Model {
     /// time where the brick holds one material (most bricks a shape covers); else voxel by
     /// voxel.
     fn rewrite_to(&self, b: UVec3, touched: &Mask, v: Option<u8>) -> Option<Rewrite> {
-        let old = self.bricks.get(&key(b));
+        let old = self.bricks.get(b);
         let (old_mask, u) = match old {
             None => (Mask::EMPTY, 0),
             Some(o) => match o.uniform() {
@@ -560,7 +526,7 @@ impl Model {
         let PriorMaterials::Uniform(p) = u.prior else {
             return self.restore_into_empty(u);
         };
-        let (old_mask, c) = match self.bricks.get(&key(u.brick)) {
+        let (old_mask, c) = match self.bricks.get(u.brick) {
             None => (Mask::EMPTY, 0),
             Some(o) => (o.mask, o.uniform()?),
         };
@@ -603,7 +569,7 @@ impl Model {
     /// A brick restore with per-voxel materials into an empty brick (a model being built):
     /// the restored voxels are the brick. `None` where the brick holds voxels.
     fn restore_into_empty(&self, u: &BrickUndo) -> Option<Option<Rewrite>> {
-        if self.bricks.contains_key(&key(u.brick)) {
+        if self.bricks.contains(u.brick) {
             return None;
         }
         let set = u.prior_mask.and(&u.touched);
@@ -628,11 +594,10 @@ impl Model {
 
     /// Stores a computed rewrite and records its undo; returns the voxels changed.
     fn commit(&mut self, r: Rewrite, undo: &mut Vec<BrickUndo>) -> u64 {
-        let k = key(r.undo.brick);
         match r.brick {
-            Some(b) => self.bricks.insert(k, b),
-            None => self.bricks.remove(&k),
-        };
+            Some(b) => self.bricks.insert(r.undo.brick, b),
+            None => self.bricks.remove(r.undo.brick),
+        }
         undo.push(r.undo);
         r.changed
     }
@@ -648,5 +613,7 @@ struct Rewrite {
     changed: u64,
 }
 
+mod build;
+mod store;
 #[cfg(test)]
 mod tests;

@@ -199,6 +199,10 @@ pub enum ObjectError {
     /// An edit with no object to act on (the editor's active object is none).
     #[error("no object is active to edit: choose one in the Objects window")]
     NoActiveObject,
+    /// A world adopted as a model by a tree whose one drawn object does not fill the grid
+    /// unturned.
+    #[error("the objects do not draw model {} alone over the whole grid, unturned", .0.0)]
+    NotTheWorld(ModelId),
     /// Objects still place the model.
     #[error("model {} is placed by {} objects", .0.0, .1)]
     ModelInUse(ModelId, usize),

@@ -64,17 +64,36 @@ impl Objects {
             Placement::at(grid / 2),
             object,
         )?;
-        let models = BTreeMap::from([(ModelId(0), Model::from_world(world)?)]);
-        let composite = Composite::new(&tree, &models, grid)?;
-        Ok((
-            Self {
-                tree,
-                models,
-                composite,
-                grid,
-            },
-            node,
-        ))
+        let objects = Self::adopting(tree, ModelId(0), BTreeMap::new(), world)?;
+        Ok((objects, node))
+    }
+
+    /// A scene of `tree` over a world that already holds what it shows: its one drawn object
+    /// places `model` (not among `others`) unturned over the whole grid, and that model is
+    /// taken from the world's voxels (each worker's slab on its own thread); nothing is
+    /// written. How a grid becomes one object, and how a file of one grid-sized object
+    /// loads as fast as a grid. Refuses any other tree, changing nothing.
+    pub fn adopting(
+        tree: ObjectTree,
+        model: ModelId,
+        mut others: BTreeMap<ModelId, Model>,
+        world: &World,
+    ) -> Result<Self, ObjectError> {
+        let grid = world.dims().voxels();
+        if others.contains_key(&model) {
+            return Err(ObjectError::ModelTaken(model));
+        }
+        others.insert(model, Model::from_world(world)?);
+        let composite = Composite::new(&tree, &others, grid)?;
+        if composite.sole_cover() != Some(model) {
+            return Err(ObjectError::NotTheWorld(model));
+        }
+        Ok(Self {
+            tree,
+            models: others,
+            composite,
+            grid,
+        })
     }
 
     /// The tree.

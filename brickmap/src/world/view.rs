@@ -171,6 +171,18 @@ impl WorldView<'_> {
         }
     }
 
+    /// The cells each worker's slab holds, in slab order: consecutive runs covering the grid
+    /// in cell order.
+    pub fn slab_cells(&self) -> Vec<Range<usize>> {
+        self.slabs.iter().map(|s| s.cell_range()).collect()
+    }
+
+    /// Every non-empty cell of slab `s` (cell index, mask, materials), in cell order: what
+    /// [`WorldView::for_each_brick`] visits of that slab, for a reader with a thread per slab.
+    pub fn visit_slab(&self, s: usize, f: &mut dyn FnMut(usize, &crate::Mask, BrickMaterials<'_>)) {
+        self.slabs[s].visit(f);
+    }
+
     /// Checks every invariant of every slab (tests use it after each step).
     pub fn validate(&self) -> std::result::Result<(), String> {
         for (w, s) in self.slabs.iter().enumerate() {

@@ -129,15 +129,16 @@ pub(super) fn to_string(scene: &Scene) -> String {
 
 fn model_record(id: ModelId, m: &Model) -> ModelRecord {
     let dims = model_dims(m.size()).expect("a model's size is within the grid limits");
-    let mut bricks: Vec<_> = m.bricks().collect();
-    bricks.sort_by_key(|(b, _)| dims.cell_index(*b));
+    // A model's bricks come in its grid's cell order, the payload's.
+    let mut count = 0u64;
     let data = payload::encode_bricks(&dims, |f| {
-        for (b, brick) in &bricks {
+        for (b, brick) in m.bricks() {
+            count += 1;
             match brick.uniform() {
-                Some(u) => f(*b, &brick.mask, BrickMaterials::Uniform(u)),
+                Some(u) => f(b, &brick.mask, BrickMaterials::Uniform(u)),
                 None => {
                     let v: Vec<u8> = brick.mask.ones().map(|bit| brick.material(bit)).collect();
-                    f(*b, &brick.mask, BrickMaterials::PerVoxel(&v));
+                    f(b, &brick.mask, BrickMaterials::PerVoxel(&v));
                 }
             }
         }
@@ -148,7 +149,7 @@ fn model_record(id: ModelId, m: &Model) -> ModelRecord {
         size: (s.x, s.y, s.z),
         voxels: VoxelRecord {
             encoding: ENCODING.into(),
-            bricks: bricks.len() as u64,
+            bricks: count,
             solid_voxels: m.solid_count(),
             data: base64::engine::general_purpose::STANDARD.encode(data),
         },
@@ -162,17 +163,32 @@ pub(super) fn from_str(s: &str, path: &Path, workers: usize) -> Result<Scene, Fo
     let file: ObjectsFile = ron::from_str(s).map_err(|e| invalid(format!("{e}")))?;
     let (params, dims, table) = header_of!(file).read(path)?;
     let tree = read_tree(&file.layers, &file.nodes).map_err(invalid)?;
+    let world = World::new(dims, WorldConfig::with_workers(workers)).map_err(world_error)?;
+    world
+        .replace_materials(table.clone())
+        .map_err(world_error)?;
+    // One object over the whole grid, unturned (what a new terrain or an opened grid
+    // saves as): its voxels go into the world as a grid's do, on the workers, and the
+    // model is taken back from the world; any other scene is built model by model and
+    // composited.
+    let sole = sole_grid_model(&tree, &file.models, dims.voxels());
     let mut models = BTreeMap::new();
     for r in &file.models {
         let at = |m: String| invalid(format!("model {}: {m}", r.id));
+        if Some(r.id) == sole {
+            write_grid_model(r, &world, &table, path).map_err(|e| at(e.to_string()))?;
+            continue;
+        }
         let model = read_model(r, &table, path).map_err(|e| at(e.to_string()))?;
         if models.insert(ModelId(r.id), model).is_some() {
             return Err(at("listed twice".into()));
         }
     }
-    let world = World::new(dims, WorldConfig::with_workers(workers)).map_err(world_error)?;
-    world.replace_materials(table).map_err(world_error)?;
-    let objects = Objects::new(tree, models, &world).map_err(|e| invalid(e.to_string()))?;
+    let objects = match sole {
+        Some(id) => Objects::adopting(tree, ModelId(id), models, &world),
+        None => Objects::new(tree, models, &world),
+    }
+    .map_err(|e| invalid(e.to_string()))?;
     world.take_dirty();
     let active = Scene::first_object(&objects);
     Ok(Scene::with_objects(world, objects, active, params))
@@ -237,6 +253,49 @@ fn read_tree(layers: &[Layer], nodes: &[NodeRecord]) -> Result<ObjectTree, Strin
         node.locked = n.locked;
     }
     Ok(tree)
+}
+
+/// The model that one drawn object places unturned over the whole grid, where that is the
+/// scene (the model listed once, of the grid's size, its first voxel at the origin).
+fn sole_grid_model(tree: &ObjectTree, records: &[ModelRecord], grid: IVec3) -> Option<u32> {
+    let [drawn] = tree.drawn()[..] else {
+        return None;
+    };
+    let mut of_it = records.iter().filter(|r| r.id == drawn.model.0);
+    let (Some(r), None) = (of_it.next(), of_it.next()) else {
+        return None;
+    };
+    let size = IVec3::new(r.size.0, r.size.1, r.size.2);
+    (size == grid
+        && drawn.placement.rot == brickmap::objects::Orientation::IDENTITY
+        && drawn.placement.place(IVec3::ZERO, size) == IVec3::ZERO)
+        .then_some(r.id)
+}
+
+/// The grid-sized model's voxels written into the (empty) world directly, checked as a
+/// model's are (every brick against the grid and the table, the solid count).
+fn write_grid_model(
+    r: &ModelRecord,
+    world: &World,
+    table: &MaterialTable,
+    path: &Path,
+) -> Result<(), FormatError> {
+    let world_error = |e: brickmap::BrickmapError| FormatError::world(path, e);
+    let bricks = r.voxels.bricks(&world.dims(), table.len(), path)?;
+    world
+        .apply(brickmap::terrain::set_bricks(bricks))
+        .map_err(world_error)?;
+    let solid = world.read().solid_count();
+    if solid != r.voxels.solid_voxels {
+        return Err(FormatError::invalid(
+            path,
+            format!(
+                "voxels hold {solid} solid voxels, the header says {}",
+                r.voxels.solid_voxels
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// A model from its record, every brick checked against the model's size and the table.
