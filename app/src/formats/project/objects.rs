@@ -20,7 +20,6 @@ use super::{
     layout, list, payload,
 };
 use crate::scene::Scene;
-use base64::Engine;
 use brickmap::objects::{
     Layer, LayerId, Model, ModelId, NewNode, NodeId, NodeKind, ObjectTree, Objects, Placement,
 };
@@ -123,7 +122,7 @@ pub(super) fn to_string(scene: &Scene) -> String {
     let mut fields = header(scene, OBJECTS_VERSION);
     fields.push(("layers", list(tree.layers(), 1)));
     fields.push(("nodes", list(&nodes, 1)));
-    fields.push(("models", list(&models, 1)));
+    fields.push(("models", models_list(&models)));
     layout(&fields)
 }
 
@@ -151,9 +150,41 @@ fn model_record(id: ModelId, m: &Model) -> ModelRecord {
             encoding: ENCODING.into(),
             bricks: count,
             solid_voxels: m.solid_count(),
-            data: base64::engine::general_purpose::STANDARD.encode(data),
+            data: super::base64_on_cores(&data),
         },
     }
+}
+
+impl ModelRecord {
+    /// The record in ron's compact form, as `ron` writes it (the payload unescaped: see
+    /// `VoxelRecord::text`).
+    fn text(&self) -> String {
+        let (x, y, z) = self.size;
+        let voxels = self.voxels.text();
+        let mut t = String::with_capacity(voxels.len() + 64);
+        t.push_str(&format!(
+            "(id: {}, size: ({x}, {y}, {z}), voxels: ",
+            self.id
+        ));
+        t.push_str(&voxels);
+        t.push(')');
+        t
+    }
+}
+
+/// The models as `list(models, 1)` lays them out.
+fn models_list(models: &[ModelRecord]) -> String {
+    let mut t = String::from("[\n");
+    for (i, m) in models.iter().enumerate() {
+        if i > 0 {
+            t.push('\n');
+        }
+        t.push_str("        ");
+        t.push_str(&m.text());
+        t.push(',');
+    }
+    t.push_str("\n    ]");
+    t
 }
 
 /// Parses version 2 project text (`path` only names it in errors).
@@ -316,4 +347,26 @@ fn read_model(r: &ModelRecord, table: &MaterialTable, path: &Path) -> Result<Mod
         )));
     }
     Ok(model)
+}
+
+#[cfg(test)]
+mod text_tests {
+    use super::*;
+
+    #[test]
+    fn models_read_as_ron_writes_them() {
+        let record = |id| ModelRecord {
+            id,
+            size: (9, 16, 2048),
+            voxels: VoxelRecord {
+                encoding: ENCODING.into(),
+                bricks: 3,
+                solid_voxels: 77,
+                data: "VlhCMQ+/=".into(),
+            },
+        };
+        let models = [record(3), record(40)];
+        assert_eq!(models_list(&models), list(&models, 1));
+        assert_eq!(models_list(&[]), list::<ModelRecord>(&[], 1));
+    }
 }
