@@ -3,9 +3,9 @@
 //! with dynamic rendering, then presented. The frame loop's GPU half; it never blocks on the
 //! GPU except when asked for a capture.
 
-use crate::viewport::{FrameRequest, FrameStatus, Viewport};
+use crate::viewport::{FrameRequest, FrameStatus, Paced, TracedImage, Viewport};
 use crate::vulkan::buffer::HostBuffer;
-use crate::vulkan::frame::FRAMES_IN_FLIGHT;
+use crate::vulkan::frame::{FRAMES_IN_FLIGHT, FrameSlot};
 use crate::vulkan::swapchain::{COLOUR, Swapchain, is_bgra};
 use crate::vulkan::{GpuContext, GpuError, vk_call};
 use ash::vk;
@@ -13,6 +13,9 @@ use brickmap::World;
 use egui_ash_renderer::{DynamicRendering, Options, RenderMode, Renderer, allocator::GpuAllocator};
 use gpu_allocator::MemoryLocation;
 use std::sync::Arc;
+
+mod target;
+use target::{Offscreen, Target};
 
 /// What egui drew this frame.
 pub struct EguiFrame<'a> {
@@ -24,15 +27,42 @@ pub struct EguiFrame<'a> {
     pub textures: &'a egui::TexturesDelta,
 }
 
-/// What a call to [`Presenter::frame`] did.
-#[derive(Debug)]
+/// What the display of a call to [`Presenter::frame`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Presented {
     /// A frame went to the screen.
-    Shown(FrameStatus),
+    Shown,
+    /// No display was asked for ([`Show::Skip`]).
+    Skipped,
     /// Nothing was drawn: no frame slot or image was free yet (try again soon).
     NotReady,
     /// The swapchain was out of date and has been recreated; draw again.
     Recreated,
+}
+
+/// Whether a call to [`Presenter::frame`] displays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Show {
+    /// Only the trace's pace: nothing on screen changed.
+    Skip,
+    /// The UI and the latest finished traced image.
+    Show,
+    /// The image of the job just submitted (waited for), captured.
+    Capture,
+}
+
+/// What a call to [`Presenter::frame`] did.
+pub struct Framed {
+    /// The display.
+    pub presented: Presented,
+    /// The trace job submitted (None: the one in flight comes first, or nothing changed).
+    pub traced: Option<FrameStatus>,
+    /// Nothing would have changed the image: no job was needed.
+    pub idle: bool,
+    /// The traced image the display showed (None: none finished yet, or no display).
+    pub image: Option<TracedImage>,
+    /// The presented pixels ([`Show::Capture`]).
+    pub capture: Option<Capture>,
 }
 
 /// A captured frame: RGB8 rows top to bottom, exactly what was presented.
@@ -52,6 +82,11 @@ pub struct Presenter {
     upload_pool: vk::CommandPool,
     /// egui textures to free once the slot that last used them finished.
     to_free: [Vec<egui::TextureId>; FRAMES_IN_FLIGHT],
+    /// The display's own frame slots (the viewport's are its trace jobs').
+    slots: Vec<FrameSlot>,
+    next: usize,
+    /// Wait for each trace job before displaying ([`Presenter::set_synchronous`]).
+    synchronous: bool,
     recreate: bool,
     size: (u32, u32),
     ctx: Arc<GpuContext>,
@@ -110,6 +145,9 @@ impl Presenter {
             egui: Some(egui),
             upload_pool,
             to_free: Default::default(),
+            slots: Vec::new(),
+            next: 0,
+            synchronous: false,
             recreate: false,
             size,
             ctx,
@@ -141,10 +179,13 @@ impl Presenter {
         Ok(())
     }
 
-    /// Draws one frame: the viewport's trace and display in `area` (x, y, width, height in
-    /// pixels, clamped to the image; None: the whole image) with the rest cleared to the
-    /// panels' grey, egui on top, presented. With `capture`, waits for the frame and returns
-    /// the presented pixels.
+    /// Draws one frame: the viewport's next trace job when its pace allows
+    /// ([`Viewport::trace_paced`]), then — unless `show` is [`Show::Skip`] — the display:
+    /// the latest *finished* traced image in `area` (x, y, width, height in pixels, clamped
+    /// to the image; None: the whole image) with the rest cleared to the panels' grey, egui
+    /// on top, presented. Never waits for the trace, except for [`Show::Capture`] (the frame
+    /// shows the job just submitted and returns the presented pixels) and a synchronous
+    /// presenter ([`Presenter::set_synchronous`]).
     pub fn frame(
         &mut self,
         viewport: &mut Viewport,
@@ -152,32 +193,86 @@ impl Presenter {
         req: &FrameRequest<'_>,
         area: Option<(u32, u32, u32, u32)>,
         ui: Option<EguiFrame<'_>>,
-        capture: bool,
-    ) -> Result<(Presented, Option<Capture>), GpuError> {
+        show: Show,
+    ) -> Result<Framed, GpuError> {
+        let mut framed = Framed {
+            presented: Presented::NotReady,
+            traced: None,
+            idle: false,
+            image: None,
+            capture: None,
+        };
         if self.size.0 == 0 || self.size.1 == 0 {
-            return Ok((Presented::NotReady, None));
+            return Ok(framed);
         }
         if self.recreate {
             self.recreate_now(viewport)?;
-            return Ok((Presented::Recreated, None));
+            framed.presented = Presented::Recreated;
+            return Ok(framed);
         }
-        let Some(frame) = viewport.begin_frame()? else {
-            return Ok((Presented::NotReady, None));
+        let target = self.target.as_ref().expect("made in new");
+        let (extent, format) = (target.extent(), target.format());
+        let area = clamp_area(area, extent);
+        let req = FrameRequest {
+            output: (area.extent.width, area.extent.height),
+            bgra: is_bgra(format),
+            ..*req
         };
+        match viewport.trace_paced(world, &req)? {
+            Paced::Traced(status) => framed.traced = Some(status),
+            Paced::Idle => framed.idle = true,
+            Paced::Busy => {}
+        }
+        let capture = show == Show::Capture;
+        if capture || self.synchronous {
+            viewport.wait_idle()?;
+        }
+        if show == Show::Skip {
+            framed.presented = Presented::Skipped;
+            return Ok(framed);
+        }
+        self.display(viewport, area, ui, capture, &mut framed)?;
+        Ok(framed)
+    }
+
+    /// A synchronous presenter waits for each trace job before the frame that shows it
+    /// (headless drivers and tests: each frame shows the state it was asked for).
+    pub fn set_synchronous(&mut self, synchronous: bool) {
+        self.synchronous = synchronous;
+    }
+
+    /// The display half of [`Presenter::frame`]: its own frame slot, so that it waits for
+    /// nothing but the previous display of that slot.
+    fn display(
+        &mut self,
+        viewport: &mut Viewport,
+        area: vk::Rect2D,
+        ui: Option<EguiFrame<'_>>,
+        capture: bool,
+        framed: &mut Framed,
+    ) -> Result<(), GpuError> {
         let ctx = self.ctx.clone();
         let d = &ctx.device;
+        while self.slots.len() < FRAMES_IN_FLIGHT {
+            self.slots.push(FrameSlot::new(&ctx)?);
+        }
+        let slot_index = self.next;
+        if !self.slots[slot_index].ready(&ctx)? {
+            return Ok(());
+        }
         let egui = self.egui.as_mut().expect("alive until drop");
         // The slot finished: textures freed by its last frame can go now.
-        for id in self.to_free[frame.slot()].drain(..) {
+        for id in self.to_free[slot_index].drain(..) {
             let _ = egui.free_texture(id);
         }
         let target = self.target.as_ref().expect("made in new");
+        let acquired = self.slots[slot_index].acquired;
         let (index, suboptimal) = match target {
-            Target::Window(swapchain) => match swapchain.acquire(frame.acquired)? {
+            Target::Window(swapchain) => match swapchain.acquire(acquired)? {
                 Some(acquired) => acquired,
                 None => {
                     self.recreate = true;
-                    return Ok((Presented::NotReady, None));
+                    return Ok(());
                 }
             },
             Target::Offscreen(_) => (0, false),
@@ -191,16 +286,14 @@ impl Presenter {
             }
         }
         let (extent, format) = (target.extent(), target.format());
-        let area = clamp_area(area, extent);
-        let req = FrameRequest {
-            output: (area.extent.width, area.extent.height),
-            bgra: is_bgra(format),
-            ..*req
-        };
-        let whole = area.extent == extent;
-        let status = viewport.trace_frame(&frame, world, &req)?;
+        let shown = viewport.shown_image()?;
+        framed.image = shown.map(|s| s.image);
+        // The traced image fills the area when it was traced for it; otherwise (the first
+        // frames, a resize) its part that fits, the rest grey.
+        let fills = shown.is_some_and(|s| s.image.size == (area.extent.width, area.extent.height));
+        let whole = area.extent == extent && fills;
         let (image, view) = target.image(index);
-        let cmd = frame.cmd;
+        let cmd = self.slots[slot_index].begin(&ctx)?;
         let capture_buffer = if capture {
             Some(HostBuffer::new(
                 &ctx,
@@ -253,19 +346,25 @@ impl Presenter {
                     crate::vulkan::barrier::Scope::TRANSFER_WRITE,
                 );
             }
-            let mut copy = whole_image(area.extent);
-            copy.image_offset = vk::Offset3D {
-                x: area.offset.x,
-                y: area.offset.y,
-                z: 0,
-            };
-            d.cmd_copy_buffer_to_image(
-                cmd,
-                viewport.output(&frame),
-                image,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &[copy],
-            );
+            if let Some(s) = shown {
+                let mut copy = whole_image(vk::Extent2D {
+                    width: s.image.size.0.min(area.extent.width),
+                    height: s.image.size.1.min(area.extent.height),
+                });
+                copy.buffer_row_length = s.image.size.0;
+                copy.image_offset = vk::Offset3D {
+                    x: area.offset.x,
+                    y: area.offset.y,
+                    z: 0,
+                };
+                d.cmd_copy_buffer_to_image(
+                    cmd,
+                    s.buffer,
+                    image,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &[copy],
+                );
+            }
             image_barrier(
                 d,
                 cmd,
@@ -368,13 +467,13 @@ impl Presenter {
                 );
             }
         }
-        let slot = frame.slot();
+        let slot = &mut self.slots[slot_index];
         match target {
             Target::Window(swapchain) => {
-                viewport.submit_frame(
-                    frame,
+                slot.submit(
+                    &ctx,
                     &[(
-                        frame.acquired,
+                        acquired,
                         vk::PipelineStageFlags::TRANSFER
                             | vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT,
                     )],
@@ -384,37 +483,36 @@ impl Presenter {
                     self.recreate = true;
                 }
             }
-            Target::Offscreen(_) => viewport.submit_frame(frame, &[], &[])?,
+            Target::Offscreen(_) => slot.submit(&ctx, &[], &[])?,
         }
+        self.next = (slot_index + 1) % FRAMES_IN_FLIGHT;
         if let Some(ui) = &ui {
-            self.to_free[slot].extend(ui.textures.free.iter().copied());
+            self.to_free[slot_index].extend(ui.textures.free.iter().copied());
         }
-        let captured = match capture_buffer {
-            Some(buf) => {
-                let waited = viewport.wait_idle();
-                let bgra = is_bgra(format);
-                let rgb = buf
-                    .read()
-                    .chunks_exact(4)
-                    .map(|p| {
-                        if bgra {
-                            [p[2], p[1], p[0]]
-                        } else {
-                            [p[0], p[1], p[2]]
-                        }
-                    })
-                    .collect();
-                buf.destroy(&ctx);
-                waited?;
-                Some(Capture {
-                    width: extent.width,
-                    height: extent.height,
-                    rgb,
+        framed.presented = Presented::Shown;
+        if let Some(buf) = capture_buffer {
+            let waited = self.slots[slot_index].wait(&ctx);
+            let bgra = is_bgra(format);
+            let rgb = buf
+                .read()
+                .chunks_exact(4)
+                .map(|p| {
+                    if bgra {
+                        [p[2], p[1], p[0]]
+                    } else {
+                        [p[0], p[1], p[2]]
+                    }
                 })
-            }
-            None => None,
-        };
-        Ok((Presented::Shown(status), captured))
+                .collect();
+            buf.destroy(&ctx);
+            waited?;
+            framed.capture = Some(Capture {
+                width: extent.width,
+                height: extent.height,
+                rgb,
+            });
+        }
+        Ok(())
     }
 }
 
@@ -448,132 +546,6 @@ fn whole_image(extent: vk::Extent2D) -> vk::BufferImageCopy {
             height: extent.height,
             depth: 1,
         },
-    }
-}
-
-/// Where frames go: a window's swapchain or an offscreen image.
-enum Target {
-    Window(Swapchain),
-    Offscreen(Offscreen),
-}
-
-impl Target {
-    fn format(&self) -> vk::Format {
-        match self {
-            Target::Window(s) => s.format,
-            Target::Offscreen(o) => o.format,
-        }
-    }
-
-    fn extent(&self) -> vk::Extent2D {
-        match self {
-            Target::Window(s) => s.extent,
-            Target::Offscreen(o) => o.extent,
-        }
-    }
-
-    /// Image `index` and its view.
-    fn image(&self, index: u32) -> (vk::Image, vk::ImageView) {
-        match self {
-            Target::Window(s) => (s.images[index as usize], s.views[index as usize]),
-            Target::Offscreen(o) => (o.image, o.view),
-        }
-    }
-}
-
-/// A device-local image of the window's size and format, for headless frames.
-struct Offscreen {
-    image: vk::Image,
-    view: vk::ImageView,
-    allocation: Option<gpu_allocator::vulkan::Allocation>,
-    extent: vk::Extent2D,
-    format: vk::Format,
-    ctx: Arc<GpuContext>,
-}
-
-impl Offscreen {
-    fn new(ctx: Arc<GpuContext>, (w, h): (u32, u32)) -> Result<Self, GpuError> {
-        let format = vk::Format::B8G8R8A8_UNORM;
-        let extent = vk::Extent2D {
-            width: w.max(1),
-            height: h.max(1),
-        };
-        let info = vk::ImageCreateInfo::default()
-            .image_type(vk::ImageType::TYPE_2D)
-            .format(format)
-            .extent(vk::Extent3D {
-                width: extent.width,
-                height: extent.height,
-                depth: 1,
-            })
-            .mip_levels(1)
-            .array_layers(1)
-            .samples(vk::SampleCountFlags::TYPE_1)
-            .tiling(vk::ImageTiling::OPTIMAL)
-            .usage(
-                vk::ImageUsageFlags::COLOR_ATTACHMENT
-                    | vk::ImageUsageFlags::TRANSFER_DST
-                    | vk::ImageUsageFlags::TRANSFER_SRC,
-            )
-            .initial_layout(vk::ImageLayout::UNDEFINED);
-        // SAFETY: the create info outlives the call; destroyed in Drop.
-        let image = vk_call("vkCreateImage", unsafe {
-            ctx.device.create_image(&info, None)
-        })?;
-        let mut me = Self {
-            image,
-            view: vk::ImageView::null(),
-            allocation: None,
-            extent,
-            format,
-            ctx: ctx.clone(),
-        };
-        // SAFETY: plain query on a live image.
-        let requirements = unsafe { ctx.device.get_image_memory_requirements(image) };
-        let allocation = ctx.allocator.lock().expect("allocator lock").allocate(
-            &gpu_allocator::vulkan::AllocationCreateDesc {
-                name: "offscreen target",
-                requirements,
-                location: MemoryLocation::GpuOnly,
-                linear: false,
-                allocation_scheme: gpu_allocator::vulkan::AllocationScheme::GpuAllocatorManaged,
-            },
-        )?;
-        // SAFETY: the allocation satisfies the image's requirements.
-        let bound = unsafe {
-            ctx.device
-                .bind_image_memory(image, allocation.memory(), allocation.offset())
-        };
-        me.allocation = Some(allocation);
-        vk_call("vkBindImageMemory", bound)?;
-        let view = vk::ImageViewCreateInfo::default()
-            .image(image)
-            .view_type(vk::ImageViewType::TYPE_2D)
-            .format(format)
-            .subresource_range(COLOUR);
-        // SAFETY: as above.
-        me.view = vk_call("vkCreateImageView", unsafe {
-            ctx.device.create_image_view(&view, None)
-        })?;
-        Ok(me)
-    }
-}
-
-impl Drop for Offscreen {
-    fn drop(&mut self) {
-        // SAFETY: the device is idle after the wait; view, image, then its memory.
-        unsafe {
-            let _ = self.ctx.device.device_wait_idle();
-            if self.view != vk::ImageView::null() {
-                self.ctx.device.destroy_image_view(self.view, None);
-            }
-            self.ctx.device.destroy_image(self.image, None);
-        }
-        if let Some(a) = self.allocation.take()
-            && let Ok(mut allocator) = self.ctx.allocator.lock()
-        {
-            let _ = allocator.free(a);
-        }
     }
 }
 
@@ -626,6 +598,9 @@ impl Drop for Presenter {
         // target (its own Drop).
         unsafe {
             let _ = self.ctx.device.device_wait_idle();
+            for s in self.slots.drain(..) {
+                s.destroy(&self.ctx);
+            }
             drop(self.egui.take());
             self.ctx.device.destroy_command_pool(self.upload_pool, None);
         }

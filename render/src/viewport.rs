@@ -22,7 +22,7 @@ use crate::vulkan::progressive::Progressive;
 pub use crate::vulkan::progressive::{RenderHow, Rendered};
 use crate::vulkan::temporal::Temporal;
 use crate::vulkan::tonemap::ToneMapper;
-use crate::vulkan::trace::{Dim, PathTracer, TraceParams, Variant, Window};
+use crate::vulkan::trace::{Band, Dim, PathTracer, TraceParams, Variant, Window};
 use crate::vulkan::world::{GpuWorld, UploadReport};
 use crate::vulkan::{GpuContext, GpuError};
 use ash::vk;
@@ -31,7 +31,9 @@ use std::mem::ManuallyDrop;
 use std::sync::Arc;
 
 mod denoised;
+mod paced;
 pub use denoised::DenoisedRender;
+pub use paced::{Paced, SLOW_JOB, ShownImage, TracedImage};
 
 /// The most bytes per traced pixel one buffer of a frame holds (the denoiser's guides; the
 /// accumulation holds 16): the internal size is fitted so that it stays within the device's
@@ -119,6 +121,10 @@ pub struct Viewport {
     /// What the last denoised frame's filter read when it was not the accumulation (the
     /// temporal history or handover).
     filter_input: Option<Binding>,
+    /// The interactive loop's jobs and the images they leave ([`Viewport::trace_paced`]).
+    pacing: paced::Pacing,
+    /// Whether the last recorded frame traced its band (not held by an upload).
+    banded: bool,
     ctx: Arc<GpuContext>,
 }
 
@@ -185,6 +191,8 @@ impl Viewport {
             temporal: None,
             scene_key: None,
             filter_input: None,
+            pacing: Default::default(),
+            banded: false,
             ctx,
         })
     }
@@ -284,7 +292,8 @@ impl Viewport {
         self.live.as_ref().map_or(0, |l| l.samples())
     }
 
-    /// GPU time of the last interactive frame that finished (timestamp queries).
+    /// GPU time of the last interactive frame that finished (timestamp queries); of a
+    /// sample pass traced in bands ([`Viewport::trace_paced`]), the sum of its bands.
     pub fn last_gpu_seconds(&self) -> Option<f64> {
         self.last_gpu_seconds
     }
@@ -342,8 +351,10 @@ impl Viewport {
         if !s.ready(&self.ctx)? {
             return Ok(None);
         }
-        if let Some(t) = s.gpu_seconds(&self.ctx) {
-            self.last_gpu_seconds = Some(t);
+        if let Some(t) = s.gpu_seconds(&self.ctx)
+            && let Some(pass) = self.pacing.timed(slot, t)
+        {
+            self.last_gpu_seconds = Some(pass);
         }
         let cmd = s.begin(&self.ctx)?;
         Ok(Some(Frame {
@@ -371,8 +382,22 @@ impl Viewport {
         world: &World,
         req: &FrameRequest<'_>,
     ) -> Result<FrameStatus, GpuError> {
+        let upload = self.world.update(&self.ctx.clone(), world)?;
+        self.record_frame(frame, world, req, upload, Band::WHOLE)
+    }
+
+    /// [`Viewport::trace_frame`] after the world's upload, tracing `band` of the image's
+    /// rows: a band before the last records only its part of the samples (no denoiser, no
+    /// display pass; `self.banded` says whether it did).
+    fn record_frame(
+        &mut self,
+        frame: &Frame,
+        world: &World,
+        req: &FrameRequest<'_>,
+        upload: UploadReport,
+        band: Band,
+    ) -> Result<FrameStatus, GpuError> {
         let ctx = self.ctx.clone();
-        let upload = self.world.update(&ctx, world)?;
         if upload.grew {
             // The grown world waited for the GPU: every slot's sets may go.
             for s in &mut self.frames {
@@ -430,8 +455,16 @@ impl Viewport {
         };
         let only_camera = !upload.changed() && self.scene_key == Some(key);
         self.scene_key = Some(key);
+        let ldr_bytes = output.0 as u64 * output.1 as u64 * 4;
+        if self.frames[frame.slot]
+            .ldr
+            .as_ref()
+            .is_some_and(|b| b.size < ldr_bytes)
+        {
+            paced::idle_for_output(&ctx)?;
+        }
         let slot = &mut self.frames[frame.slot];
-        slot.ensure_ldr(&ctx, output.0 as u64 * output.1 as u64 * 4)?;
+        slot.ensure_ldr(&ctx, ldr_bytes)?;
         // SAFETY: recording; earlier frames' and the staging ring's writes (same queue,
         // earlier in submission order) come before this frame's reads and writes.
         unsafe { after_earlier_passes(&ctx, frame.cmd) };
@@ -450,8 +483,19 @@ impl Viewport {
                 (req.spp, req.target_spp),
                 &mut slot.uniforms,
                 &mut slot.sets,
+                band,
             )?
         };
+        self.banded = !hold;
+        if !band.is_last() && !hold {
+            // The display pass waits for the pass's last band.
+            return Ok(FrameStatus {
+                samples: live.samples(),
+                added,
+                restarted,
+                upload,
+            });
+        }
         // SAFETY: recording: the trace's writes before the display pass reads them.
         unsafe { between_passes(&ctx, frame.cmd) };
         let mut shown = live.accumulation();
@@ -545,6 +589,7 @@ impl Viewport {
         unsafe {
             barrier(&ctx, frame.cmd, Scope::SHADER_WRITE, Scope::TRANSFER_READ);
         }
+        self.pacing.recording(frame.slot, output, live.samples());
         Ok(FrameStatus {
             samples: live.samples(),
             added,
@@ -569,6 +614,7 @@ impl Viewport {
         signals: &[vk::Semaphore],
     ) -> Result<(), GpuError> {
         self.frames[frame.slot].submit(&self.ctx, waits, signals)?;
+        self.pacing.submitted(frame.slot);
         self.next = (frame.slot + 1) % FRAMES_IN_FLIGHT;
         Ok(())
     }

@@ -20,17 +20,13 @@ use super::jobs::Edit;
 use super::{Editor, Gfx, budget, files, panels, preview, selecting};
 use anyhow::{Context, Result};
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
-use render::present::{EguiFrame, Presented, Presenter};
-use render::viewport::{FrameRequest, Viewport};
-use render::vulkan::trace::Dim;
+use render::present::{EguiFrame, Presented, Presenter, Show};
+use render::viewport::Viewport;
 use render::vulkan::{ContextOptions, GpuContext, WindowHandles};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use winit::event_loop::ActiveEventLoop;
 use winit::window::Window;
-
-/// The weight of what lies outside the edited object's box when the others are dimmed.
-const DIM_FACTOR: f32 = 0.25;
 
 /// The frames' own state.
 pub(super) struct Frames {
@@ -42,6 +38,18 @@ pub(super) struct Frames {
     pub(super) budget: budget::FrameBudget,
     /// egui's texture changes, kept until a frame with the UI applies them.
     pub(super) textures: egui::TexturesDelta,
+    /// The trace job whose image the last frame showed.
+    pub(super) shown_job: Option<u64>,
+    /// When to look for the trace job's end again ([`Editor::pump_trace`]).
+    pub(super) pump_at: Option<Instant>,
+    /// The internal size and target samples the last frame asked for (pumped jobs ask
+    /// the same).
+    pub(super) asked: ((u32, u32), u32),
+    /// An input or a result (edit, file) came since the last trace job: the next job's
+    /// image is the first to show it.
+    pub(super) awaited: bool,
+    /// The trace job whose image first shows the last input or result.
+    pub(super) input_job: Option<u64>,
     /// Tests only: the frame that fails as if the device were lost
     /// (`VOXBRICK_TEST_GPU_FAILURE_AT_FRAME`), to check nothing is lost when the GPU fails.
     #[cfg(feature = "test-hooks")]
@@ -55,6 +63,11 @@ impl Frames {
             last_added: 0,
             budget: Default::default(),
             textures: Default::default(),
+            shown_job: None,
+            pump_at: None,
+            asked: ((1, 1), 1),
+            awaited: false,
+            input_job: None,
             #[cfg(feature = "test-hooks")]
             fail_at: std::env::var("VOXBRICK_TEST_GPU_FAILURE_AT_FRAME")
                 .ok()
@@ -176,9 +189,11 @@ impl Editor {
     pub(super) fn take_results(&mut self) {
         while let Ok(done) = self.files.done.try_recv() {
             self.file_done(done);
+            self.frames.awaited = true;
         }
         while let Ok(edited) = self.edits.done.try_recv() {
             self.edited(edited);
+            self.frames.awaited = true;
         }
         self.render_finished();
         if !self.edits.busy() {
@@ -494,7 +509,7 @@ impl Editor {
         let moving = self.motion.is_moving() || self.pointer.is_drawing();
         let still = internal;
         let internal = if moving {
-            self.budgeted(scaled(
+            self.budgeted(super::pacing::scaled(
                 shown,
                 self.settings.moving_scale.min(self.settings.internal_scale),
             ))
@@ -515,71 +530,54 @@ impl Editor {
         } else {
             self.settings.target_spp
         };
+        self.frames.asked = (internal, target_spp);
         let doc = self.doc.clone();
         let doc = doc.read().unwrap_or_else(|p| p.into_inner());
         let mut params = doc.scene.params.clone();
         params.camera = self.viewing.camera.camera.clone();
-        let request = FrameRequest {
-            params: &params,
-            internal,
-            output: shown,
-            spp: self.frames.budget.spp,
-            target_spp,
-            exposure: doc.scene.params.settings.exposure + self.settings.exposure,
-            bgra: false,
-            // A script run's capture is compared with headless renders: never denoised.
-            denoise: self.settings.denoise && self.script.is_none(),
-            reproject: self.settings.reproject,
-            // Likewise never dimmed.
-            dim: (self.settings.dim_others
-                && self.script.is_none()
-                && self.settings.brush.tool != super::tools::Tool::Arrange)
-                .then(|| super::arranging::edited_box(&doc.scene))
-                .flatten()
-                .map(|(lo, hi)| Dim {
-                    lo,
-                    hi,
-                    factor: DIM_FACTOR,
-                }),
-            grid: (self.settings.grid && self.script.is_none())
-                .then_some(self.settings.grid_spacing as f32),
-        };
+        let request = self.request(&doc, &params, internal, shown, target_spp);
         let ui = (!capture_now).then(|| EguiFrame {
             primitives: &primitives,
             pixels_per_point,
             textures: &self.frames.textures,
         });
-        let (presented, captured) = gfx.presenter.frame(
+        let framed = gfx.presenter.frame(
             &mut gfx.viewport,
             &doc.scene.world,
             &request,
             Some(self.viewing.area()),
             ui,
-            capture_now,
+            if capture_now {
+                Show::Capture
+            } else {
+                Show::Show
+            },
         )?;
         drop(doc);
-        match &presented {
-            Presented::Shown(status) => {
+        self.traced(gfx, &framed, (still, internal));
+        match framed.presented {
+            Presented::Shown => {
                 if !capture_now {
                     self.frames.textures.clear();
                 }
-                self.frames.last_added = status.added;
+                self.frames.shown_job = framed.image.map(|i| i.job);
+                // "pending": the image shown is older than what the last input or result
+                // asked of the trace (the UI shows it already; the traced image follows).
+                let shown = framed.image.map_or(0, |i| i.job);
+                let pending =
+                    self.frames.awaited || self.frames.input_job.is_some_and(|j| shown < j);
                 self.report.line(format_args!(
-                    "frame {} spp {}",
+                    "frame {} spp {}{}",
                     self.frames.count,
-                    gfx.viewport.samples()
+                    framed.image.map_or(0, |i| i.samples),
+                    if pending { " pending" } else { "" }
                 ));
                 self.motion.shown();
-                // The budget reasons about the still image: a moving frame's time is scaled
-                // by the pixels it left out.
-                let ratio = (f64::from(still.0) * f64::from(still.1))
-                    / (f64::from(internal.0) * f64::from(internal.1)).max(1.0);
-                if status.added > 0 {
-                    self.adapt_samples(gfx.viewport.last_gpu_seconds().map(|t| t * ratio));
-                }
             }
+            Presented::Skipped => {}
             Presented::NotReady | Presented::Recreated => gfx.host.request_redraw(),
         }
+        let captured = framed.capture;
         if let Some(c) = captured {
             self.finish_capture(gfx, c)?;
         }
@@ -596,10 +594,15 @@ impl Editor {
         if self.quitting {
             self.exit = true;
         }
-        // Keep drawing while refining, moving, running a script or waiting for files.
+        // Keep drawing while moving, running a script or waiting for files; while refining,
+        // look again soon for the trace job's end (`pump_trace`): its image gets a frame then.
         // (Refinement that waits for the UI is not: the end of the wait wakes the loop.)
-        let busy = (gfx.viewport.samples() < self.settings.target_spp && !ui_first)
-            || moving
+        if (gfx.viewport.samples() < self.settings.target_spp && !ui_first)
+            || gfx.viewport.in_flight()? > 0
+        {
+            self.frames.pump_at = Some(Instant::now() + super::pacing::PUMP);
+        }
+        let busy = moving
             || self.flight.is_flying()
             || self.script.is_some()
             || !self.files.running.is_empty()
@@ -610,28 +613,6 @@ impl Editor {
             gfx.host.request_redraw();
         }
         Ok(())
-    }
-
-    /// The traced size for a viewport of `size`: the internal scale, then the budget's.
-    pub(super) fn internal_size(&self, size: (u32, u32)) -> (u32, u32) {
-        self.budgeted(scaled(size, self.settings.internal_scale))
-    }
-
-    /// `internal` scaled by the frame budget (not in a script run: its capture is compared
-    /// with renders at the internal scale).
-    fn budgeted(&self, internal: (u32, u32)) -> (u32, u32) {
-        if self.script.is_some() {
-            internal
-        } else {
-            self.frames.budget.apply(internal)
-        }
-    }
-
-    /// Samples per frame and the traced resolution follow the GPU time ([`budget`]).
-    pub(super) fn adapt_samples(&mut self, gpu: Option<f64>) {
-        if let Some(t) = gpu {
-            self.frames.budget.update(t);
-        }
     }
 
     /// Runs the script's next step, one per frame, so the viewport shows each edit; a camera
@@ -672,14 +653,6 @@ impl Editor {
         }
         Ok(())
     }
-}
-
-pub(super) fn scaled((w, h): (u32, u32), f: f32) -> (u32, u32) {
-    let f = f.clamp(0.05, 1.0) as f64;
-    (
-        ((w as f64 * f).ceil() as u32).max(1),
-        ((h as f64 * f).ceil() as u32).max(1),
-    )
 }
 
 /// A rectangle in points as whole pixels inside a window of `size`: at least one pixel.

@@ -48,6 +48,7 @@ impl Editor {
     pub(super) fn handle_logged(&mut self, input: Input, consumed: bool) {
         let line = self.report.on().then(|| input.report_line()).flatten();
         self.handle_input(input, consumed);
+        self.frames.awaited = true;
         if let Some(line) = line {
             self.report.line(format_args!("input {line}"));
         }

@@ -40,7 +40,9 @@ impl Editor {
         .context("no usable Vulkan device")?;
         let ctx = Arc::new(ctx);
         let size = (size.0.max(1), size.1.max(1));
-        let presenter = Presenter::offscreen(ctx.clone(), size)?;
+        let mut presenter = Presenter::offscreen(ctx.clone(), size)?;
+        // Each headless frame shows what it was asked to (tests look at it).
+        presenter.set_synchronous(true);
         editor.attach(ctx, presenter, Host::Headless(Headless::new(size)), size)?;
         Ok(editor)
     }

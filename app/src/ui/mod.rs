@@ -40,6 +40,7 @@ mod measure;
 mod motion;
 mod object_menu;
 pub mod outliner;
+mod pacing;
 mod paint_panel;
 pub mod panels;
 mod pending;
@@ -507,6 +508,17 @@ impl ApplicationHandler<Wake> for Editor {
             } else {
                 self.ui_touched = None;
                 self.request_redraw();
+            }
+        }
+        // A trace job in flight: look for its end soon (its image, or the next job).
+        if let Some(t) = self.frames.pump_at {
+            if t <= Instant::now() {
+                if let Err(e) = self.pump_trace() {
+                    self.gpu_failed(e);
+                }
+            }
+            if let Some(t) = self.frames.pump_at {
+                wake = Some(wake.map_or(t, |w| w.min(t)));
             }
         }
         if let Some(w) = wake {

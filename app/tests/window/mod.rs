@@ -262,8 +262,12 @@ impl Report {
         }
     }
 
-    /// Waits until a frame is shown after every line consumed so far.
+    /// Waits until a frame is shown after every line consumed so far whose traced image
+    /// shows them too (not "pending": the trace runs at its own pace, and the frames in
+    /// between show the UI over the previous image).
     pub fn frame(&mut self) {
-        self.wait("a frame", |l| l.starts_with("frame "));
+        self.wait("a frame", |l| {
+            l.starts_with("frame ") && !l.ends_with(" pending")
+        });
     }
 }

@@ -21,6 +21,9 @@ use ash::vk;
 pub enum Dispatch {
     /// x × y × z groups.
     Groups(u32, u32, u32),
+    /// The rows of groups `y0..y1` of an x × (rows) × z dispatch (its group IDs as in the
+    /// whole one: a band of the image, so that a long dispatch can be submitted in parts).
+    Rows(u32, (u32, u32), u32),
     /// Read by the device from a buffer (three u32 at the offset).
     Indirect(vk::Buffer, u64),
 }
@@ -193,11 +196,12 @@ impl ComputePass {
             } else {
                 stage.specialization_info(&spec)
             };
+            // Any pass may be dispatched in bands of rows (`Dispatch::Rows`).
             let flags = if ctx.pipeline_stats.is_some() {
                 vk::PipelineCreateFlags::CAPTURE_STATISTICS_KHR
             } else {
                 vk::PipelineCreateFlags::empty()
-            };
+            } | vk::PipelineCreateFlags::DISPATCH_BASE;
             let info = [vk::ComputePipelineCreateInfo::default()
                 .flags(flags)
                 .stage(stage)
@@ -325,6 +329,9 @@ impl ComputePass {
             }
             match dispatch {
                 Dispatch::Groups(x, y, z) => d.cmd_dispatch(cmd, x, y, z),
+                Dispatch::Rows(x, (y0, y1), z) => {
+                    d.cmd_dispatch_base(cmd, 0, y0, 0, x, y1.saturating_sub(y0), z)
+                }
                 Dispatch::Indirect(buffer, offset) => d.cmd_dispatch_indirect(cmd, buffer, offset),
             }
         }

@@ -16,7 +16,9 @@
 use super::buffer::{Binding, HostBuffer, read_device};
 use super::pass::SetCache;
 use super::tonemap::ToneMapper;
-use super::trace::{MAX_SAMPLES_PER_DISPATCH, PathTracer, RayCounts, TraceParams, Variant, Window};
+use super::trace::{
+    Band, MAX_SAMPLES_PER_DISPATCH, PathTracer, RayCounts, TraceParams, Variant, Window,
+};
 use super::world::GpuWorld;
 use super::{GpuContext, GpuError};
 use crate::cpu::RenderJob;
@@ -269,7 +271,9 @@ impl Progressive {
     /// (fewer when the tracer's batch shape says so) into `cmd` with the frame slot's
     /// parameter buffer and sets, without submitting; restarts on a changed key. Returns
     /// (samples added, whether it restarted). `base` is [`TraceParams::new`] for this
-    /// accumulation's size, computed by the caller under a short world read lock.
+    /// accumulation's size, computed by the caller under a short world read lock. With a
+    /// `band` of several, only its rows are traced and the samples count once the last band
+    /// is recorded (the caller keeps `spp` for the whole pass).
     #[allow(clippy::too_many_arguments)]
     pub fn record_batch(
         &mut self,
@@ -282,6 +286,7 @@ impl Progressive {
         (spp, target): (u32, u32),
         uniforms: &mut HostBuffer,
         sets: &mut SetCache,
+        band: Band,
     ) -> Result<(u32, bool), GpuError> {
         self.check_key(&base, variant);
         let restarted = self.samples == 0;
@@ -295,7 +300,7 @@ impl Progressive {
             tracer.samples_per_dispatch_for(pixels, variant),
             tracer.sample_slices(pixels),
         );
-        if restarted && self.traced && self.fresh_restarts {
+        if restarted && self.traced && self.fresh_restarts && band.index == 0 {
             self.epoch = self.epoch.wrapping_add(1);
         }
         let epoch = if self.fresh_restarts { self.epoch } else { 0 };
@@ -313,7 +318,12 @@ impl Progressive {
             uniforms,
             self.accum.binding(),
             sets,
+            band,
         )?;
+        // A pass in bands has added its samples once its last band is recorded.
+        if !band.is_last() {
+            return Ok((0, restarted));
+        }
         self.samples += per * split;
         Ok((per * split, restarted))
     }

@@ -152,6 +152,34 @@ struct ShadowQueue {
     capacity: u64,
 }
 
+/// Which part of an image's rows one dispatch traces: band `index` of `count` equal bands of
+/// workgroup rows (count 1: the whole image). A sample pass in bands adds the same samples
+/// as one dispatch; it only lets each band be its own submission.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Band {
+    /// This band (0..count).
+    pub index: u32,
+    /// Bands in the pass.
+    pub count: u32,
+}
+
+impl Band {
+    /// The whole image in one dispatch.
+    pub const WHOLE: Band = Band { index: 0, count: 1 };
+
+    /// Whether this is the pass's last band (its samples are then complete).
+    pub fn is_last(&self) -> bool {
+        self.index + 1 >= self.count
+    }
+
+    /// This band's workgroup rows of `rows`.
+    pub fn rows(&self, rows: u32) -> (u32, u32) {
+        let count = self.count.max(1) as u64;
+        let at = |k: u64| (k * rows as u64 / count) as u32;
+        (at(self.index as u64), at(self.index as u64 + 1))
+    }
+}
+
 /// A dispatch ready to record: which pipelines, what they bind, how many groups.
 struct Plan {
     pass: (Variant, bool, bool),
@@ -451,8 +479,19 @@ impl PathTracer {
         uniforms: &mut HostBuffer,
         accum: Binding,
         sets: &mut SetCache,
+        band: Band,
     ) -> Result<(), GpuError> {
-        let plan = self.plan(ctx, world, variant, p, slices, uniforms, accum)?;
+        let mut plan = self.plan(ctx, world, variant, p, slices, uniforms, accum)?;
+        if band.count > 1 {
+            let Dispatch::Groups(x, y, z) = plan.groups else {
+                unreachable!("a plan dispatches groups")
+            };
+            plan.groups = Dispatch::Rows(x, band.rows(y), z);
+            // The sliced shader's zeroing of a new accumulation: once, before the first band.
+            if band.index > 0 {
+                plan.zero = None;
+            }
+        }
         let (trace, shadow) = self.passes_of(&plan);
         let trace_set = sets.get(ctx, trace, &plan.bound)?;
         let shadow_set = shadow.map(|s| sets.get(ctx, s, &plan.bound)).transpose()?;

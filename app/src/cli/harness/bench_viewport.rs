@@ -13,7 +13,7 @@ use anyhow::{Result, bail};
 use app::builtin::{SceneSize, default_scene, thesis_scene};
 use brickmap::World;
 use render::SceneParams;
-use render::present::{EguiFrame, Presented, Presenter};
+use render::present::{EguiFrame, Presented, Presenter, Show};
 use render::viewport::{FrameRequest, Viewport};
 use std::time::Instant;
 
@@ -260,8 +260,8 @@ fn run_case_ui(
                 textures: &pending,
             };
             let r = FrameRequest { params: &p, ..req };
-            let (shown, _) = presenter.frame(vp, world, &r, None, Some(ui), false)?;
-            if !matches!(shown, Presented::Shown(_)) {
+            let framed = presenter.frame(vp, world, &r, None, Some(ui), Show::Show)?;
+            if framed.presented != Presented::Shown {
                 std::thread::yield_now();
                 continue;
             }
