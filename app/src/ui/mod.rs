@@ -512,10 +512,10 @@ impl ApplicationHandler<Wake> for Editor {
         }
         // A trace job in flight: look for its end soon (its image, or the next job).
         if let Some(t) = self.frames.pump_at {
-            if t <= Instant::now() {
-                if let Err(e) = self.pump_trace() {
-                    self.gpu_failed(e);
-                }
+            if t <= Instant::now()
+                && let Err(e) = self.pump_trace()
+            {
+                self.gpu_failed(e);
             }
             if let Some(t) = self.frames.pump_at {
                 wake = Some(wake.map_or(t, |w| w.min(t)));
