@@ -9,7 +9,7 @@ use brickmap::{EditOp, Mode, Shape};
 use glam::{DVec3, IVec3};
 use render::cpu::RenderJob;
 use render::finished::{Finish, PictureError, Stop, relative_error};
-use render::viewport::{FrameRequest, RenderHow, Viewport};
+use render::viewport::{FrameRequest, Paced, RenderHow, Viewport};
 use render::vulkan::trace::Dim;
 use render::vulkan::{DeviceChoice, GpuContext};
 use std::sync::Arc;
@@ -538,5 +538,84 @@ fn a_noise_target_is_reached_as_a_converged_reference_measures_it() {
     }
     assert!(taken[1] >= 2 * taken[0], "{taken:?}");
     drop(vp);
+    assert_eq!(ctx.validation_errors(), 0);
+}
+
+/// Paced jobs until `done` (at most `limit` submitted), then waits for the device.
+fn paced(
+    vp: &mut Viewport,
+    world: &brickmap::World,
+    req: &FrameRequest<'_>,
+    limit: usize,
+    done: impl Fn(&Viewport) -> bool,
+) -> usize {
+    let mut submitted = 0;
+    for _ in 0..limit * 1000 {
+        if done(vp) || submitted >= limit {
+            break;
+        }
+        match vp.trace_paced(world, req).unwrap() {
+            Paced::Traced(_) => submitted += 1,
+            Paced::Busy => std::thread::sleep(std::time::Duration::from_millis(1)),
+            Paced::Idle => break,
+        }
+    }
+    vp.wait_idle().unwrap();
+    submitted
+}
+
+#[test]
+fn a_pass_traced_in_bands_is_the_whole_dispatchs_image_and_only_whole_passes_show() {
+    let Some(ctx) = context() else { return };
+    let (world, params) = common::showcase();
+    let size = (40, 24);
+    let req = request(&params, size, 1, 4);
+    let mut whole = Viewport::new(ctx.clone(), &world.read()).unwrap();
+    frames(&mut whole, &world, &req, 64, |v| v.samples() >= 4);
+    let mut banded = Viewport::new(ctx.clone(), &world.read()).unwrap();
+    banded.set_bands(Some(3));
+    let jobs = paced(&mut banded, &world, &req, 64, |v| v.samples() >= 4);
+    assert_eq!(jobs, 12, "four passes of three bands");
+    assert_eq!(banded.samples(), 4);
+    let shown = banded.shown_image().unwrap().expect("a finished image");
+    assert_eq!(shown.image.samples, 4, "the shown image is a whole pass's");
+    assert_eq!(shown.image.job, 4, "one image per pass");
+    let (a, b) = (
+        whole.live_hdr().unwrap().unwrap(),
+        banded.live_hdr().unwrap().unwrap(),
+    );
+    assert_eq!(a.pixels, b.pixels, "the same samples of the same pixels");
+    // Converged and unchanged: nothing to trace.
+    assert!(matches!(
+        banded.trace_paced(&world, &req).unwrap(),
+        Paced::Idle
+    ));
+    assert_eq!(ctx.validation_errors(), 0);
+}
+
+#[test]
+fn the_shown_image_is_the_last_finished_one_while_the_next_is_traced() {
+    let Some(ctx) = context() else { return };
+    let (world, params) = common::showcase();
+    let mut vp = Viewport::new(ctx.clone(), &world.read()).unwrap();
+    let small = request(&params, (16, 16), 1, 1);
+    assert_eq!(paced(&mut vp, &world, &small, 8, |v| v.samples() >= 1), 1);
+    let first = vp.shown_image().unwrap().expect("the first job finished");
+    // A long job (many samples of a larger image): until it is done the first stays shown,
+    // and asking never waits for it.
+    let long = request(&params, (256, 192), 16, 16);
+    assert!(matches!(
+        vp.trace_paced(&world, &long).unwrap(),
+        Paced::Traced(_)
+    ));
+    let meanwhile = vp.shown_image().unwrap().expect("still the first");
+    assert_eq!(
+        meanwhile.image, first.image,
+        "shown before the long job finished"
+    );
+    vp.wait_idle().unwrap();
+    let after = vp.shown_image().unwrap().expect("the long job finished");
+    assert_eq!(after.image.size, (256, 192));
+    assert!(after.image.job > first.image.job);
     assert_eq!(ctx.validation_errors(), 0);
 }

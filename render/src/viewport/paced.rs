@@ -81,6 +81,8 @@ pub(super) struct Pacing {
     pass_seconds: f64,
     /// GPU time of the last job read back.
     job_seconds: Option<f64>,
+    /// Bands of every new pass, fixed ([`Viewport::set_bands`]).
+    fixed_bands: Option<u32>,
 }
 
 impl Pacing {
@@ -186,10 +188,10 @@ impl Viewport {
             Some(pass) if !changed => pass,
             _ => {
                 let rows = self.fit_internal(req.internal).1.div_ceil(8);
-                let count = if converged {
-                    1
-                } else {
-                    Pacing::bands_for(self.last_gpu_seconds, rows)
+                let count = match self.pacing.fixed_bands {
+                    Some(n) => n.clamp(1, rows.max(1)),
+                    None if converged => 1,
+                    None => Pacing::bands_for(self.last_gpu_seconds, rows),
                 };
                 (Band { index: 0, count }, req.spp)
             }
@@ -208,6 +210,13 @@ impl Viewport {
         }
         self.submit_frame(frame, &[], &[])?;
         Ok(Paced::Traced(status))
+    }
+
+    /// Every new sample pass of [`Viewport::trace_paced`] in `bands` bands (at most one per
+    /// row of workgroups) instead of as many as its GPU time asks (None): tests and
+    /// measurements.
+    pub fn set_bands(&mut self, bands: Option<u32>) {
+        self.pacing.fixed_bands = bands;
     }
 
     /// The job whose image will show what the jobs submitted so far traced: the last one
