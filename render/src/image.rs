@@ -3,6 +3,8 @@
 
 use std::io::Write;
 
+pub mod parallel_png;
+
 /// A linear RGB image, rows top to bottom.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
@@ -155,14 +157,12 @@ pub fn write_png_rgb8(
     height: u32,
     rgb: &[u8],
 ) -> std::io::Result<()> {
-    let mut encoder = png::Encoder::new(out, width, height);
-    encoder.set_color(png::ColorType::Rgb);
-    encoder.set_depth(png::BitDepth::Eight);
-    let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
-    writer
-        .write_image_data(rgb)
-        .map_err(std::io::Error::other)?;
-    writer.finish().map_err(std::io::Error::other)
+    let layout = parallel_png::Layout {
+        channels: 3,
+        deep: false,
+        srgb: false,
+    };
+    parallel_png::write(out, width, height, layout, rgb)
 }
 
 #[cfg(test)]

@@ -115,46 +115,50 @@ fn write_png(
     let scale = 2f32.powf(exposure);
     let alpha = picture.alpha.as_deref();
     let channels = if alpha.is_some() { 4 } else { 3 };
+    let bytes_per_pixel = channels * if deep { 2 } else { 1 };
     let max = if deep { 65535.0 } else { 255.0 };
-    let mut values: Vec<f32> = Vec::with_capacity(img.pixels.len() * channels);
-    for (i, p) in img.pixels.iter().enumerate() {
+    let quantise = |v: f32| (v.clamp(0.0, 1.0) * max + 0.5) as u32;
+    // One pixel's samples: tone mapped, straight alpha (the colour of what covers it).
+    let pixel = |i: usize, out: &mut [u8]| {
+        let p = img.pixels[i];
+        let mut values = [0.0f32; 4];
         match alpha {
             Some(a) => {
                 let a = a[i].clamp(0.0, 1.0);
-                // Straight alpha: the colour of what covers the pixel.
                 let c = if a > 0.0 { p.map(|x| x / a) } else { [0.0; 3] };
-                values.extend(display(c, scale));
-                values.push(a);
+                values[..3].copy_from_slice(&display(c, scale));
+                values[3] = a;
             }
-            None => values.extend(display(*p, scale)),
+            None => values[..3].copy_from_slice(&display(p, scale)),
         }
-    }
-    let mut encoder = png::Encoder::new(out, img.width, img.height);
-    encoder.set_color(if alpha.is_some() {
-        png::ColorType::Rgba
-    } else {
-        png::ColorType::Rgb
-    });
-    encoder.set_depth(if deep {
-        png::BitDepth::Sixteen
-    } else {
-        png::BitDepth::Eight
-    });
-    encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-    let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
-    let quantise = |v: f32| (v.clamp(0.0, 1.0) * max + 0.5) as u32;
-    let bytes: Vec<u8> = if deep {
-        values
-            .iter()
-            .flat_map(|&v| (quantise(v) as u16).to_be_bytes())
-            .collect()
-    } else {
-        values.iter().map(|&v| quantise(v) as u8).collect()
+        for (k, v) in values[..channels].iter().enumerate() {
+            if deep {
+                out[2 * k..2 * k + 2].copy_from_slice(&(quantise(*v) as u16).to_be_bytes());
+            } else {
+                out[k] = quantise(*v) as u8;
+            }
+        }
     };
-    writer
-        .write_image_data(&bytes)
-        .map_err(std::io::Error::other)?;
-    writer.finish().map_err(std::io::Error::other)
+    // Tone mapping on every core: a large picture's pixels are most of its write.
+    let mut bytes = vec![0u8; img.pixels.len() * bytes_per_pixel];
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let per = img.pixels.len().div_ceil(threads).max(1 << 14);
+    std::thread::scope(|s| {
+        for (k, part) in bytes.chunks_mut(per * bytes_per_pixel).enumerate() {
+            let pixel = &pixel;
+            s.spawn(move || {
+                for (j, out) in part.chunks_exact_mut(bytes_per_pixel).enumerate() {
+                    pixel(k * per + j, out);
+                }
+            });
+        }
+    });
+    let layout = render::image::parallel_png::Layout {
+        channels: channels as u8,
+        deep,
+        srgb: true,
+    };
+    render::image::parallel_png::write(out, img.width, img.height, layout, &bytes)
 }
 
 fn write_exr(out: &mut dyn Write, picture: &Picture, half: bool) -> std::io::Result<()> {
@@ -250,5 +254,59 @@ mod tests {
             numbered(Path::new("t.exr"), 12345, 20000),
             Path::new("t_12345.exr")
         );
+    }
+
+    #[test]
+    fn a_large_pictures_png_is_written_in_bands_and_decodes_to_its_quantised_pixels() {
+        // 1500 × 1000 RGBA at 16 bits is 12 MB: past the banded writer's threshold.
+        let (w, h) = (1500u32, 1000u32);
+        let n = (w * h) as usize;
+        let image = render::image::Image {
+            width: w,
+            height: h,
+            pixels: (0..n)
+                .map(|i| {
+                    [
+                        (i % w as usize) as f32 / w as f32,
+                        0.25,
+                        (i / 997 % 7) as f32,
+                    ]
+                })
+                .collect(),
+        };
+        let alpha: Vec<f32> = (0..n).map(|i| (i % 5) as f32 / 4.0).collect();
+        let picture = render::finished::Picture {
+            image,
+            alpha: Some(alpha.clone()),
+            samples: (1, 1),
+            noise: None,
+            tiles: 1,
+            gpu_seconds: None,
+        };
+        let mut out = Vec::new();
+        write_png(&mut out, &picture, true, 0.5).unwrap();
+        assert!(out.len() > 8, "written");
+        let mut reader = png::Decoder::new(std::io::Cursor::new(&out))
+            .read_info()
+            .unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert_eq!((info.width, info.height), (w, h));
+        assert_eq!(info.color_type, png::ColorType::Rgba);
+        let scale = 2f32.powf(0.5);
+        for i in [0, 1, 777, n / 2 + 3, n - 1] {
+            let a = alpha[i];
+            let p = picture.image.pixels[i];
+            let c = if a > 0.0 { p.map(|x| x / a) } else { [0.0; 3] };
+            let want: Vec<u16> = display(c, scale)
+                .into_iter()
+                .chain([a])
+                .map(|v| (v.clamp(0.0, 1.0) * 65535.0 + 0.5) as u16)
+                .collect();
+            let got: Vec<u16> = (0..4)
+                .map(|k| u16::from_be_bytes([buf[i * 8 + 2 * k], buf[i * 8 + 2 * k + 1]]))
+                .collect();
+            assert_eq!(got, want, "pixel {i}");
+        }
     }
 }
