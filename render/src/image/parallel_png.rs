@@ -101,8 +101,7 @@ fn write_bands(
         .collect();
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut pieces: Vec<Option<std::io::Result<(Vec<u8>, u32, usize)>>> =
-        (0..bands.len()).map(|_| None).collect();
+    let mut pieces: Vec<Option<std::io::Result<Piece>>> = (0..bands.len()).map(|_| None).collect();
     let slots: Vec<std::sync::Mutex<&mut Option<_>>> =
         pieces.iter_mut().map(std::sync::Mutex::new).collect();
     std::thread::scope(|s| {
@@ -151,6 +150,9 @@ fn write_bands(
     chunk(out, b"IEND", &[])
 }
 
+/// A band's deflate data, the Adler-32 of its filtered bytes and their length.
+type Piece = (Vec<u8>, u32, usize);
+
 /// Rows `y0..y1` filtered with Paeth and deflated: (the deflate data, the filtered bytes'
 /// Adler-32, their length). `last` finishes the deflate stream.
 fn band(
@@ -159,7 +161,7 @@ fn band(
     bpp: usize,
     (y0, y1): (usize, usize),
     last: bool,
-) -> std::io::Result<(Vec<u8>, u32, usize)> {
+) -> std::io::Result<Piece> {
     let mut filtered = Vec::with_capacity((y1 - y0) * (row + 1));
     for y in y0..y1 {
         let cur = &data[y * row..(y + 1) * row];
