@@ -15,7 +15,7 @@ run() { # binary, label, extra args
   $R/.device/vb-$1 render thesis.ron --out big-$1-$2.png --width 16384 --height 16384 --spp 4 ${@:3} > log-$1-$2.txt 2>&1
   local rc=$?
   local t1=$(date +%s.%N)
-  echo "$1 $2 rc $rc wall $(echo "$t1 - $t0" | bc) s size $(stat -c %s big-$1-$2.png) bytes :: $(tail -2 log-$1-$2.txt | tr '\n' ' ')"
+  echo "$1 $2 rc $rc wall $(awk "BEGIN{print $t1 - $t0}") s size $(stat -c %s big-$1-$2.png) bytes :: $(tail -2 log-$1-$2.txt | tr '\n' ' ')"
   rm -f big-$1-$2.png
 }
 run base png8
