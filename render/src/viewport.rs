@@ -123,8 +123,6 @@ pub struct Viewport {
     filter_input: Option<Binding>,
     /// The interactive loop's jobs and the images they leave ([`Viewport::trace_paced`]).
     pacing: paced::Pacing,
-    /// Whether the last recorded frame traced its band (not held by an upload).
-    banded: bool,
     ctx: Arc<GpuContext>,
 }
 
@@ -192,7 +190,6 @@ impl Viewport {
             scene_key: None,
             filter_input: None,
             pacing: Default::default(),
-            banded: false,
             ctx,
         })
     }
@@ -383,12 +380,12 @@ impl Viewport {
         req: &FrameRequest<'_>,
     ) -> Result<FrameStatus, GpuError> {
         let upload = self.world.update(&self.ctx.clone(), world)?;
-        self.record_frame(frame, world, req, upload, Band::WHOLE)
+        Ok(self.record_frame(frame, world, req, upload, Band::WHOLE)?.0)
     }
 
     /// [`Viewport::trace_frame`] after the world's upload, tracing `band` of the image's
     /// rows: a band before the last records only its part of the samples (no denoiser, no
-    /// display pass; `self.banded` says whether it did).
+    /// display pass). Also returns whether the band was traced (not held by an upload).
     fn record_frame(
         &mut self,
         frame: &Frame,
@@ -396,7 +393,7 @@ impl Viewport {
         req: &FrameRequest<'_>,
         upload: UploadReport,
         band: Band,
-    ) -> Result<FrameStatus, GpuError> {
+    ) -> Result<(FrameStatus, bool), GpuError> {
         let ctx = self.ctx.clone();
         if upload.grew {
             // The grown world waited for the GPU: every slot's sets may go.
@@ -486,15 +483,15 @@ impl Viewport {
                 band,
             )?
         };
-        self.banded = !hold;
         if !band.is_last() && !hold {
             // The display pass waits for the pass's last band.
-            return Ok(FrameStatus {
+            let status = FrameStatus {
                 samples: live.samples(),
                 added,
                 restarted,
                 upload,
-            });
+            };
+            return Ok((status, true));
         }
         // SAFETY: recording: the trace's writes before the display pass reads them.
         unsafe { between_passes(&ctx, frame.cmd) };
@@ -590,20 +587,13 @@ impl Viewport {
             barrier(&ctx, frame.cmd, Scope::SHADER_WRITE, Scope::TRANSFER_READ);
         }
         self.pacing.recording(frame.slot, output, live.samples());
-        Ok(FrameStatus {
+        let status = FrameStatus {
             samples: live.samples(),
             added,
             restarted,
             upload,
-        })
-    }
-
-    /// The frame's display output: packed 8-bit pixels at the output size, rows top down.
-    pub fn output(&self, frame: &Frame) -> vk::Buffer {
-        self.frames[frame.slot]
-            .ldr
-            .as_ref()
-            .map_or(vk::Buffer::null(), |b| b.raw)
+        };
+        Ok((status, !hold))
     }
 
     /// Ends and submits the frame (waiting on `waits`, signalling `signals`); never blocks.

@@ -101,22 +101,27 @@ fn write_bands(
         .collect();
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut pieces: Vec<Option<std::io::Result<Piece>>> = (0..bands.len()).map(|_| None).collect();
-    let slots: Vec<std::sync::Mutex<&mut Option<_>>> =
-        pieces.iter_mut().map(std::sync::Mutex::new).collect();
-    std::thread::scope(|s| {
-        for _ in 0..threads.min(bands.len()) {
-            s.spawn(|| {
-                loop {
-                    let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                    let Some(&(y0, y1)) = bands.get(k) else { break };
-                    let piece = band(data, row, bpp, (y0, y1), k + 1 == bands.len());
-                    **slots[k].lock().unwrap_or_else(|p| p.into_inner()) = Some(piece);
-                }
-            });
-        }
+    // Each thread takes the next band until none is left; the pieces are then put in order.
+    let mut pieces: Vec<(usize, std::io::Result<Piece>)> = std::thread::scope(|s| {
+        let workers: Vec<_> = (0..threads.min(bands.len()))
+            .map(|_| {
+                s.spawn(|| {
+                    let mut done = Vec::new();
+                    loop {
+                        let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(&rows) = bands.get(k) else { break };
+                        done.push((k, band(data, row, bpp, rows, k + 1 == bands.len())));
+                    }
+                    done
+                })
+            })
+            .collect();
+        workers
+            .into_iter()
+            .flat_map(|w| w.join().expect("a band's thread does not panic"))
+            .collect()
     });
-    drop(slots);
+    pieces.sort_by_key(|(k, _)| *k);
     out.write_all(b"\x89PNG\r\n\x1a\n")?;
     let mut ihdr = Vec::with_capacity(13);
     ihdr.extend(width.to_be_bytes());
@@ -134,8 +139,8 @@ fn write_bands(
     }
     let mut adler = 1u32;
     let count = pieces.len();
-    for (k, piece) in pieces.into_iter().enumerate() {
-        let (deflated, band_adler, len) = piece.expect("every band was compressed")?;
+    for (k, piece) in pieces {
+        let (deflated, band_adler, len) = piece?;
         adler = adler32_combine(adler, band_adler, len as u64);
         // The zlib header (deflate, 32 KiB window, default level) before the first band,
         // the Adler-32 after the last.

@@ -69,8 +69,8 @@ pub(super) struct Pacing {
     jobs: u64,
     /// The slot being recorded and what it will hold.
     recording: Option<(usize, TracedImage)>,
-    /// What the last paced job was asked (the request but its samples per frame).
-    signature: Option<u64>,
+    /// What the last paced job was asked.
+    asked: Option<Asked>,
     /// The sample pass in bands being traced: its next band and samples per pixel.
     pass: Option<(Band, u32)>,
     /// The band of the job being recorded (None: no paced band).
@@ -166,7 +166,7 @@ impl Viewport {
         // A finished job's output is the one shown from now on: the next job goes to another
         // slot (one job in flight), so no frame waits on the device for what it shows.
         self.poll_shown()?;
-        let signature = signature(req);
+        let asked = Asked::of(req);
         let converged = self
             .live
             .as_ref()
@@ -177,12 +177,12 @@ impl Viewport {
         let upload = self.world.update(&self.ctx.clone(), world)?;
         let changed = upload.changed()
             || upload.deferred_bytes > 0
-            || self.pacing.signature != Some(signature);
+            || self.pacing.asked.as_ref() != Some(&asked);
         if converged && !changed && self.pacing.pass.is_none() && self.pacing.latest.is_some() {
             // The slot's command buffer stays unsubmitted; its next `begin` resets it.
             return Ok(Paced::Idle);
         }
-        self.pacing.signature = Some(signature);
+        self.pacing.asked = Some(asked);
         // A pass in bands goes on while nothing changed; a change starts a new one.
         let (band, spp) = match self.pacing.pass {
             Some(pass) if !changed => pass,
@@ -197,8 +197,8 @@ impl Viewport {
             }
         };
         let req = FrameRequest { spp, ..*req };
-        let status = self.record_frame(&frame, world, &req, upload, band)?;
-        if self.banded {
+        let (status, traced_band) = self.record_frame(&frame, world, &req, upload, band)?;
+        if traced_band {
             self.pacing.band = Some(band);
             self.pacing.pass = (!band.is_last()).then_some((
                 Band {
@@ -265,13 +265,30 @@ pub(super) fn idle_for_output(ctx: &GpuContext) -> Result<(), GpuError> {
     vk_call("vkDeviceWaitIdle", unsafe { ctx.device.device_wait_idle() })
 }
 
-/// A request's identity for pacing: everything but the samples per frame (the budget's).
-fn signature(req: &FrameRequest<'_>) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let text = format!("{:?}", FrameRequest { spp: 0, ..*req });
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    text.hash(&mut h);
-    h.finish()
+/// A request as pacing compares it: everything but the samples per frame (the budget's).
+#[derive(Clone, Debug, PartialEq)]
+struct Asked {
+    params: SceneParams,
+    sizes: ((u32, u32), (u32, u32)),
+    target_spp: u32,
+    exposure: f32,
+    flags: [bool; 3],
+    dim: Option<crate::vulkan::trace::Dim>,
+    grid: Option<f32>,
+}
+
+impl Asked {
+    fn of(req: &FrameRequest<'_>) -> Self {
+        Self {
+            params: req.params.clone(),
+            sizes: (req.internal, req.output),
+            target_spp: req.target_spp,
+            exposure: req.exposure,
+            flags: [req.bgra, req.denoise, req.reproject],
+            dim: req.dim,
+            grid: req.grid,
+        }
+    }
 }
 
 #[cfg(test)]
@@ -362,7 +379,7 @@ mod tests {
     }
 
     #[test]
-    fn the_signature_ignores_the_samples_per_frame_only() {
+    fn a_request_is_the_same_but_for_its_samples_per_frame() {
         let params = SceneParams::framing(glam::DVec3::splat(16.0));
         let req = FrameRequest {
             params: &params,
@@ -377,10 +394,10 @@ mod tests {
             dim: None,
             grid: None,
         };
-        assert_eq!(signature(&req), signature(&FrameRequest { spp: 8, ..req }));
+        assert_eq!(Asked::of(&req), Asked::of(&FrameRequest { spp: 8, ..req }));
         assert_ne!(
-            signature(&req),
-            signature(&FrameRequest {
+            Asked::of(&req),
+            Asked::of(&FrameRequest {
                 exposure: 0.5,
                 ..req
             })
@@ -388,8 +405,8 @@ mod tests {
         let mut moved = params.clone();
         moved.camera.yaw_deg += 0.01;
         assert_ne!(
-            signature(&req),
-            signature(&FrameRequest {
+            Asked::of(&req),
+            Asked::of(&FrameRequest {
                 params: &moved,
                 ..req
             })
