@@ -64,7 +64,7 @@ pub fn default_scene(size: SceneSize, workers: usize) -> Result<Scene> {
     })?;
 
     world
-        .apply(terrain::rolling_hills(dims))
+        .apply_unrecorded(terrain::rolling_hills(dims))
         .context("building the terrain")?;
     let size = dims.voxels().as_dvec3();
     let unit = size.x / 512.0;
@@ -228,7 +228,9 @@ pub fn heightmap_scene(
             _ => m.rock[0],
         }
     });
-    world.apply(edit).map_err(|e| FormatError::world(path, e))?;
+    world
+        .apply_unrecorded(edit)
+        .map_err(|e| FormatError::world(path, e))?;
     world.take_dirty();
     let params = render::SceneParams::framing(size.as_dvec3());
     Ok(Scene::new(world, params))
@@ -243,7 +245,7 @@ pub fn thesis_scene(workers: usize) -> Result<Scene> {
     let materials = terrain_materials(world)?;
     let params = thesis_terrain(materials, dims.voxels().y as u32);
     world
-        .apply(terrain::NoiseTerrain::new(params, dims)?.edit())
+        .apply_unrecorded(terrain::NoiseTerrain::new(params, dims)?.edit())
         .context("generating the terrain")?;
     place_statue(world)?;
     Ok(adopt(owned))

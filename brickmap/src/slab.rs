@@ -15,7 +15,10 @@ use glam::{IVec3, UVec3};
 use std::sync::Arc;
 
 mod edits;
+mod undo;
 mod validate;
+
+pub(crate) use undo::Undo;
 
 const NO_BUCKET: u32 = u32::MAX;
 const BRICK_BYTES: u64 = std::mem::size_of::<Brick>() as u64;

@@ -259,6 +259,12 @@ impl World {
 
     /// Validates and queues an edit; the ticket waits for it.
     pub fn submit(&self, op: EditOp) -> Result<Ticket<'_>> {
+        self.submit_as(op, false)
+    }
+
+    /// Queues an edit; `compact`: its parts record whole-brick writes into empty cells as
+    /// positions (see `slab::Undo`).
+    fn submit_as(&self, op: EditOp, compact: bool) -> Result<Ticket<'_>> {
         self.validate(&op)?;
         let parts = self.split(op);
         let (reply, rx) = crossbeam_channel::unbounded();
@@ -269,6 +275,7 @@ impl World {
                 self.senders[w]
                     .send(Job::Work {
                         item,
+                        compact,
                         reply: reply.clone(),
                     })
                     .map_err(|_| BrickmapError::WorkerGone(w))?;
@@ -284,6 +291,14 @@ impl World {
     /// Submits an edit and waits for it.
     pub fn apply(&self, op: EditOp) -> Result<EditOutcome> {
         self.submit(op)?.wait()
+    }
+
+    /// Applies an edit nobody will undo (building a new scene, loading a file) and returns
+    /// the voxels it changed. The same edit as [`World::apply`], and a failure still leaves
+    /// the world as before it, but no inverse is kept: a whole-brick write into an empty
+    /// cell is remembered by its position alone, for the rollback, and dropped after.
+    pub fn apply_unrecorded(&self, op: EditOp) -> Result<u64> {
+        self.submit_as(op, true)?.wait_unrecorded()
     }
 
     fn validate(&self, op: &EditOp) -> Result<()> {
@@ -344,6 +359,7 @@ impl World {
             .ok_or(BrickmapError::WorkerGone(w))?
             .send(Job::Work {
                 item: WorkItem::Panic,
+                compact: false,
                 reply,
             })
             .map_err(|_| BrickmapError::WorkerGone(w))?;
@@ -363,6 +379,7 @@ impl World {
             for (w, s) in self.senders.iter().enumerate() {
                 s.send(Job::Work {
                     item: WorkItem::Restore(Vec::new()),
+                    compact: false,
                     reply: reply.clone(),
                 })
                 .map_err(|_| BrickmapError::WorkerGone(w))?;
@@ -456,14 +473,16 @@ impl World {
 
     /// Recomputes the lights of the bricks an edit changed and of their neighbours (nothing
     /// when no material is a light).
+    /// Whether an edit's bricks can change the lights (some material emits).
+    fn lights_matter(&self) -> bool {
+        self.lights
+            .read()
+            .unwrap_or_else(|p| p.into_inner())
+            .any_lit_material()
+    }
+
     fn refresh_lights(&self, changed: &[UVec3]) {
-        if changed.is_empty()
-            || !self
-                .lights
-                .read()
-                .unwrap_or_else(|p| p.into_inner())
-                .any_lit_material()
-        {
+        if changed.is_empty() || !self.lights_matter() {
             return;
         }
         let _one = self.light_updates.lock().unwrap_or_else(|p| p.into_inner());

@@ -144,3 +144,105 @@ fn worker_panic_is_an_error_not_a_hang() {
     assert!(world.apply(near).unwrap().changed_voxels > 0);
     drop(world); // joins the workers without hanging
 }
+
+/// `count` partial bricks (every other voxel solid, so each needs a stored brick) in x-major
+/// order across the grid, one brick named twice.
+fn partial_bricks(
+    world: &World,
+    count: u32,
+) -> Vec<(glam::UVec3, brickmap::Mask, brickmap::PriorMaterials)> {
+    let b = world.dims().bricks();
+    let mut mask = brickmap::Mask::EMPTY;
+    for bit in (0..512).step_by(2) {
+        mask.set(bit);
+    }
+    let mut list: Vec<_> = (0..count)
+        .map(|i| {
+            let brick = glam::UVec3::new(i % b.x, (i / b.x) % b.y, i / (b.x * b.y));
+            (
+                brick,
+                mask,
+                brickmap::PriorMaterials::Uniform((i % 2) as u8),
+            )
+        })
+        .collect();
+    list.push((
+        list[0].0,
+        brickmap::Mask::FULL,
+        brickmap::PriorMaterials::Uniform(1),
+    ));
+    list
+}
+
+#[test]
+fn an_unrecorded_bulk_write_is_the_same_edit_and_still_rolls_back() {
+    let config = |max_bricks| WorldConfig {
+        workers: 2,
+        max_bricks,
+        ..Default::default()
+    };
+    let dims = GridDims::new(16, 8, 16).unwrap();
+    let prepared = |max_bricks| {
+        let world = World::new(dims, config(max_bricks)).unwrap();
+        world
+            .push_material(brickmap::Material::lambertian(9))
+            .unwrap();
+        // Cells that are not empty before the write: their records are whole restores.
+        world
+            .apply(EditOp::Shape {
+                shape: Shape::Sphere {
+                    centre: DVec3::splat(20.0),
+                    radius: 9.0,
+                },
+                mode: Mode::Add(1),
+            })
+            .unwrap();
+        world
+    };
+    // The same write, recorded and not: the same world.
+    let (a, b) = (prepared(u64::MAX), prepared(u64::MAX));
+    let changed = a
+        .apply(brickmap::terrain::set_bricks(partial_bricks(&a, 300)))
+        .unwrap()
+        .changed_voxels;
+    let unrecorded = b
+        .apply_unrecorded(brickmap::terrain::set_bricks(partial_bricks(&b, 300)))
+        .unwrap();
+    assert_eq!(unrecorded, changed);
+    assert_eq!(a.read().content_hash(), b.read().content_hash());
+    b.read().validate().unwrap();
+    // Undone (its inverse applied as history does), the write that names a brick twice
+    // leaves the world as before it.
+    let c = prepared(u64::MAX);
+    let before = c.read().content_hash();
+    let done = c
+        .apply(brickmap::terrain::set_bricks(partial_bricks(&c, 300)))
+        .unwrap();
+    c.apply(EditOp::Restore(done.inverse)).unwrap();
+    assert_eq!(
+        c.read().content_hash(),
+        before,
+        "the undo left part of the write"
+    );
+    // Over the brick budget part way (one 1024-brick chunk, 1500 bricks asked for across
+    // both workers), recorded or not: the world as before, the pre-existing bricks and the
+    // brick named twice included.
+    for unrecorded in [false, true] {
+        let world = prepared(1024);
+        let (hash, solid) = (world.read().content_hash(), world.read().solid_count());
+        let write = brickmap::terrain::set_bricks(partial_bricks(&world, 1500));
+        let err = if unrecorded {
+            world.apply_unrecorded(write).unwrap_err()
+        } else {
+            world.apply(write).unwrap_err()
+        };
+        assert_eq!(err, BrickmapError::OutOfSpace("brick"));
+        assert_eq!(
+            world.read().content_hash(),
+            hash,
+            "failed write changed the world"
+        );
+        assert_eq!(world.read().solid_count(), solid);
+        world.read().validate().unwrap();
+    }
+}

@@ -84,7 +84,7 @@ pub(crate) fn new(a: NewArgs, workers: usize) -> Result<()> {
             a.height_max.unwrap_or(params.height_range.1),
         );
         params.water_level = a.water_level.unwrap_or(params.water_level);
-        world.apply(NoiseTerrain::new(params, dims)?.edit())?;
+        world.apply_unrecorded(NoiseTerrain::new(params, dims)?.edit())?;
         world.take_dirty();
         Ok(Scene::new(
             world,

@@ -152,7 +152,7 @@ pub fn import_bytes(
     }
     let map = install_materials(&world, &data, &placed, &mut report, Ok).map_err(invalid)?;
     world
-        .apply(voxels_edit(&placed, |i| map[i as usize], &mut report))
+        .apply_unrecorded(voxels_edit(&placed, |i| map[i as usize], &mut report))
         .map_err(world_error)?;
     world.take_dirty();
     Ok((Scene::new(world, params), report))

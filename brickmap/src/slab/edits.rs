@@ -8,8 +8,10 @@ use super::*;
 impl Slab {
     /// Applies this slab's part of an edit. On error the slab is rolled back to its state
     /// before the call and the error returned.
-    pub(crate) fn run(&mut self, item: WorkItem) -> Result<(Vec<BrickUndo>, u64)> {
-        let mut undo = Vec::new();
+    /// `compact`: whole-brick writes into empty cells are recorded as positions (see
+    /// [`Undo`]).
+    pub(crate) fn run(&mut self, item: WorkItem, compact: bool) -> Result<(Undo, u64)> {
+        let mut undo = Undo::new(compact);
         let result = match item {
             WorkItem::Shape(job) => self.run_shape(&job.0, job.1, &mut undo),
             WorkItem::Voxels(list) => self.run_voxels(&list, &mut undo),
@@ -21,9 +23,9 @@ impl Slab {
         match result {
             Ok(changed) => Ok((undo, changed)),
             Err(e) => {
-                // Undo in reverse; restoring only returns to states that fitted before.
-                let mut ignored = Vec::new();
-                for u in undo.iter().rev() {
+                // Restoring only returns to states that fitted before.
+                let mut ignored = Undo::new(true);
+                for u in &undo.into_inverse() {
                     let _ = self.restore_brick(u, &mut ignored);
                 }
                 Err(e)
@@ -31,7 +33,7 @@ impl Slab {
         }
     }
 
-    fn run_shape(&mut self, shape: &Shape, mode: Mode, undo: &mut Vec<BrickUndo>) -> Result<u64> {
+    fn run_shape(&mut self, shape: &Shape, mode: Mode, undo: &mut Undo) -> Result<u64> {
         let (lo, hi) = shape.voxel_bounds();
         let max = self.dims.voxels() - 1;
         let lo = lo.clamp(IVec3::ZERO, max);
@@ -65,7 +67,7 @@ impl Slab {
         b: UVec3,
         region: &Mask,
         mode: Mode,
-        undo: &mut Vec<BrickUndo>,
+        undo: &mut Undo,
     ) -> Result<u64> {
         let cell = self.dims.cell_index(b);
         let (old_mask, old) = self.read(cell);
@@ -140,7 +142,7 @@ impl Slab {
         Ok(changed)
     }
 
-    fn run_restore(&mut self, list: &[BrickUndo], undo: &mut Vec<BrickUndo>) -> Result<u64> {
+    fn run_restore(&mut self, list: &[BrickUndo], undo: &mut Undo) -> Result<u64> {
         let mut changed = 0;
         for u in list {
             changed += self.restore_brick(u, undo)?;
@@ -149,11 +151,7 @@ impl Slab {
     }
 
     /// Every column of the slab from the generator; cells it leaves out become empty.
-    fn run_generate(
-        &mut self,
-        source: &dyn ColumnSource,
-        undo: &mut Vec<BrickUndo>,
-    ) -> Result<u64> {
+    fn run_generate(&mut self, source: &dyn ColumnSource, undo: &mut Undo) -> Result<u64> {
         let height = self.dims.bricks().y;
         let mut column: Vec<(u32, Mask, PriorMaterials)> = Vec::new();
         let mut changed = 0;
@@ -195,7 +193,7 @@ impl Slab {
     }
 
     /// Puts back the touched voxels of one brick, recording what they were.
-    fn restore_brick(&mut self, u: &BrickUndo, undo: &mut Vec<BrickUndo>) -> Result<u64> {
+    fn restore_brick(&mut self, u: &BrickUndo, undo: &mut Undo) -> Result<u64> {
         let cell = self.dims.cell_index(u.brick);
         let (old_mask, old) = self.read(cell);
         if u.touched.is_full() && old_mask.is_empty() {
@@ -205,12 +203,7 @@ impl Slab {
                 PriorMaterials::PerVoxel(v) => NewMats::Bytes(v),
             };
             self.store(cell, u.prior_mask, new)?;
-            undo.push(BrickUndo {
-                brick: u.brick,
-                prior_mask: Mask::EMPTY,
-                touched: Mask::FULL,
-                prior: PriorMaterials::PerVoxel(Vec::new()),
-            });
+            undo.was_empty(u.brick);
             return Ok(u.prior_mask.count() as u64);
         }
         let back = u.prior_mask.and(&u.touched);
@@ -249,7 +242,7 @@ impl Slab {
     /// first grouped by brick (a stable radix sort on the cell, so a later write to a voxel
     /// still wins), so each brick is visited once and memory is walked in order: in arrival
     /// order, scattered writes spend most of their time waiting on cache misses.
-    fn run_voxels(&mut self, list: &[VoxelEdit], undo: &mut Vec<BrickUndo>) -> Result<u64> {
+    fn run_voxels(&mut self, list: &[VoxelEdit], undo: &mut Undo) -> Result<u64> {
         let packed: Vec<u64> = list
             .iter()
             .map(|e| {

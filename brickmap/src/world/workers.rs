@@ -7,21 +7,28 @@ use super::*;
 pub(super) enum Job {
     Work {
         item: WorkItem,
+        /// Record whole-brick writes into empty cells as positions (`apply_unrecorded`).
+        compact: bool,
         reply: Sender<PartResult>,
     },
     Stop,
 }
 
-pub(super) type PartResult = (usize, Result<(Vec<crate::edit::BrickUndo>, u64)>);
+pub(super) type PartResult = (usize, Result<(crate::slab::Undo, u64)>);
 
 pub(super) fn worker_loop(worker: usize, slab: Arc<RwLock<Slab>>, rx: Receiver<Job>) {
     for job in rx {
-        let Job::Work { item, reply } = job else {
+        let Job::Work {
+            item,
+            compact,
+            reply,
+        } = job
+        else {
             break;
         };
         let result =
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match slab.write() {
-                Ok(mut s) => s.run(item),
+                Ok(mut s) => s.run(item, compact),
                 Err(_) => Err(BrickmapError::WorkerPanicked {
                     worker,
                     message: "an earlier edit panicked; the slab may be inconsistent".into(),
@@ -51,6 +58,21 @@ impl Ticket<'_> {
     /// Waits for every part; on failure of any part rolls back the others and returns the
     /// first error, leaving the world as before the edit.
     pub fn wait(self) -> Result<EditOutcome> {
+        let (undo, changed_voxels) = self.collect()?;
+        Ok(EditOutcome {
+            inverse: inverse_of(undo),
+            changed_voxels,
+        })
+    }
+
+    /// [`Ticket::wait`] without the inverse: the voxels changed.
+    pub(super) fn wait_unrecorded(self) -> Result<u64> {
+        Ok(self.collect()?.1)
+    }
+
+    /// Every part's record (in worker order) and the voxels changed, the lights refreshed;
+    /// on a failure the parts that succeeded rolled back and the first error.
+    fn collect(self) -> Result<(Vec<crate::slab::Undo>, u64)> {
         let mut parts = Vec::with_capacity(self.expected);
         let mut first_error = None;
         for _ in 0..self.expected {
@@ -65,17 +87,10 @@ impl Ticket<'_> {
             }
         }
         parts.sort_by_key(|(w, _)| *w);
-        let mut inverse = EditInverse::default();
-        let mut changed_voxels = 0;
-        for (_, (undo, changed)) in parts {
-            inverse.bricks.extend(undo);
-            changed_voxels += changed;
-        }
-        if first_error.is_none() {
-            let changed: Vec<UVec3> = inverse.bricks.iter().map(|u| u.brick).collect();
-            self.world.refresh_lights(&changed);
-        }
+        let changed_voxels = parts.iter().map(|(_, (_, c))| c).sum();
+        let undo: Vec<crate::slab::Undo> = parts.into_iter().map(|(_, (u, _))| u).collect();
         if let Some(e) = first_error {
+            let inverse = inverse_of(undo);
             if !inverse.is_empty()
                 && let Err(rollback) = self.world.apply(EditOp::Restore(inverse))
             {
@@ -86,9 +101,20 @@ impl Ticket<'_> {
             }
             return Err(e);
         }
-        Ok(EditOutcome {
-            inverse,
-            changed_voxels,
-        })
+        if self.world.lights_matter() {
+            let changed: Vec<UVec3> = undo.iter().flat_map(|u| u.bricks()).collect();
+            self.world.refresh_lights(&changed);
+        }
+        Ok((undo, changed_voxels))
     }
+}
+
+/// The parts' records as one inverse (each part's in the order that puts it back; the
+/// parts touch disjoint slabs).
+fn inverse_of(undo: Vec<crate::slab::Undo>) -> EditInverse {
+    let mut inverse = EditInverse::default();
+    for u in undo {
+        inverse.bricks.extend(u.into_inverse());
+    }
+    inverse
 }

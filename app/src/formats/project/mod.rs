@@ -272,7 +272,7 @@ fn grid_from_str(text: &str, path: &Path, workers: usize) -> Result<Scene, Forma
         .replace_materials(table)
         .map_err(|e| FormatError::world(path, e))?;
     world
-        .apply(terrain::set_bricks(bricks))
+        .apply_unrecorded(terrain::set_bricks(bricks))
         .map_err(|e| FormatError::world(path, e))?;
     let solid = world.read().solid_count();
     if solid != file.voxels.solid_voxels {

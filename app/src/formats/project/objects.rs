@@ -314,7 +314,7 @@ fn write_grid_model(
     let world_error = |e: brickmap::BrickmapError| FormatError::world(path, e);
     let bricks = r.voxels.bricks(&world.dims(), table.len(), path)?;
     world
-        .apply(brickmap::terrain::set_bricks(bricks))
+        .apply_unrecorded(brickmap::terrain::set_bricks(bricks))
         .map_err(world_error)?;
     let solid = world.read().solid_count();
     if solid != r.voxels.solid_voxels {
