@@ -18,20 +18,22 @@ use glam::{DVec3, IVec3};
 impl Editor {
     pub(super) fn action(&mut self, action: Action) {
         match action {
-            Action::Undo => self.edits.submit(&self.doc, Edit::Undo),
-            Action::Redo => self.edits.submit(&self.doc, Edit::Redo),
+            Action::Undo => self.docs.submit(Edit::Undo),
+            Action::Redo => self.docs.submit(Edit::Redo),
             Action::New => self.panels.new_open = true,
             Action::Open => self.guard_unsaved(Pending::Open(None)),
             Action::Save => self.save(false),
             Action::SaveAs => self.save(true),
-            Action::Import => self.files.pick(Purpose::Import, self.folder(), None),
+            Action::Import => self.docs.files.pick(Purpose::Import, self.folder(), None),
             Action::Export => {
-                self.files
+                self.docs
+                    .files
                     .pick(Purpose::Export, self.folder(), Some("scene.vox".into()))
             }
             Action::NewFromHeightmap => self.guard_unsaved(Pending::Heightmap),
             Action::ExportMesh => {
-                self.files
+                self.docs
+                    .files
                     .pick(Purpose::ExportMesh, self.folder(), Some("scene.glb".into()))
             }
             Action::Frame => {
@@ -120,7 +122,7 @@ impl Editor {
             Action::Cut => self.execute(Command::Cut),
             // The copy is on the document once queued edits (a copy just asked for) ran;
             // until then the placement shows nothing and a click pastes nothing.
-            Action::Paste => self.pointer.pasting = true,
+            Action::Paste => self.controls.pointer.pasting = true,
             Action::Nudge(n) if self.settings.brush.tool == Tool::Arrange => self.arrange_nudge(n),
             Action::Nudge(n) => self.nudge(n),
             Action::Turn(axis) => self.turn_or_flip(SelectionTransform::Turn { axis, quarters: 1 }),
@@ -200,9 +202,11 @@ impl Editor {
             }
             UiEvent::AddMaterial(m) => self.execute(Command::AddMaterial(m)),
             UiEvent::PaletteFile { save: false } => {
-                self.files.pick(Purpose::LoadPalette, self.folder(), None)
+                self.docs
+                    .files
+                    .pick(Purpose::LoadPalette, self.folder(), None)
             }
-            UiEvent::PaletteFile { save: true } => self.files.pick(
+            UiEvent::PaletteFile { save: true } => self.docs.files.pick(
                 Purpose::SavePalette,
                 self.folder(),
                 Some("palette.png".into()),
@@ -227,7 +231,8 @@ impl Editor {
             }
             UiEvent::RenderImage => {
                 let name = format!("render.{}", self.settings.render_image.format.extension());
-                self.files
+                self.docs
+                    .files
                     .pick(Purpose::RenderImage, self.folder(), Some(name))
             }
             UiEvent::EditObject(n) => {
@@ -240,10 +245,10 @@ impl Editor {
             }
             UiEvent::Jump { undo, redo } => {
                 for _ in 0..undo {
-                    self.edits.submit(&self.doc, Edit::Undo);
+                    self.docs.submit(Edit::Undo);
                 }
                 for _ in 0..redo {
-                    self.edits.submit(&self.doc, Edit::Redo);
+                    self.docs.submit(Edit::Redo);
                 }
             }
             UiEvent::UseViewAsSceneCamera => {
@@ -253,17 +258,17 @@ impl Editor {
                 self.guard_unsaved(Pending::New { size, terrain })
             }
             UiEvent::Picked(purpose, path) => self.picked(purpose, path),
-            UiEvent::PickCancelled => self.waits.save_abandoned(),
+            UiEvent::PickCancelled => self.docs.waits.save_abandoned(),
             UiEvent::Unsaved(answer) => {
                 self.panels.asking_unsaved = false;
-                let Some(then) = self.waits.answered() else {
+                let Some(then) = self.docs.waits.answered() else {
                     return;
                 };
                 match answer {
                     UnsavedAnswer::Cancel => {}
                     UnsavedAnswer::Discard => self.proceed(then),
                     UnsavedAnswer::Save => {
-                        self.waits.after_save(then);
+                        self.docs.waits.after_save(then);
                         self.save(false);
                     }
                 }
@@ -271,8 +276,8 @@ impl Editor {
             UiEvent::Recover(yes) => {
                 if let Some(p) = self.panels.recovery.take() {
                     if yes {
-                        self.waits.recovering();
-                        self.files.load(p, self.options.workers);
+                        self.docs.waits.recovering();
+                        self.docs.files.load(p, self.options.workers);
                     } else {
                         self.config.remove_recovery();
                     }

@@ -28,7 +28,7 @@ impl Editor {
             let node = hit.and_then(|v| doc.scene.objects().object_at(v));
             (hit, node, node.is_some(), doc.scene.active())
         };
-        let mods = self.pointer.mods;
+        let mods = self.controls.pointer.mods;
         let picked = &mut self.panels.outliner.picked;
         match node {
             Some(n) if mods.shift => {
@@ -43,7 +43,7 @@ impl Editor {
         }
         // A press on nothing starts a box select (a click without moving only clears).
         if node.is_none() {
-            self.pointer.boxing = Some(self.pointer.cursor);
+            self.controls.pointer.boxing = Some(self.controls.pointer.cursor);
         }
         // A press on a picked object (no modifier) starts dragging the picked ones.
         if let (Some(v), Some(n)) = (hit, node)
@@ -52,7 +52,7 @@ impl Editor {
             && picked.contains(&n)
         {
             let y = f64::from(v.y) + 0.5;
-            self.pointer.moving = on_plane(origin, dir, y).map(|start| MoveDrag {
+            self.controls.pointer.moving = on_plane(origin, dir, y).map(|start| MoveDrag {
                 y,
                 start,
                 by: IVec3::ZERO,
@@ -69,14 +69,14 @@ impl Editor {
 
     /// While dragging picked objects: the whole voxels the cursor moved on the drag's plane.
     pub(super) fn arrange_to_cursor(&mut self) {
-        let Some(m) = &self.pointer.moving else {
+        let Some(m) = &self.controls.pointer.moving else {
             return;
         };
         let (origin, dir) = self.cursor_ray();
         if let Some(p) = on_plane(origin, dir, m.y) {
             let d = (p - m.start).round();
             let by = IVec3::new(d.x as i32, 0, d.z as i32);
-            if let Some(m) = &mut self.pointer.moving {
+            if let Some(m) = &mut self.controls.pointer.moving {
                 m.by = by;
             }
         }
@@ -85,8 +85,8 @@ impl Editor {
     /// The release of a drag of picked objects: one move by what the drag showed; of a box
     /// select: the objects in the box picked (Shift: added, Ctrl: taken away).
     pub(super) fn arrange_release(&mut self) {
-        if let Some(from) = self.pointer.boxing.take() {
-            let band = band(from, self.pointer.cursor);
+        if let Some(from) = self.controls.pointer.boxing.take() {
+            let band = band(from, self.controls.pointer.cursor);
             if band.1.0 - band.0.0 < MIN_BAND && band.1.1 - band.0.1 < MIN_BAND {
                 return;
             }
@@ -95,7 +95,7 @@ impl Editor {
                 let objects = doc.scene.objects();
                 in_band(&objects, band, |p| self.viewing.window_point(p))
             };
-            let mods = self.pointer.mods;
+            let mods = self.controls.pointer.mods;
             let picked = &mut self.panels.outliner.picked;
             if mods.ctrl {
                 picked.retain(|p| !inside.contains(p));
@@ -108,7 +108,7 @@ impl Editor {
             }
             return;
         }
-        let Some(m) = self.pointer.moving.take() else {
+        let Some(m) = self.controls.pointer.moving.take() else {
             return;
         };
         let nodes = self.panels.outliner.picked.clone();
@@ -122,7 +122,11 @@ impl Editor {
 
     /// How far picked objects being dragged have moved (zero when none is).
     pub(super) fn dragged_by(&self) -> IVec3 {
-        self.pointer.moving.as_ref().map_or(IVec3::ZERO, |m| m.by)
+        self.controls
+            .pointer
+            .moving
+            .as_ref()
+            .map_or(IVec3::ZERO, |m| m.by)
     }
 
     /// A nudge key in arrange mode: the picked nodes move a voxel (Shift: a brick).
@@ -132,7 +136,7 @@ impl Editor {
             return;
         }
         let step = nudge_offset(n, self.viewing.camera.camera.forward());
-        let by = if self.pointer.mods.shift {
+        let by = if self.controls.pointer.mods.shift {
             step * 8
         } else {
             step
@@ -160,9 +164,10 @@ pub fn band(a: (f64, f64), b: (f64, f64)) -> ((f64, f64), (f64, f64)) {
 /// The box select being dragged, in window pixels.
 pub(super) fn boxing_band(editor: &Editor) -> Option<((f64, f64), (f64, f64))> {
     editor
+        .controls
         .pointer
         .boxing
-        .map(|from| band(from, editor.pointer.cursor))
+        .map(|from| band(from, editor.controls.pointer.cursor))
         .filter(|(lo, hi)| hi.0 - lo.0 >= MIN_BAND || hi.1 - lo.1 >= MIN_BAND)
 }
 

@@ -14,38 +14,21 @@ use crate::editor::history::{DEFAULT_BUDGET, History};
 use crate::editor::script;
 use anyhow::{Result, anyhow};
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, RwLock};
 
 impl Editor {
     pub(super) fn read(&self) -> std::sync::RwLockReadGuard<'_, Document> {
-        self.doc.read().unwrap_or_else(|p| p.into_inner())
-    }
-
-    /// Saves on the file worker once the edits asked for before are applied (Ctrl+Z then
-    /// Ctrl+S saves the undone scene).
-    pub(super) fn save_to(&mut self, path: PathBuf, autosave: bool) {
-        if self.edits.busy() {
-            self.saves.defer(path, autosave);
-        } else {
-            self.files.save(&self.doc, path, autosave);
-        }
-    }
-
-    /// Applies finished saves' bookkeeping (file, clean flag) to the document, unless
-    /// another save is reading it right now (then next frame: the UI never waits).
-    pub(super) fn mark_saved(&mut self) {
-        self.saves.mark_saved(&self.doc);
+        self.docs.read()
     }
 
     /// Queues a command on the edit thread (the UI never waits for the world's workers).
     pub(super) fn execute(&mut self, command: Command) {
-        self.edits.submit(&self.doc, Edit::Command(command));
+        self.docs.submit(Edit::Command(command));
     }
 
     /// What an edit on the edit thread did. A failed script step ends the run (non-zero,
     /// naming the step).
     pub(super) fn edited(&mut self, edited: Edited) {
-        self.edits.finished();
+        self.docs.edits.finished();
         match edited {
             Edited::Command(label, result, said) => {
                 let outcome = match &result {
@@ -77,7 +60,7 @@ impl Editor {
             Edited::Stroke(Err(e)) => {
                 self.report.line(format_args!("edited stroke: error {e}"));
                 // The stroke is undone and closed: stop sending it segments.
-                self.pointer.drawing = None;
+                self.controls.pointer.drawing = None;
                 self.panels.errors.push(format!("stroke: {e}"));
             }
             Edited::ScriptStep {
@@ -128,7 +111,7 @@ impl Editor {
     pub(super) fn replace_document(&mut self, mut scene: Scene, path: Option<PathBuf>) {
         // The clipboard outlives the document: copy in one scene, paste in the next.
         scene.clipboard = self.read().scene.clipboard.clone();
-        self.pointer.cancel_placing();
+        self.controls.pointer.cancel_placing();
         let mut doc = Document::new(scene, History::with_budget(DEFAULT_BUDGET));
         doc.folder = path
             .as_ref()
@@ -142,24 +125,20 @@ impl Editor {
             let _ = self.config.add_recent(p);
             self.panels.recent = self.config.recent();
         }
-        if self.recording.on() {
+        if self.docs.recording.on() {
             doc.recorder = self.carry_recording(path.as_deref());
         }
         doc.path = path.filter(|_| is_project);
         self.viewing.camera = scene_view(&doc.scene);
-        self.progress = doc.progress.clone();
-        self.doc = Arc::new(RwLock::new(doc));
-        self.generation += 1;
+        self.docs.replace(doc);
         self.refresh_stats();
     }
 
     /// The recorder for the next document (see [`recording::Recording::carry`]).
     fn carry_recording(&mut self, path: Option<&Path>) -> Option<script::Recorder> {
-        let previous = (self.generation > 0).then(|| {
-            let mut doc = self.doc.write().unwrap_or_else(|p| p.into_inner());
-            doc.recorder.take()
-        });
-        self.recording
+        let previous = (self.docs.generation() > 0).then(|| self.docs.write().recorder.take());
+        self.docs
+            .recording
             .carry(previous, path)
             .unwrap_or_else(|message| {
                 self.panels.errors.push(message);
@@ -169,13 +148,13 @@ impl Editor {
 
     /// The session's recording so far (the document's, or the one a built scene ended).
     pub(super) fn recording_text(&self) -> Option<String> {
-        self.recording.text(self.read().recorder.as_ref())
+        self.docs.recording.text(self.read().recorder.as_ref())
     }
 
     /// Runs `then` now, or asks about unsaved changes first.
     pub(super) fn guard_unsaved(&mut self, then: Pending) {
         if self.read().dirty && self.script.is_none() {
-            self.waits.ask(then);
+            self.docs.waits.ask(then);
             self.panels.asking_unsaved = true;
         } else {
             self.proceed(then);
@@ -185,17 +164,22 @@ impl Editor {
     pub(super) fn proceed(&mut self, then: Pending) {
         match then {
             Pending::Quit => self.quit_now(),
-            Pending::Open(Some(p)) => self.files.load(p, self.options.workers),
-            Pending::Open(None) => self.files.pick(Purpose::Open, self.folder(), None),
+            Pending::Open(Some(p)) => self.docs.files.load(p, self.options.workers),
+            Pending::Open(None) => self.docs.files.pick(Purpose::Open, self.folder(), None),
             Pending::New { size, terrain } => self.new_scene(size, terrain),
-            Pending::Heightmap => self.files.pick(Purpose::Heightmap, self.folder(), None),
+            Pending::Heightmap => self
+                .docs
+                .files
+                .pick(Purpose::Heightmap, self.folder(), None),
         }
     }
 
     pub(super) fn new_scene(&mut self, size: (u32, u32, u32), terrain: bool) {
         // Built on a worker; it replaces the document like a default-scene build.
-        self.waits.building();
-        self.files.build_new(size, terrain, self.options.workers);
+        self.docs.waits.building();
+        self.docs
+            .files
+            .build_new(size, terrain, self.options.workers);
     }
 
     pub(super) fn folder(&self) -> Option<PathBuf> {
@@ -209,8 +193,9 @@ impl Editor {
     pub(super) fn save(&mut self, as_new: bool) {
         let path = self.read().path.clone();
         match path.filter(|_| !as_new) {
-            Some(p) => self.save_to(p, false),
+            Some(p) => self.docs.save_to(p, false),
             None => self
+                .docs
                 .files
                 .pick(Purpose::SaveAs, self.folder(), Some("scene.ron".into())),
         }
@@ -229,11 +214,11 @@ impl Editor {
     /// A path the user chose (in a native dialog or the in-app browser) for `purpose`.
     pub(super) fn picked(&mut self, purpose: Purpose, path: PathBuf) {
         match purpose {
-            Purpose::Open => self.files.load(path, self.options.workers),
+            Purpose::Open => self.docs.files.load(path, self.options.workers),
             Purpose::Heightmap => {
                 // Built on a worker; it replaces the document like New.
-                self.waits.building();
-                self.files.load_heightmap(path, self.options.workers);
+                self.docs.waits.building();
+                self.docs.files.load_heightmap(path, self.options.workers);
             }
             Purpose::SaveAs | Purpose::Export => {
                 let path = if purpose == Purpose::SaveAs && path.extension().is_none() {
@@ -241,7 +226,7 @@ impl Editor {
                 } else {
                     path
                 };
-                self.save_to(path, false)
+                self.docs.save_to(path, false)
             }
             Purpose::ExportMesh => {
                 let path = if path.extension().is_none() {
@@ -250,14 +235,15 @@ impl Editor {
                     path
                 };
                 let options = self.settings.mesh_export.clone();
-                let progress =
-                    std::sync::Arc::new(super::progress::TaskProgress::waking(self.files.waker()));
-                self.mesh_task = Some((path.clone(), progress.clone()));
-                self.files.export_mesh(&self.doc, path, options, progress)
+                let progress = std::sync::Arc::new(super::progress::TaskProgress::waking(
+                    self.docs.files.waker(),
+                ));
+                self.docs.mesh_task = Some((path.clone(), progress.clone()));
+                self.docs.export_mesh(path, options, progress)
             }
             // Asks for the offset first (the import dialog), then `ImportVox`.
             Purpose::Import => self.panels.import = Some((path, [0, 0, 0])),
-            Purpose::LoadPalette => self.files.load_palette(path),
+            Purpose::LoadPalette => self.docs.files.load_palette(path),
             Purpose::RenderImage => self.start_render(path),
             Purpose::SavePalette => {
                 let path = if path.extension().is_none() {
@@ -270,7 +256,7 @@ impl Editor {
                     let table = doc.scene.world.materials();
                     (0..=255u8).map(|i| table.colour(i)).collect()
                 };
-                self.files.save_palette(colours, path);
+                self.docs.files.save_palette(colours, path);
             }
         }
     }
@@ -286,27 +272,33 @@ impl Editor {
         };
         let text = crate::formats::project::to_string(&self.read().scene);
         let device = self
+            .screen
             .gfx
             .as_ref()
             .map_or_else(|| "gpu".to_string(), |g| g.viewport.ctx().name.clone());
         self.report
             .line(format_args!("rendering image {}", path.display()));
-        self.render_task = Some(super::render_image::RenderTask::start(
+        self.docs.render_task = Some(super::render_image::RenderTask::start(
             text,
             self.viewing.camera.camera.clone(),
             &self.settings.render_image,
             path,
             device,
-            self.files.waker(),
+            self.docs.files.waker(),
         ));
     }
 
     /// Takes File → Render image…'s outcome once its job ended.
     pub(super) fn render_finished(&mut self) {
-        let Some(outcome) = self.render_task.as_ref().and_then(|t| t.take_outcome()) else {
+        let Some(outcome) = self
+            .docs
+            .render_task
+            .as_ref()
+            .and_then(|t| t.take_outcome())
+        else {
             return;
         };
-        let task = self.render_task.take().expect("a task");
+        let task = self.docs.render_task.take().expect("a task");
         let path = task.path;
         if outcome.is_err() && task.progress.cancelled() {
             self.report
@@ -337,7 +329,7 @@ impl Editor {
     }
 
     pub(super) fn file_done(&mut self, done: Done) {
-        self.files.finished();
+        self.docs.files.finished();
         match done {
             Done::Picked(purpose, Some(path)) => self.picked(purpose, path),
             Done::Palette(Ok(colours)) => self.execute(Command::SetPalette(colours)),
@@ -349,7 +341,7 @@ impl Editor {
                     Some(crate::formats::FormatError::Cancelled { .. })
                 ) =>
             {
-                self.mesh_task = None;
+                self.docs.mesh_task = None;
                 self.report
                     .line(format_args!("mesh export cancelled {}", path.display()));
                 self.panels.notify(format!(
@@ -358,7 +350,7 @@ impl Editor {
                 ));
             }
             Done::MeshExported(path, Ok(stats)) => {
-                self.mesh_task = None;
+                self.docs.mesh_task = None;
                 self.report
                     .line(format_args!("exported mesh {}", path.display()));
                 self.panels.notify(format!(
@@ -369,14 +361,14 @@ impl Editor {
                 ));
             }
             Done::MeshExported(_, Err(e)) => {
-                self.mesh_task = None;
+                self.docs.mesh_task = None;
                 self.panels.errors.push(format!("Could not export {e:#}"))
             }
             Done::PaletteSaved(path, Err(e)) => self
                 .panels
                 .errors
                 .push(format!("writing {}: {e:#}", path.display())),
-            Done::Picked(_, None) => self.waits.save_abandoned(),
+            Done::Picked(_, None) => self.docs.waits.save_abandoned(),
             // No native dialog: the in-app browser asks (nothing is written meanwhile).
             Done::NoDialog {
                 purpose,
@@ -398,7 +390,7 @@ impl Editor {
             Done::Loaded(path, loaded) => match *loaded {
                 Ok(scene) => {
                     // A file opened while the default scene was building wins.
-                    let Some(recovered) = self.waits.arrived(path.is_some()) else {
+                    let Some(recovered) = self.docs.waits.arrived(path.is_some()) else {
                         return;
                     };
                     if self.report.on() {
@@ -413,14 +405,12 @@ impl Editor {
                     }
                     self.replace_document(scene, path.filter(|_| !recovered));
                     if recovered {
-                        if let Ok(mut d) = self.doc.write() {
-                            d.dirty = true;
-                        }
+                        self.docs.write().dirty = true;
                         self.config.remove_recovery();
                     }
                 }
                 Err(e) => {
-                    self.waits.load_failed();
+                    self.docs.waits.load_failed();
                     self.panels.errors.push(format!("{e:#}"));
                 }
             },
@@ -437,16 +427,16 @@ impl Editor {
                 Ok(()) => {
                     self.report.line(format_args!("saved {}", path.display()));
                     self.panels.notify(format!("Saved {}", path.display()));
-                    self.saves.finished(path.clone(), revision);
-                    self.mark_saved();
+                    self.docs.saves.finished(path.clone(), revision);
+                    self.docs.mark_saved();
                     let _ = self.config.add_recent(&path);
                     self.panels.recent = self.config.recent();
-                    if let Some(then) = self.waits.saved() {
+                    if let Some(then) = self.docs.waits.saved() {
                         self.proceed(then);
                     }
                 }
                 Err(e) => {
-                    self.waits.save_abandoned();
+                    self.docs.waits.save_abandoned();
                     self.panels.errors.push(format!("{e:#}"));
                 }
             },
@@ -454,12 +444,12 @@ impl Editor {
     }
 
     pub(super) fn autosave(&mut self) {
-        if self.script.is_some() || !self.saves.autosave_due(self.settings.autosave_secs) {
+        if self.script.is_some() || !self.docs.saves.autosave_due(self.settings.autosave_secs) {
             return;
         }
         if self.read().dirty {
             let recovery = self.config.recovery_file();
-            self.save_to(recovery, true);
+            self.docs.save_to(recovery, true);
         }
     }
 
@@ -469,7 +459,7 @@ impl Editor {
     pub(super) fn gpu_failed(&mut self, e: anyhow::Error) {
         // The message itself is the run's error, printed once at exit.
         let message = format!("{e:#}");
-        self.gfx = None;
+        self.screen.gfx = None;
         if self.read().dirty {
             let recovery = self.config.recovery_file();
             match std::fs::create_dir_all(self.config.0.as_path())
@@ -482,10 +472,10 @@ impl Editor {
                 ),
                 Err(e) => eprintln!("voxbrick: writing {} failed: {e:#}", recovery.display()),
             }
-            if self.script.is_none() && !self.headless {
+            if self.script.is_none() && !self.screen.headless() {
                 self.offer_save(&message);
             }
-        } else if self.script.is_none() && !self.headless {
+        } else if self.script.is_none() && !self.screen.headless() {
             rfd::MessageDialog::new()
                 .set_level(rfd::MessageLevel::Error)
                 .set_title("voxbrick: the GPU failed")
@@ -525,7 +515,7 @@ impl Editor {
 
     /// With `--record`: the session's script, starting from the file opened (atomic write).
     pub(super) fn write_recording(&mut self) -> Result<()> {
-        self.recording.write(self.read().recorder.as_ref())
+        self.docs.recording.write(self.read().recorder.as_ref())
     }
 }
 

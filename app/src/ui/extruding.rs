@@ -36,10 +36,10 @@ impl Editor {
         ) else {
             return;
         };
-        self.pointer.extruding = Some(ExtrudeDrag {
+        self.controls.pointer.extruding = Some(ExtrudeDrag {
             voxel: hit.voxel,
             normal: hit.normal,
-            from: self.pointer.cursor,
+            from: self.controls.pointer.cursor,
             step: (b.0 - a.0, b.1 - a.1),
             distance: 0,
         });
@@ -48,8 +48,8 @@ impl Editor {
     /// While dragging: the distance is the cursor's move along the normal as the screen shows
     /// it, in voxels (a normal pointing at the camera shows no length: nothing to drag).
     pub(super) fn extrude_to_cursor(&mut self) {
-        let cursor = self.pointer.cursor;
-        let Some(d) = &mut self.pointer.extruding else {
+        let cursor = self.controls.pointer.cursor;
+        let Some(d) = &mut self.controls.pointer.extruding else {
             return;
         };
         let len2 = d.step.0 * d.step.0 + d.step.1 * d.step.1;
@@ -62,7 +62,7 @@ impl Editor {
 
     /// The release: the extrude, when the drag went anywhere.
     pub(super) fn extrude_release(&mut self) {
-        let Some(d) = self.pointer.extruding.take() else {
+        let Some(d) = self.controls.pointer.extruding.take() else {
             return;
         };
         if d.distance != 0 {

@@ -17,67 +17,17 @@
 
 use super::host::Host;
 use super::jobs::Edit;
-use super::{Editor, Gfx, budget, files, panels, preview, selecting};
+use super::screen::Gfx;
+use super::{Editor, files, panels, preview, selecting};
 use anyhow::{Context, Result};
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use render::present::{EguiFrame, Presented, Presenter, Show};
 use render::viewport::Viewport;
 use render::vulkan::{ContextOptions, GpuContext, WindowHandles};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 use winit::event_loop::ActiveEventLoop;
 use winit::window::Window;
-
-/// The frames' own state.
-pub(super) struct Frames {
-    /// Frames drawn.
-    pub(super) count: u64,
-    /// Samples per pixel the last shown frame added (0 once converged).
-    pub(super) last_added: u32,
-    /// Samples per frame and the traced resolution's scale, from the GPU time per frame.
-    pub(super) budget: budget::FrameBudget,
-    /// egui's texture changes, kept until a frame with the UI applies them.
-    pub(super) textures: egui::TexturesDelta,
-    /// The trace job whose image the last frame showed.
-    pub(super) shown_job: Option<u64>,
-    /// When to look for the trace job's end again ([`Editor::pump_trace`]).
-    pub(super) pump_at: Option<Instant>,
-    /// The internal size and target samples the last frame asked for (pumped jobs ask
-    /// the same).
-    pub(super) asked: ((u32, u32), u32),
-    /// An input or a result (edit, file) came since the last trace job: the next job's
-    /// image is the first to show it.
-    pub(super) awaited: bool,
-    /// The trace job whose image first shows the last input or result.
-    pub(super) input_job: Option<u64>,
-    /// Tests only: the frame that fails as if the device were lost
-    /// (`VOXBRICK_TEST_GPU_FAILURE_AT_FRAME`), to check nothing is lost when the GPU fails.
-    #[cfg(feature = "test-hooks")]
-    pub(super) fail_at: Option<u64>,
-}
-
-impl Frames {
-    pub(super) fn new() -> Self {
-        Self {
-            count: 0,
-            last_added: 0,
-            budget: Default::default(),
-            textures: Default::default(),
-            shown_job: None,
-            pump_at: None,
-            asked: ((1, 1), 1),
-            awaited: false,
-            input_job: None,
-            #[cfg(feature = "test-hooks")]
-            fail_at: std::env::var("VOXBRICK_TEST_GPU_FAILURE_AT_FRAME")
-                .ok()
-                .and_then(|v| v.parse().ok()),
-        }
-    }
-}
-
-/// How long after pointer or key input on the UI refinement waits (frames are the UI's).
-pub(super) const UI_FIRST: Duration = Duration::from_millis(350);
 
 impl Editor {
     pub(super) fn create_gfx(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
@@ -106,7 +56,7 @@ impl Editor {
         let size = window.inner_size();
         let presenter = Presenter::new(ctx.clone(), (size.width, size.height))?;
         let egui_state = Box::new(egui_winit::State::new(
-            self.egui.clone(),
+            self.screen.egui.clone(),
             egui::ViewportId::ROOT,
             &window,
             Some(window.scale_factor() as f32),
@@ -141,21 +91,22 @@ impl Editor {
             let epoch = (doc.scene.epoch(), doc.scene.shifted());
             (Viewport::new(ctx, &view)?, epoch)
         };
-        self.gfx = Some(Gfx {
+        self.screen.gfx = Some(Gfx::new(
             presenter,
             viewport,
             host,
-            generation: self.generation,
+            self.docs.generation(),
             epoch,
-            title: String::new(),
-        });
+        ));
         self.refresh_stats();
         // The accessibility tree names the widgets drawn: a headless driver asks for them
         // (`Editor::widget`), a report file is told where they are.
-        if matches!(self.gfx.as_ref().map(|g| &g.host), Some(Host::Headless(_)))
-            || self.report.to_file()
+        if matches!(
+            self.screen.gfx.as_ref().map(|g| &g.host),
+            Some(Host::Headless(_))
+        ) || self.report.to_file()
         {
-            self.egui.enable_accesskit();
+            self.screen.egui.enable_accesskit();
         }
         Ok(())
     }
@@ -163,11 +114,11 @@ impl Editor {
     /// One frame: script step, file results, egui, trace, present. Skipped (not waited
     /// for) while a command runs on the worker; its completion wakes the loop.
     pub(super) fn redraw(&mut self) -> Result<()> {
-        let gate = self.edits.gate.clone();
+        let gate = self.docs.edits.gate.clone();
         let Ok(_frame) = gate.try_lock() else {
             // No frame can be drawn while an edit holds the document; a long one (terrain)
             // shows its progress in the title, refreshed by `about_to_wait`'s timer.
-            if let (Some(f), Some(g)) = (self.progress.fraction(), &mut self.gfx) {
+            if let (Some(f), Some(g)) = (self.docs.progress(), &mut self.screen.gfx) {
                 g.set_title(format!("voxbrick — generating terrain {:.0} %", f * 100.0));
             }
             return Ok(());
@@ -176,41 +127,37 @@ impl Editor {
         self.tick_fly();
         self.step_script();
         self.autosave();
-        let Some(mut gfx) = self.gfx.take() else {
+        let Some(mut gfx) = self.screen.gfx.take() else {
             return Ok(());
         };
         let result = self.draw(&mut gfx);
-        self.gfx = Some(gfx);
+        self.screen.gfx = Some(gfx);
         result
     }
 
     /// What finished since the last frame (files, edits, saves; the backlog's input), the
     /// frame gate held.
     pub(super) fn take_results(&mut self) {
-        while let Ok(done) = self.files.done.try_recv() {
+        while let Ok(done) = self.docs.files.done.try_recv() {
             self.file_done(done);
-            self.frames.awaited = true;
+            self.screen.frames.awaited = true;
         }
-        while let Ok(edited) = self.edits.done.try_recv() {
+        while let Ok(edited) = self.docs.edits.done.try_recv() {
             self.edited(edited);
-            self.frames.awaited = true;
+            self.screen.frames.awaited = true;
         }
         self.render_finished();
-        if !self.edits.busy() {
-            for (path, autosave) in self.saves.take_waiting() {
-                self.files.save(&self.doc, path, autosave);
-            }
-        }
-        self.mark_saved();
-        for (input, consumed) in std::mem::take(&mut self.backlog) {
+        self.docs.start_waiting_saves();
+        self.docs.mark_saved();
+        for (input, consumed) in self.controls.take_backlog() {
             self.handle_logged(input, consumed);
         }
     }
 
     pub(super) fn draw(&mut self, gfx: &mut Gfx) -> Result<()> {
-        self.frames.count += 1;
+        self.screen.frames.count += 1;
         #[cfg(feature = "test-hooks")]
-        if self.frames.fail_at == Some(self.frames.count) {
+        if self.screen.frames.fail_at == Some(self.screen.frames.count) {
             return Err(render::vulkan::GpuError::Vk {
                 call: "vkQueueSubmit (simulated: VOXBRICK_TEST_GPU_FAILURE_AT_FRAME)",
                 result: ash::vk::Result::ERROR_DEVICE_LOST,
@@ -221,11 +168,11 @@ impl Editor {
             let doc = self.read();
             (doc.scene.epoch(), doc.scene.shifted())
         };
-        if gfx.generation != self.generation || gfx.epoch.0 != epoch.0 {
+        if gfx.generation != self.docs.generation() || gfx.epoch.0 != epoch.0 {
             // A new document, or the scene moved into a larger grid: a new GPU world on the
             // same device (the old one goes first). Within a document the view follows the
             // scene's shift.
-            if gfx.generation == self.generation {
+            if gfx.generation == self.docs.generation() {
                 self.viewing.shift((epoch.1 - gfx.epoch.1).as_dvec3());
             }
             let ctx = gfx.viewport.ctx().clone();
@@ -235,7 +182,7 @@ impl Editor {
                 Viewport::new(ctx, &view)?
             };
             gfx.viewport = next;
-            gfx.generation = self.generation;
+            gfx.generation = self.docs.generation();
             gfx.epoch = epoch;
             self.refresh_stats();
         }
@@ -245,14 +192,16 @@ impl Editor {
             .is_some_and(|s| s.captured_at.is_none() && s.finished && self.outcome.is_ok())
             && gfx.viewport.samples() >= self.settings.target_spp;
         // The status line and the panels.
-        self.panels.busy = self.files.running.clone();
-        self.panels.busy.extend(self.edits.pending.iter().cloned());
+        self.panels.busy = self.docs.files.running.clone();
+        self.panels
+            .busy
+            .extend(self.docs.edits.pending.iter().cloned());
         let samples = gfx.viewport.samples();
         let gpu_ms = gfx.viewport.last_gpu_seconds().map_or(0.0, |s| s * 1e3);
         let size = gfx.host.inner_size();
         let shown = (self.viewing.area().2, self.viewing.area().3);
         let internal = gfx.viewport.fit_internal(self.internal_size(shown));
-        let paths = internal.0 as f64 * internal.1 as f64 * self.frames.last_added as f64;
+        let paths = internal.0 as f64 * internal.1 as f64 * self.screen.frames.last_added as f64;
         let figures = format!(
             "{samples}/{} spp · GPU {gpu_ms:.2} ms/frame · {:.1} Mpaths/s · internal {}x{}{} · {}{}",
             self.settings.target_spp,
@@ -269,33 +218,37 @@ impl Editor {
                 ""
             },
             gfx.viewport.ctx().name,
-            self.motion.latency().map_or_else(String::new, |l| format!(
-                " · input to photon {:.1} ms",
-                l.as_secs_f64() * 1e3
-            )),
+            self.controls
+                .motion
+                .latency()
+                .map_or_else(String::new, |l| format!(
+                    " · input to photon {:.1} ms",
+                    l.as_secs_f64() * 1e3
+                )),
         );
         // One pick ray a frame: the status line and the ruler share it.
         let hovered = self.hovered();
         self.panels.status = self.status_line(&figures, hovered);
         gfx.set_title(files::title(&self.read()));
         let raw = gfx.host.take_egui_input();
-        let egui_ctx = self.egui.clone();
+        let egui_ctx = self.screen.egui.clone();
         let mut events = Vec::new();
         let output = {
-            let doc = self.doc.clone();
+            let doc = self.docs.shared();
             let doc = doc.read().unwrap_or_else(|p| p.into_inner());
             {
                 let view = doc.scene.world.read();
                 let stroke = self.previewed_stroke(&view);
                 drop(view);
-                self.preview
-                    .update(&self.doc, stroke.as_ref(), doc.revision);
+                self.controls
+                    .preview
+                    .update(&self.docs.shared(), stroke.as_ref(), doc.revision);
             }
             let paste = self.paste_target(&doc);
             // The Stamp tool's stamps: the drag's, or the one a press would put down.
-            let stamping =
-                self.settings.brush.tool == super::tools::Tool::Stamp && !self.pointer.pasting;
-            let stamps: Vec<(glam::IVec3, glam::IVec3)> = match &self.pointer.stamping {
+            let stamping = self.settings.brush.tool == super::tools::Tool::Stamp
+                && !self.controls.pointer.pasting;
+            let stamps: Vec<(glam::IVec3, glam::IVec3)> = match &self.controls.pointer.stamping {
                 Some(d) => {
                     let size = doc.scene.clipboard.as_ref().map_or(glam::IVec3::ONE, |c| {
                         crate::editor::stamp::turned_size(
@@ -305,16 +258,16 @@ impl Editor {
                     });
                     d.at.iter().map(|a| (*a, size)).collect()
                 }
-                None if stamping && !self.on_ui(self.pointer.cursor) => {
+                None if stamping && !self.on_ui(self.controls.pointer.cursor) => {
                     self.stamp_target(&doc, None).into_iter().collect()
                 }
                 None => Vec::new(),
             };
-            self.preview.set_paste(
+            self.controls.preview.set_paste(
                 doc.scene
                     .clipboard
                     .as_ref()
-                    .filter(|_| self.pointer.pasting || stamping),
+                    .filter(|_| self.controls.pointer.pasting || stamping),
                 if stamping {
                     self.settings.brush.stamp_quarters
                 } else {
@@ -327,12 +280,14 @@ impl Editor {
                 || (brush.mode == crate::editor::command::BrushMode::Attach
                     && !brush.follow_surface);
             let layer = self
+                .controls
                 .pointer
                 .drawing
                 .as_ref()
                 .filter(|_| keeps_layer)
                 .map(|d| d.layer);
             let drawn_box = self
+                .controls
                 .pointer
                 .drawing
                 .as_ref()
@@ -350,7 +305,7 @@ impl Editor {
             let band = super::arranging::boxing_band(self);
             // The ruler (Measure tool): its ends, the second following the cursor.
             let ruler = (self.settings.brush.tool == super::tools::Tool::Measure)
-                .then(|| self.pointer.ruler.ends(hovered.map(|(v, _)| v)))
+                .then(|| self.controls.pointer.ruler.ends(hovered.map(|(v, _)| v)))
                 .flatten();
             // Outside arrange mode, the box of the object brushes edit (when it is not the
             // scene's only object).
@@ -367,11 +322,16 @@ impl Editor {
                     egui::pos2(x as f32 / ppp, y as f32 / ppp),
                     egui::vec2(w as f32 / ppp, h as f32 / ppp),
                 );
-                self.preview.paint(&painter, &self.viewing.camera, rect);
+                self.controls
+                    .preview
+                    .paint(&painter, &self.viewing.camera, rect);
                 let brush = &self.settings.brush;
                 let dims = doc.scene.world.dims().voxels();
-                self.preview.set_selection(doc.scene.selection.as_ref());
-                self.preview
+                self.controls
+                    .preview
+                    .set_selection(doc.scene.selection.as_ref());
+                self.controls
+                    .preview
                     .paint_selection(&painter, &self.viewing.camera, rect);
                 selecting::paint(
                     &painter,
@@ -414,26 +374,28 @@ impl Editor {
                 }
                 // A box being dragged says its size beside the cursor.
                 let cursor = egui::pos2(
-                    self.pointer.cursor.0 as f32 / ppp,
-                    self.pointer.cursor.1 as f32 / ppp,
+                    self.controls.pointer.cursor.0 as f32 / ppp,
+                    self.controls.pointer.cursor.1 as f32 / ppp,
                 );
                 if let Some(b) = drawn_box.or(dragged.map(|(lo, hi, _)| (lo, hi))) {
                     preview::paint_box_size(&painter, cursor, b);
                 }
-                if let Some(d) = &self.pointer.rect_selecting {
+                if let Some(d) = &self.controls.pointer.rect_selecting {
                     let from = egui::pos2(d.from.0 as f32 / ppp, d.from.1 as f32 / ppp);
                     super::rect_selecting::paint(&painter, from, cursor, d.adds());
                 }
-                if let Some(d) = &self.pointer.extruding {
+                if let Some(d) = &self.controls.pointer.extruding {
                     super::extruding::paint_distance(&painter, cursor, d.distance);
                 }
                 // The voxels a click pastes, where it pastes them (the box is drawn above).
                 if let Some((at, _)) = paste {
-                    self.preview
+                    self.controls
+                        .preview
                         .paint_paste(&painter, &self.viewing.camera, rect, at);
                 }
                 for (at, size) in &stamps {
-                    self.preview
+                    self.controls
+                        .preview
                         .paint_paste(&painter, &self.viewing.camera, rect, *at);
                     let stroke = egui::Stroke::new(1.0, egui::Color32::from_rgb(255, 210, 60));
                     preview::paint_box(
@@ -454,7 +416,7 @@ impl Editor {
                     dims,
                 );
                 events = panels::draw(ui, &mut self.panels, &doc, &mut self.settings);
-                if let Some((path, p)) = &self.mesh_task {
+                if let Some((path, p)) = &self.docs.mesh_task {
                     super::progress::window(
                         ui.ctx(),
                         "Exporting a mesh",
@@ -466,7 +428,7 @@ impl Editor {
                     ui.ctx(),
                     &mut self.panels.render_image_open,
                     &mut self.settings.render_image,
-                    self.render_task.as_ref(),
+                    self.docs.render_task.as_ref(),
                 ));
             })
         };
@@ -476,7 +438,9 @@ impl Editor {
         // The viewport is what the bars and docks left this frame (a script run's capture
         // is compared with whole-window renders: the whole window, the panels over it).
         let area = match self.panels.viewport {
-            Some(r) if self.script.is_none() => pixel_area(r, self.egui.pixels_per_point(), size),
+            Some(r) if self.script.is_none() => {
+                pixel_area(r, self.screen.egui.pixels_per_point(), size)
+            }
             _ => (0, 0, size.0, size.1),
         };
         if self.viewing.set_area(area) {
@@ -502,11 +466,11 @@ impl Editor {
         }
         gfx.host.handle_platform_output(platform_output);
         // Texture changes wait here until a frame with the UI applies them.
-        self.frames.textures.append(textures_delta);
+        self.screen.frames.textures.append(textures_delta);
         let primitives = egui_ctx.tessellate(shapes, pixels_per_point);
         // While the camera moves and while a stroke is drawn: the moving scale, so each
         // change shows in the next, cheaper frame.
-        let moving = self.motion.is_moving() || self.pointer.is_drawing();
+        let moving = self.controls.motion.is_moving() || self.controls.pointer.is_drawing();
         let still = internal;
         let internal = if moving {
             self.budgeted(super::pacing::scaled(
@@ -524,14 +488,14 @@ impl Editor {
             && self.script.is_none()
             && (egui::Popup::is_any_open(&egui_ctx)
                 || egui_ctx.egui_is_using_pointer()
-                || self.ui_touched.is_some_and(|t| t.elapsed() < UI_FIRST));
+                || self.controls.ui_first(Instant::now()));
         let target_spp = if ui_first {
             1
         } else {
             self.settings.target_spp
         };
-        self.frames.asked = (internal, target_spp);
-        let doc = self.doc.clone();
+        self.screen.frames.asked = (internal, target_spp);
+        let doc = self.docs.shared();
         let doc = doc.read().unwrap_or_else(|p| p.into_inner());
         let mut params = doc.scene.params.clone();
         params.camera = self.viewing.camera.camera.clone();
@@ -539,7 +503,7 @@ impl Editor {
         let ui = (!capture_now).then(|| EguiFrame {
             primitives: &primitives,
             pixels_per_point,
-            textures: &self.frames.textures,
+            textures: &self.screen.frames.textures,
         });
         let framed = gfx.presenter.frame(
             &mut gfx.viewport,
@@ -558,21 +522,21 @@ impl Editor {
         match framed.presented {
             Presented::Shown => {
                 if !capture_now {
-                    self.frames.textures.clear();
+                    self.screen.frames.textures.clear();
                 }
-                self.frames.shown_job = framed.image.map(|i| i.job);
+                self.screen.frames.shown_job = framed.image.map(|i| i.job);
                 // "pending": the image shown is older than what the last input or result
                 // asked of the trace (the UI shows it already; the traced image follows).
                 let shown = framed.image.map_or(0, |i| i.job);
-                let pending =
-                    self.frames.awaited || self.frames.input_job.is_some_and(|j| shown < j);
+                let pending = self.screen.frames.awaited
+                    || self.screen.frames.input_job.is_some_and(|j| shown < j);
                 self.report.line(format_args!(
                     "frame {} spp {}{}",
-                    self.frames.count,
+                    self.screen.frames.count,
                     framed.image.map_or(0, |i| i.samples),
                     if pending { " pending" } else { "" }
                 ));
-                self.motion.shown();
+                self.controls.motion.shown();
             }
             Presented::Skipped => {}
             Presented::NotReady | Presented::Recreated => gfx.host.request_redraw(),
@@ -600,14 +564,14 @@ impl Editor {
         if (gfx.viewport.samples() < self.settings.target_spp && !ui_first)
             || gfx.viewport.in_flight()? > 0
         {
-            self.frames.pump_at = Some(Instant::now() + super::pacing::PUMP);
+            self.screen.frames.pump_at = Some(Instant::now() + super::pacing::PUMP);
         }
         let busy = moving
-            || self.flight.is_flying()
+            || self.controls.flight.is_flying()
             || self.script.is_some()
-            || !self.files.running.is_empty()
-            || self.edits.busy()
-            || !self.saves.settled()
+            || !self.docs.files.running.is_empty()
+            || self.docs.edits.busy()
+            || !self.docs.saves.settled()
             || viewport_output.values().any(|v| v.repaint_delay.is_zero());
         if busy {
             gfx.host.request_redraw();
@@ -627,8 +591,7 @@ impl Editor {
             return;
         }
         if let Some(run) = s.run.take() {
-            self.edits
-                .submit(&self.doc, Edit::ScriptStep(s.script.clone(), run));
+            self.docs.submit(Edit::ScriptStep(s.script.clone(), run));
         }
     }
 

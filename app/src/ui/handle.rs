@@ -33,12 +33,12 @@ impl Editor {
             self.handle_logged(input, consumed);
             return;
         }
-        let gate = self.edits.gate.clone();
+        let gate = self.docs.edits.gate.clone();
         let Ok(_between_frames) = gate.try_lock() else {
-            self.backlog.push((input, consumed));
+            self.controls.defer(input, consumed);
             return;
         };
-        for (earlier, c) in std::mem::take(&mut self.backlog) {
+        for (earlier, c) in self.controls.take_backlog() {
             self.handle_logged(earlier, c);
         }
         self.handle_logged(input, consumed);
@@ -48,31 +48,31 @@ impl Editor {
     pub(super) fn handle_logged(&mut self, input: Input, consumed: bool) {
         let line = self.report.on().then(|| input.report_line()).flatten();
         self.handle_input(input, consumed);
-        self.frames.awaited = true;
+        self.screen.frames.awaited = true;
         if let Some(line) = line {
             self.report.line(format_args!("input {line}"));
         }
     }
 
     fn handle_input(&mut self, input: Input, consumed: bool) {
-        if self.gfx.is_none() {
+        if self.screen.gfx.is_none() {
             return;
         }
         let to_ui = match &input {
             Input::Moved { x, y } => self.on_ui((*x, *y)),
-            Input::Button { .. } | Input::Wheel(_) => self.on_ui(self.pointer.cursor),
-            Input::Key { .. } => consumed || self.egui.egui_wants_keyboard_input(),
+            Input::Button { .. } | Input::Wheel(_) => self.on_ui(self.controls.pointer.cursor),
+            Input::Key { .. } => consumed || self.screen.egui.egui_wants_keyboard_input(),
             Input::Text(_) => true,
             _ => false,
         };
         if to_ui {
-            self.ui_touched = Some(Instant::now());
+            self.controls.touch_ui(Instant::now());
         }
         match input {
             Input::Close => self.action(Action::Quit),
             Input::Resized(w, h) => {
                 self.viewing.set_window((w, h));
-                if let Some(gfx) = &mut self.gfx {
+                if let Some(gfx) = &mut self.screen.gfx {
                     gfx.presenter.resize((w, h));
                     gfx.host.request_redraw();
                 }
@@ -87,7 +87,7 @@ impl Editor {
                     ));
                 }
             }
-            Input::Modifiers(m) => self.pointer.mods = m,
+            Input::Modifiers(m) => self.controls.pointer.mods = m,
             // egui's alone.
             Input::Text(_) => {}
             Input::Key {
@@ -100,7 +100,7 @@ impl Editor {
             Input::Button { button, pressed } => self.button(button, pressed),
             Input::Moved { x, y } => self.cursor_moved(x, y),
             Input::Wheel(steps) => {
-                if self.on_ui(self.pointer.cursor) {
+                if self.on_ui(self.controls.pointer.cursor) {
                     return;
                 }
                 self.zoom(steps);
@@ -110,36 +110,40 @@ impl Editor {
 
     fn key(&mut self, code: KeyCode, pressed: bool, repeat: bool, consumed: bool) {
         if !pressed {
-            if self.flight.holds(code) {
+            if self.controls.flight.holds(code) {
                 // The flight lasts until the release, not until the last frame before it.
                 self.tick_fly();
-                self.flight.release(code);
+                self.controls.flight.release(code);
             }
             return;
         }
-        if consumed || self.egui.egui_wants_keyboard_input() {
+        if consumed || self.screen.egui.egui_wants_keyboard_input() {
             return;
         }
         if code == KeyCode::Escape {
-            self.pointer.sky_held = false;
+            self.controls.pointer.sky_held = false;
         }
-        if code == KeyCode::Escape && self.pointer.drawing.take().is_some() {
-            self.edits.submit(&self.doc, Edit::StrokeAbort);
+        if code == KeyCode::Escape && self.controls.pointer.drawing.take().is_some() {
+            self.docs.submit(Edit::StrokeAbort);
             return;
         }
-        if code == KeyCode::Escape && self.pointer.cancel_placing() {
+        if code == KeyCode::Escape && self.controls.pointer.cancel_placing() {
             return;
         }
-        if let Some(a) = self.keymap.action(code, self.pointer.mods) {
+        if let Some(a) = self
+            .controls
+            .keymap
+            .action(code, self.controls.pointer.mods)
+        {
             if !repeat {
                 self.action(a);
             }
-        } else if !self.pointer.mods.ctrl && input::fly_axis(code).is_some() {
+        } else if !self.controls.pointer.mods.ctrl && input::fly_axis(code).is_some() {
             // Keys already held fly until now in their old direction.
-            if self.flight.is_flying() {
+            if self.controls.flight.is_flying() {
                 self.tick_fly();
             }
-            self.flight.press(code);
+            self.controls.flight.press(code);
             self.moved();
         }
     }
@@ -149,15 +153,16 @@ impl Editor {
     /// is open (a click then only closes it). A press there belongs to the UI until its
     /// release; the viewport never sees it.
     pub(super) fn on_ui(&self, at: (f64, f64)) -> bool {
-        egui::Popup::is_any_open(&self.egui) || self.covered(at)
+        egui::Popup::is_any_open(&self.screen.egui) || self.covered(at)
     }
 
     /// Whether a panel, the bars or a window cover the window point `(x, y)` (pixels), as
     /// drawn in the last frame; outside the viewport's rectangle counts as covered.
     pub(super) fn covered(&self, (x, y): (f64, f64)) -> bool {
-        let ppp = f64::from(self.egui.pixels_per_point());
+        let ppp = f64::from(self.screen.egui.pixels_per_point());
         let pos = egui::pos2((x / ppp) as f32, (y / ppp) as f32);
         let over_window = self
+            .screen
             .egui
             .layer_id_at(pos)
             .is_some_and(|l| l.order != egui::Order::Background);
@@ -166,62 +171,72 @@ impl Editor {
 
     fn button(&mut self, button: MouseButton, pressed: bool) {
         self.request_redraw();
-        let free = !self.on_ui(self.pointer.cursor);
+        let free = !self.on_ui(self.controls.pointer.cursor);
         if !pressed && button == MouseButton::Left {
-            self.pointer.sky_held = false;
+            self.controls.pointer.sky_held = false;
         }
         match (pressed, button) {
             (true, MouseButton::Left) if free => self.press(),
-            (false, MouseButton::Left) if self.pointer.drawing.is_some() => {
+            (false, MouseButton::Left) if self.controls.pointer.drawing.is_some() => {
                 // The release position was the last move's, already taken (taking it again
                 // would dig an erase stroke deeper where the cursor stopped).
-                if let Some(d) = &self.pointer.drawing {
+                if let Some(d) = &self.controls.pointer.drawing {
                     self.report.line(format_args!(
                         "stroke release {} {} voxel {} {} {}",
-                        self.pointer.cursor.0, self.pointer.cursor.1, d.last.x, d.last.y, d.last.z
+                        self.controls.pointer.cursor.0,
+                        self.controls.pointer.cursor.1,
+                        d.last.x,
+                        d.last.y,
+                        d.last.z
                     ));
                 }
-                self.pointer.drawing = None;
-                self.edits.submit(&self.doc, Edit::StrokeEnd);
+                self.controls.pointer.drawing = None;
+                self.docs.submit(Edit::StrokeEnd);
                 // The next random-paint stroke varies differently.
                 if let PaintMode::Random { seed, .. } = &mut self.settings.brush.paint {
                     *seed = seed.wrapping_add(1);
                 }
                 // Back to the full internal size shortly after, as after a move.
-                self.motion.settling();
+                self.controls.motion.settling();
             }
-            (false, MouseButton::Left) if self.pointer.selecting.is_some() => self.select_release(),
-            (false, MouseButton::Left) if self.pointer.extruding.is_some() => {
+            (false, MouseButton::Left) if self.controls.pointer.selecting.is_some() => {
+                self.select_release()
+            }
+            (false, MouseButton::Left) if self.controls.pointer.extruding.is_some() => {
                 self.extrude_release()
             }
-            (false, MouseButton::Left) if self.pointer.stamping.is_some() => self.stamp_release(),
-            (false, MouseButton::Left) if self.pointer.rect_selecting.is_some() => {
+            (false, MouseButton::Left) if self.controls.pointer.stamping.is_some() => {
+                self.stamp_release()
+            }
+            (false, MouseButton::Left) if self.controls.pointer.rect_selecting.is_some() => {
                 self.rect_select_release()
             }
             (false, MouseButton::Left)
-                if self.pointer.moving.is_some() || self.pointer.boxing.is_some() =>
+                if self.controls.pointer.moving.is_some()
+                    || self.controls.pointer.boxing.is_some() =>
             {
                 self.arrange_release()
             }
             (true, _) if free => {
-                self.pointer.drag = input::drag_for_button(button, self.pointer.mods)
-                    .map(|d| (d, self.pointer.cursor));
+                self.controls.pointer.drag =
+                    input::drag_for_button(button, self.controls.pointer.mods)
+                        .map(|d| (d, self.controls.pointer.cursor));
             }
-            (false, _) => self.pointer.drag = None,
+            (false, _) => self.controls.pointer.drag = None,
             _ => {}
         }
     }
 
     fn cursor_moved(&mut self, x: f64, y: f64) {
-        let previous = self.pointer.cursor;
-        self.pointer.cursor = (x, y);
+        let previous = self.controls.pointer.cursor;
+        self.controls.pointer.cursor = (x, y);
         // The preview follows the cursor.
         self.request_redraw();
-        if let Some((drag, _)) = self.pointer.drag {
+        if let Some((drag, _)) = self.controls.pointer.drag {
             let h = self.viewing.area().3.max(1) as f64;
             let (dx, dy) = (
-                self.pointer.cursor.0 - previous.0,
-                self.pointer.cursor.1 - previous.1,
+                self.controls.pointer.cursor.0 - previous.0,
+                self.controls.pointer.cursor.1 - previous.1,
             );
             match drag {
                 Drag::Orbit => self.viewing.camera.orbit(-dx * 0.3, -dy * 0.3),
@@ -232,7 +247,7 @@ impl Editor {
             }
             self.moved();
         }
-        if self.pointer.sky_held && self.pointer.drawing.is_none() {
+        if self.controls.pointer.sky_held && self.controls.pointer.drawing.is_none() {
             self.stroke_from_sky(previous);
         } else {
             self.stroke_to_cursor();
@@ -246,15 +261,15 @@ impl Editor {
     /// Left button down: a paste being placed goes down, the eyedropper (Alt), the selection
     /// tool, or a new stroke under the cursor.
     pub(super) fn press(&mut self) {
-        if self.pointer.pasting {
+        if self.controls.pointer.pasting {
             self.paste_press();
             return;
         }
-        if self.settings.brush.tool == Tool::Select && !self.pointer.mods.alt {
+        if self.settings.brush.tool == Tool::Select && !self.controls.pointer.mods.alt {
             self.select_press();
             return;
         }
-        if self.settings.brush.tool == Tool::Arrange && !self.pointer.mods.alt {
+        if self.settings.brush.tool == Tool::Arrange && !self.controls.pointer.mods.alt {
             self.arrange_press();
             return;
         }
@@ -262,25 +277,25 @@ impl Editor {
             self.measure_press();
             return;
         }
-        if self.settings.brush.tool == Tool::Stamp && !self.pointer.mods.alt {
+        if self.settings.brush.tool == Tool::Stamp && !self.controls.pointer.mods.alt {
             self.stamp_press();
             return;
         }
-        if self.settings.brush.tool == Tool::Extrude && !self.pointer.mods.alt {
+        if self.settings.brush.tool == Tool::Extrude && !self.controls.pointer.mods.alt {
             self.extrude_press();
             return;
         }
         let (origin, dir) = self.cursor_ray();
-        let doc = self.doc.clone();
+        let doc = self.docs.shared();
         let doc = doc.read().unwrap_or_else(|p| p.into_inner());
         let view = doc.scene.world.read();
-        if self.pointer.mods.alt {
+        if self.controls.pointer.mods.alt {
             if let Some((_, material)) = tools::pick(&view, origin, dir) {
                 self.settings.brush.material = material;
             }
             return;
         }
-        if self.pointer.mods.shift
+        if self.controls.pointer.mods.shift
             && self.settings.brush.mode == crate::editor::command::BrushMode::Paint
         {
             // Flood fill: the connected surface of the clicked voxel's material.
@@ -295,7 +310,7 @@ impl Editor {
             }
             return;
         }
-        if self.pointer.mods.shift
+        if self.controls.pointer.mods.shift
             && self.settings.brush.mode == crate::editor::command::BrushMode::Attach
         {
             // Plane fill: the empty layer in front of the clicked face.
@@ -314,7 +329,7 @@ impl Editor {
         let brush = &self.settings.brush;
         let Some((v, layer)) = tools::start(&view, brush.mode, origin, dir) else {
             // On the sky: the stroke waits for the drag to reach the scene.
-            self.pointer.sky_held = true;
+            self.controls.pointer.sky_held = true;
             return;
         };
         drop(view);
@@ -328,15 +343,15 @@ impl Editor {
         let stroke = self.settings.brush.stroke(vec![tools::centre(v)], dims);
         self.report.line(format_args!(
             "stroke begin {} {} voxel {} {} {}",
-            self.pointer.cursor.0, self.pointer.cursor.1, v.x, v.y, v.z
+            self.controls.pointer.cursor.0, self.controls.pointer.cursor.1, v.x, v.y, v.z
         ));
-        self.pointer.drawing = Some(super::pointer::Drawing {
+        self.controls.pointer.drawing = Some(super::pointer::Drawing {
             layer,
             first: v,
             last: v,
             points: vec![v],
         });
-        self.edits.submit(&self.doc, Edit::StrokeBegin(stroke));
+        self.docs.submit(Edit::StrokeBegin(stroke));
     }
 
     /// A brush press held since it hit nothing: the cursor's path from `from` to where it is
@@ -344,7 +359,7 @@ impl Editor {
     /// meets the scene and follows the rest of the path (so a fast drag off the sky draws
     /// from where it crossed onto the ground, not from where the next event landed).
     fn stroke_from_sky(&mut self, from: (f64, f64)) {
-        let to = self.pointer.cursor;
+        let to = self.controls.pointer.cursor;
         let length = (to.0 - from.0).hypot(to.1 - from.1);
         let steps = ((length / PATH_STEP).ceil() as usize).clamp(1, MAX_PATH_STEPS);
         let at = |i: usize| {
@@ -352,8 +367,8 @@ impl Editor {
             (from.0 + (to.0 - from.0) * f, from.1 + (to.1 - from.1) * f)
         };
         for i in 1..=steps {
-            self.pointer.cursor = at(i);
-            if self.pointer.drawing.is_some() {
+            self.controls.pointer.cursor = at(i);
+            if self.controls.pointer.drawing.is_some() {
                 self.stroke_to_cursor();
                 continue;
             }
@@ -364,16 +379,16 @@ impl Editor {
                 tools::start(&view, self.settings.brush.mode, origin, dir)
             };
             if let Some((v, layer)) = first {
-                self.pointer.sky_held = false;
+                self.controls.pointer.sky_held = false;
                 self.begin_stroke(v, layer);
             }
         }
-        self.pointer.cursor = to;
+        self.controls.pointer.cursor = to;
     }
 
     /// While drawing: the stroke's next point, when the cursor reached another voxel.
     pub(super) fn stroke_to_cursor(&mut self) {
-        let Some(d) = &self.pointer.drawing else {
+        let Some(d) = &self.controls.pointer.drawing else {
             return;
         };
         let (origin, dir) = self.cursor_ray();
@@ -385,16 +400,15 @@ impl Editor {
         if let Some(v) = next
             && v != d.last
         {
-            if let Some(d) = &mut self.pointer.drawing {
+            if let Some(d) = &mut self.controls.pointer.drawing {
                 d.last = v;
                 d.points.push(v);
             }
             self.report.line(format_args!(
                 "stroke point {} {} voxel {} {} {}",
-                self.pointer.cursor.0, self.pointer.cursor.1, v.x, v.y, v.z
+                self.controls.pointer.cursor.0, self.controls.pointer.cursor.1, v.x, v.y, v.z
             ));
-            self.edits
-                .submit(&self.doc, Edit::StrokeExtend(vec![tools::centre(v)]));
+            self.docs.submit(Edit::StrokeExtend(vec![tools::centre(v)]));
         }
     }
 
@@ -405,10 +419,10 @@ impl Editor {
     ) -> Option<crate::editor::command::Stroke> {
         let brush = &self.settings.brush;
         let dims = view.dims().voxels();
-        if brush.tool != Tool::Brush || self.pointer.pasting {
+        if brush.tool != Tool::Brush || self.controls.pointer.pasting {
             return None;
         }
-        match &self.pointer.drawing {
+        match &self.controls.pointer.drawing {
             Some(d) if brush.shape == crate::editor::command::BrushShape::Box => {
                 Some(brush.stroke(vec![tools::centre(d.first), tools::centre(d.last)], dims))
             }
@@ -418,7 +432,7 @@ impl Editor {
             }
             Some(_) => None,
             None => {
-                if self.on_ui(self.pointer.cursor) {
+                if self.on_ui(self.controls.pointer.cursor) {
                     return None;
                 }
                 let (origin, dir) = self.cursor_ray();
@@ -455,9 +469,13 @@ impl Editor {
     /// Held movement keys move the camera by the time since the last tick ([`flight`]):
     /// half the view distance per second (Shift: twice it), at least 8 voxels' worth.
     pub(super) fn tick_fly(&mut self) {
-        let speed =
-            self.viewing.camera.distance.max(8.0) * if self.pointer.mods.shift { 2.0 } else { 0.5 };
-        if let Some(step) = self.flight.step(speed) {
+        let speed = self.viewing.camera.distance.max(8.0)
+            * if self.controls.pointer.mods.shift {
+                2.0
+            } else {
+                0.5
+            };
+        if let Some(step) = self.controls.flight.step(speed) {
             self.viewing.camera.fly(step);
             self.moved();
         }

@@ -14,7 +14,8 @@ use super::camera::ViewCamera;
 use super::event::Input;
 use super::files::SharedDocument;
 use super::host::{Headless, Host};
-use super::{Editor, EditorOptions, Gfx, report, tools};
+use super::screen::Gfx;
+use super::{Editor, EditorOptions, report, tools};
 use anyhow::{Context, Result};
 use glam::DVec3;
 use render::present::Presenter;
@@ -51,18 +52,18 @@ impl Editor {
     pub fn input(&mut self, input: Input) {
         let mods = match &input {
             Input::Modifiers(m) => *m,
-            _ => self.pointer.mods,
+            _ => self.controls.pointer.mods,
         };
-        let kept = input.kept_from(&self.egui);
+        let kept = input.kept_from(&self.screen.egui);
         if let Some(Gfx {
             host: Host::Headless(h),
             ..
-        }) = &mut self.gfx
+        }) = &mut self.screen.gfx
             && !kept
         {
             h.push(&input, mods);
         }
-        let consumed = !kept && input.consumed_by(&self.egui);
+        let consumed = !kept && input.consumed_by(&self.screen.egui);
         self.input_with(input, consumed);
     }
 
@@ -81,7 +82,7 @@ impl Editor {
     /// Takes what finished (edits, files, saves, the backlog) without drawing, when no edit
     /// holds the frame gate.
     pub fn pump(&mut self) {
-        let gate = self.edits.gate.clone();
+        let gate = self.docs.edits.gate.clone();
         if let Ok(_frame) = gate.try_lock() {
             self.take_results();
         }
@@ -89,26 +90,23 @@ impl Editor {
 
     /// Whether the edit thread is alive (it never ends while the editor runs: a panic did).
     pub fn edit_thread_alive(&self) -> bool {
-        self.edits.alive()
+        self.docs.edits.alive()
     }
 
     /// Bumped whenever the document is replaced (open, new, recovery).
     pub fn generation(&self) -> u64 {
-        self.generation
+        self.docs.generation()
     }
 
     /// Whether everything asked for is done: no edit queued or running, no file job, no save
     /// waiting or unrecorded, no input in the backlog.
     pub fn settled(&self) -> bool {
-        !self.edits.busy()
-            && self.files.running.is_empty()
-            && self.saves.settled()
-            && self.backlog.is_empty()
+        self.docs.settled() && self.controls.backlog_empty()
     }
 
     /// The document (shared with the edit thread and the file worker).
     pub fn document(&self) -> SharedDocument {
-        self.doc.clone()
+        self.docs.shared()
     }
 
     /// The handshake log's lines since the last call (a headless editor keeps them).
@@ -135,7 +133,8 @@ impl Editor {
 
     /// Validation messages so far (0 without the layer).
     pub fn validation_errors(&self) -> u64 {
-        self.gfx
+        self.screen
+            .gfx
             .as_ref()
             .map_or(0, |g| g.viewport.ctx().validation_errors() as u64)
     }
@@ -185,7 +184,7 @@ impl Editor {
 
     /// A rectangle in points as (x, y, width, height) in window pixels.
     fn pixel_rect(&self, r: egui::Rect) -> (f64, f64, f64, f64) {
-        let ppp = f64::from(self.egui.pixels_per_point());
+        let ppp = f64::from(self.screen.egui.pixels_per_point());
         (
             f64::from(r.min.x) * ppp,
             f64::from(r.min.y) * ppp,
@@ -200,11 +199,11 @@ impl Editor {
         let Some(Gfx {
             host: Host::Headless(h),
             ..
-        }) = &self.gfx
+        }) = &self.screen.gfx
         else {
             return None;
         };
-        let ppp = f64::from(self.egui.pixels_per_point());
+        let ppp = f64::from(self.screen.egui.pixels_per_point());
         h.widgets.iter().find(|(l, _)| l == label).map(|(_, r)| {
             let c = r.center();
             (f64::from(c.x) * ppp, f64::from(c.y) * ppp)
@@ -217,6 +216,7 @@ impl Editor {
         let id = super::editing::window_id(title);
         let layer = egui::LayerId::new(egui::Order::Middle, id);
         let r = self
+            .screen
             .egui
             .memory(|m| {
                 m.areas()
@@ -229,13 +229,13 @@ impl Editor {
 
     /// How many voxel faces tint a selection made as a set (0: none, or a box selection).
     pub fn selection_tint_faces(&self) -> usize {
-        self.preview.selection_faces()
+        self.controls.preview.selection_faces()
     }
 
     /// How many voxel faces the paste being placed, or the Stamp tool, shows (0: neither, or
     /// too large a clip).
     pub fn paste_preview_faces(&self) -> usize {
-        self.preview.paste_faces()
+        self.controls.preview.paste_faces()
     }
 
     /// Whether the in-app file browser is open.
@@ -250,7 +250,7 @@ impl Editor {
 
     /// Fly keys move by the time that passed, as in a window (not 1/60 s per tick).
     pub fn fly_in_real_time(&mut self) {
-        self.flight.in_real_time();
+        self.controls.flight.in_real_time();
     }
 
     /// The view camera.
@@ -260,12 +260,12 @@ impl Editor {
 
     /// Whether a menu or another popup is open (as of the last frame).
     pub fn popup_open(&self) -> bool {
-        egui::Popup::is_any_open(&self.egui)
+        egui::Popup::is_any_open(&self.screen.egui)
     }
 
     /// Samples per pixel the viewport's image holds.
     pub fn samples(&self) -> u32 {
-        self.gfx.as_ref().map_or(0, |g| g.viewport.samples())
+        self.screen.gfx.as_ref().map_or(0, |g| g.viewport.samples())
     }
 
     /// The view settings (kept in settings.ron).

@@ -90,7 +90,7 @@ impl Editor {
     /// over nothing).
     pub(super) fn hovered(&self) -> Option<(IVec3, IVec3)> {
         let (x, y, w, h) = self.viewing.area();
-        let (cx, cy) = self.pointer.cursor;
+        let (cx, cy) = self.controls.pointer.cursor;
         if cx < x as f64 || cy < y as f64 || cx >= (x + w) as f64 || cy >= (y + h) as f64 {
             return None;
         }
@@ -103,7 +103,7 @@ impl Editor {
     /// A click with the Measure tool.
     pub(super) fn measure_press(&mut self) {
         if let Some((v, _)) = self.hovered() {
-            self.pointer.ruler.click(v);
+            self.controls.pointer.ruler.click(v);
         }
     }
 }

@@ -5,14 +5,17 @@
 //! refinement adds samples until the target, then the loop waits for events.
 //!
 //! In detail:
-//! the editor: `run` owns the winit 0.30 event loop; `Editor` (ApplicationHandler) keeps the
-//! document as `Arc<RwLock<Document>>` (the file worker reads it for saves; every edit goes to
-//! `jobs::EditQueue`), the view (`viewing::Viewing`: camera, stored views, window and
-//! viewport area), view settings, panels, and `Gfx` (presenter,
-//! viewport, `Host`); window events become `Input`s and go to `handle.rs`. Refines until the
-//! target spp, then `ControlFlow::Wait`; internal resolution × `moving_scale` while a stroke is
-//! drawn and for 150 ms after a camera move or a stroke; samples per frame adapt to ~16 ms of
-//! GPU time. `--script` runs `ScriptRun` steps live and captures the presented frame at
+//! the editor: `run` owns the winit 0.30 event loop; `Editor` (ApplicationHandler) holds its
+//! options and the session's end, and owned parts with narrow methods: `docs::Docs` (the
+//! document as `Arc<RwLock<Document>>`, shared with the edit thread and the file worker;
+//! every edit goes through `Docs::submit` to `jobs::EditQueue`, every save through
+//! `Docs::save_to`), `controls::Controls` (key map, pointer, preview, fly keys, motion, the
+//! input backlog, the UI's last use), `screen::Screen` (`Gfx`: presenter, viewport, `Host`;
+//! the frames; egui), the panels and view settings, and `viewing::Viewing` (camera, stored
+//! views, window and viewport area). Window events become `Input`s and go to `handle.rs`.
+//! Refines until the target spp, then `ControlFlow::Wait`; internal resolution ×
+//! `moving_scale` while a stroke is drawn and for 150 ms after a camera move or a stroke.
+//! `--script` runs `ScriptRun` steps live and captures the presented frame at
 //! `--capture-spp`. A GPU error mid-session: unsaved work to the recovery file at once, then a
 //! native dialog (tested with `VOXBRICK_TEST_GPU_FAILURE_AT_FRAME`).
 
@@ -21,7 +24,9 @@ mod arranging;
 mod browser;
 mod budget;
 pub mod camera;
+mod controls;
 mod dialog_tools;
+mod docs;
 mod document;
 mod editing;
 pub mod event;
@@ -53,6 +58,7 @@ mod rect_selecting;
 pub mod render_image;
 pub mod report;
 mod saves;
+mod screen;
 mod selecting;
 mod selection_panel;
 mod stamping;
@@ -68,15 +74,14 @@ use crate::editor::script::{self, ReplayOptions, Script, ScriptRun};
 use anyhow::{Context, Result, anyhow};
 use camera::ViewCamera;
 pub use event::Input;
-use files::{ConfigDir, FileWorker, SharedDocument};
+use files::{ConfigDir, FileWorker};
 use glam::DVec3;
 use host::Host;
 use jobs::EditQueue;
 use panels::{PanelState, ViewSettings};
-use render::present::Presenter;
-use render::viewport::Viewport;
+use screen::Gfx;
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, RwLock};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
@@ -132,33 +137,6 @@ pub fn run(options: EditorOptions) -> Result<()> {
     std::mem::replace(&mut editor.outcome, Ok(()))
 }
 
-/// What the GPU and the window are, once the window exists (or its headless stand-in).
-/// Field order is drop order: the presenter and the session go before the window their
-/// surface belongs to.
-struct Gfx {
-    presenter: Presenter,
-    viewport: Viewport,
-    host: Host,
-    /// The document generation whose world the viewport holds.
-    generation: u64,
-    /// The scene's world (its epoch) the viewport holds, and how far the scene had moved
-    /// then (a regrid makes a new world and moves the scene).
-    epoch: (u64, glam::IVec3),
-    /// The window title last set.
-    title: String,
-}
-
-impl Gfx {
-    /// Sets the window's title when it changed (each set is a round trip to the window
-    /// system).
-    fn set_title(&mut self, title: String) {
-        if title != self.title {
-            self.host.set_title(&title);
-            self.title = title;
-        }
-    }
-}
-
 /// A script run through the live editor.
 struct LiveScript {
     script: Arc<Script>,
@@ -170,62 +148,27 @@ struct LiveScript {
     captured_at: Option<Instant>,
 }
 
-/// The application handler.
+/// The application handler: the session's options and lifecycle, and its owned parts.
 pub struct Editor {
     options: EditorOptions,
     config: ConfigDir,
-    gfx: Option<Gfx>,
-    egui: egui::Context,
-    doc: SharedDocument,
-    /// The document's long-edit progress (read without the document's lock).
-    progress: Arc<crate::editor::progress::Progress>,
-    /// Bumped whenever the document is replaced (the GPU world is then rebuilt).
-    generation: u64,
-    files: FileWorker,
-    edits: EditQueue,
-    /// Input that arrived while an edit held the frame gate (and whether egui kept it),
-    /// handled in order once it is free: a keystroke during a long undo is late, never lost.
-    backlog: Vec<(Input, bool)>,
-    /// Saves waiting for queued edits, finished saves to record, the autosave clock.
-    saves: saves::Saves,
-    /// The view camera, the stored views, the window's size and the viewport's area.
-    viewing: viewing::Viewing,
-    /// File → Render image…'s job, while it runs.
-    render_task: Option<render_image::RenderTask>,
-    /// File → Export mesh's file and progress, while it runs.
-    mesh_task: Option<(PathBuf, std::sync::Arc<progress::TaskProgress>)>,
+    /// The document, the edit queue, the file worker, saves and the long file jobs.
+    docs: docs::Docs,
+    /// The key map, the pointer, previews, fly keys, motion, input waiting for an edit.
+    controls: controls::Controls,
+    /// The GPU session and its host, the frames, egui.
+    screen: screen::Screen,
     settings: ViewSettings,
     panels: PanelState,
-    /// When pointer or key input last went to the UI (a panel, a menu, a window): for
-    /// [`frame::UI_FIRST`] after it, refinement waits and frames are the UI's.
-    ui_touched: Option<Instant>,
-    /// Fly keys held and their clock.
-    flight: flight::Flight,
-    /// The view in motion (the moving scale) and input to photon.
-    motion: motion::Motion,
-    /// The unsaved-changes question, a save before an open or a quit, a built scene on its
-    /// way, a recovery being loaded.
-    waits: pending::Waits,
+    /// The view camera, the stored views, the window's size and the viewport's area.
+    viewing: viewing::Viewing,
     script: Option<LiveScript>,
     quitting: bool,
     outcome: Result<()>,
-    /// Which keys do what (keys.ron).
-    keymap: keymap::KeyMap,
-    /// The modifiers, the cursor and the gesture in progress.
-    pointer: pointer::Pointer,
-    /// What a click would change, under the cursor.
-    preview: preview::Preview,
     /// The handshake log (`VOXBRICK_REPORT`).
     report: report::Report,
-    /// Frames drawn, the samples-per-frame budget, textures waiting for a frame.
-    frames: frame::Frames,
-    /// No window: frames are drawn offscreen, no native dialog is shown, fly keys move the
-    /// camera a fixed 1/60 s per frame (a headless session is a function of its input).
-    headless: bool,
     /// The editor asked to stop (the window loop exits; a headless driver is told).
     exit: bool,
-    /// `--record`: the copies of opened files and a recording a built scene ended.
-    recording: recording::Recording,
 }
 
 impl Editor {
@@ -292,39 +235,17 @@ impl Editor {
                 ..Default::default()
             },
             config,
-            gfx: None,
-            egui: egui::Context::default(),
-            progress: doc.progress.clone(),
-            doc: Arc::new(RwLock::new(doc)),
-            generation: 0,
-            files,
-            edits,
-            backlog: Vec::new(),
-            saves: saves::Saves::new(),
+            docs: docs::Docs::new(doc, files, edits, recording),
+            controls: controls::Controls::new(headless, wake_preview),
+            screen: screen::Screen::new(headless),
             viewing: viewing::Viewing::new(view),
-            render_task: None,
-            mesh_task: None,
-            ui_touched: None,
-            flight: flight::Flight::new(headless),
-            motion: motion::Motion::new(),
-            waits: Default::default(),
             quitting: false,
             outcome: Ok(()),
-            keymap: Default::default(),
-            preview: preview::Preview::new(wake_preview),
-            pointer: pointer::Pointer::default(),
             report: report::Report::from_env(),
-            frames: frame::Frames::new(),
             script: script_run,
             options,
-            headless,
             exit: false,
-            recording,
         };
-        // No fades or slides: egui's clock stands still while a slow frame blocks the loop
-        // (host::InputClock), so on a slow device a 0.1 s fade took seconds and dialogs
-        // appeared as ghosts (seen at 1280 × 720 on lavapipe).
-        editor.egui.all_styles_mut(|s| s.animation_time = 0.0);
         editor.panels.errors.extend(settings_error);
         if editor.script.is_none() {
             editor.load_keys();
@@ -343,10 +264,10 @@ impl Editor {
                 editor.panels.recovery = Some(recovery);
             }
             match editor.options.file.clone() {
-                Some(f) => editor.files.load(f, editor.options.workers),
+                Some(f) => editor.docs.files.load(f, editor.options.workers),
                 None => {
-                    editor.waits.building();
-                    editor.files.build_default(editor.options.workers);
+                    editor.docs.waits.building();
+                    editor.docs.files.build_default(editor.options.workers);
                 }
             }
         }
@@ -354,14 +275,12 @@ impl Editor {
     }
 
     fn moved(&mut self) {
-        self.motion.moved();
+        self.controls.motion.moved();
         self.request_redraw();
     }
 
     fn request_redraw(&mut self) {
-        if let Some(g) = &mut self.gfx {
-            g.host.request_redraw();
-        }
+        self.screen.request_redraw();
     }
 
     /// The viewport's aspect ratio.
@@ -371,7 +290,7 @@ impl Editor {
 
     /// Normalized device coordinates of the cursor in the viewport (v up).
     fn cursor_ndc(&self) -> (f64, f64) {
-        self.ndc(self.pointer.cursor)
+        self.ndc(self.controls.pointer.cursor)
     }
 
     /// Normalized device coordinates of a window point in the viewport (v up).
@@ -383,9 +302,10 @@ impl Editor {
     /// The key map: the settings' preset under keys.ron; the Shortcuts window lists it.
     fn load_keys(&mut self) {
         let (keymap, error) = self.config.keymap(self.settings.key_preset);
-        self.keymap = keymap;
+        self.controls.keymap = keymap;
         self.panels.errors.extend(error);
         self.panels.keys = self
+            .controls
             .keymap
             .bindings()
             .iter()
@@ -394,7 +314,7 @@ impl Editor {
     }
 
     fn cursor_ray(&self) -> (DVec3, DVec3) {
-        self.viewing.ray_at(self.pointer.cursor)
+        self.viewing.ray_at(self.controls.pointer.cursor)
     }
 }
 
@@ -415,7 +335,7 @@ fn content_bounds(scene: &Scene) -> (DVec3, DVec3) {
 
 impl ApplicationHandler<Wake> for Editor {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
-        if self.gfx.is_none()
+        if self.screen.gfx.is_none()
             && let Err(e) = self.create_gfx(event_loop)
         {
             self.outcome = Err(e);
@@ -439,7 +359,7 @@ impl ApplicationHandler<Wake> for Editor {
                 if let Some(Gfx {
                     host: Host::Window { clock, .. },
                     ..
-                }) = &mut self.gfx
+                }) = &mut self.screen.gfx
                 {
                     clock.frame_ran(began);
                 }
@@ -447,8 +367,10 @@ impl ApplicationHandler<Wake> for Editor {
             WindowEvent::ScaleFactorChanged { .. } => self.request_redraw(),
             _ => {
                 let input = Input::from_window_event(&event);
-                let tab = input.as_ref().is_some_and(|i| i.kept_from(&self.egui));
-                let consumed = match &mut self.gfx {
+                let tab = input
+                    .as_ref()
+                    .is_some_and(|i| i.kept_from(&self.screen.egui));
+                let consumed = match &mut self.screen.gfx {
                     _ if tab => false,
                     Some(Gfx {
                         host:
@@ -478,7 +400,7 @@ impl ApplicationHandler<Wake> for Editor {
     fn new_events(&mut self, _event_loop: &ActiveEventLoop, cause: winit::event::StartCause) {
         // A long edit's progress, or refinement that waited while the UI was used.
         if matches!(cause, winit::event::StartCause::ResumeTimeReached { .. })
-            && (self.progress.fraction().is_some() || self.ui_touched.is_some())
+            && (self.docs.progress().is_some() || self.controls.ui_waiting())
         {
             self.request_redraw();
         }
@@ -489,7 +411,7 @@ impl ApplicationHandler<Wake> for Editor {
             event_loop.exit();
         }
         event_loop.set_control_flow(ControlFlow::Wait);
-        if self.edits.busy() || self.progress.fraction().is_some() {
+        if self.docs.busy() {
             // An edit is running: look at a long one's progress ten times a second.
             event_loop.set_control_flow(ControlFlow::WaitUntil(
                 Instant::now() + Duration::from_millis(100),
@@ -498,26 +420,22 @@ impl ApplicationHandler<Wake> for Editor {
         }
         let mut wake: Option<Instant> = None;
         if self.script.is_none() {
-            wake = self.saves.next_autosave(self.settings.autosave_secs);
+            wake = self.docs.saves.next_autosave(self.settings.autosave_secs);
         }
         // Refinement resumes when the UI has been left alone for `UI_FIRST`.
-        if let Some(t) = self.ui_touched {
-            let resume = t + frame::UI_FIRST;
-            if resume > Instant::now() {
-                wake = Some(wake.map_or(resume, |w| w.min(resume)));
-            } else {
-                self.ui_touched = None;
-                self.request_redraw();
-            }
+        match self.controls.ui_wait(Instant::now()) {
+            controls::UiWait::None => {}
+            controls::UiWait::Until(resume) => wake = Some(wake.map_or(resume, |w| w.min(resume))),
+            controls::UiWait::Ended => self.request_redraw(),
         }
         // A trace job in flight: look for its end soon (its image, or the next job).
-        if let Some(t) = self.frames.pump_at {
+        if let Some(t) = self.screen.frames.pump_at {
             if t <= Instant::now()
                 && let Err(e) = self.pump_trace()
             {
                 self.gpu_failed(e);
             }
-            if let Some(t) = self.frames.pump_at {
+            if let Some(t) = self.screen.frames.pump_at {
                 wake = Some(wake.map_or(t, |w| w.min(t)));
             }
         }
@@ -535,13 +453,11 @@ impl Editor {
     /// The session ends: validation errors become the outcome, the GPU objects go before
     /// the window, the recording is written.
     fn finish(&mut self) {
-        if let Some(g) = &self.gfx {
-            let errors = g.viewport.ctx().validation_errors();
-            if errors > 0 && self.outcome.is_ok() {
-                self.outcome = Err(anyhow!("{errors} Vulkan validation errors"));
-            }
+        let errors = self.screen.validation_errors();
+        if errors > 0 && self.outcome.is_ok() {
+            self.outcome = Err(anyhow!("{errors} Vulkan validation errors"));
         }
-        self.gfx = None;
+        self.screen.release();
         if let Err(e) = self.write_recording() {
             eprintln!("voxbrick: {e:#}");
             if self.outcome.is_ok() {
@@ -553,7 +469,6 @@ impl Editor {
 
 impl Drop for Editor {
     fn drop(&mut self) {
-        self.gfx = None;
-        self.frames.textures.clear();
+        self.screen.release();
     }
 }

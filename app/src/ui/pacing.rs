@@ -4,7 +4,8 @@
 //! finished, and a frame asked for once a job's image is ready to show — so that the UI's
 //! frames never wait for a trace ([`render::viewport::Viewport::trace_paced`]).
 
-use super::{Editor, Gfx};
+use super::Editor;
+use super::screen::Gfx;
 use anyhow::Result;
 use render::present::{Framed, Show};
 use render::viewport::FrameRequest;
@@ -35,7 +36,7 @@ impl Editor {
             params,
             internal,
             output: shown,
-            spp: self.frames.budget.spp,
+            spp: self.screen.frames.budget.spp,
             target_spp,
             exposure: doc.scene.params.settings.exposure + self.settings.exposure,
             bgra: false,
@@ -62,19 +63,19 @@ impl Editor {
     /// the jobs before it (`sizes`: the still and the traced internal size), and which job
     /// first shows the last input or result.
     pub(super) fn traced(&mut self, gfx: &Gfx, framed: &Framed, (still, internal): Sizes) {
-        if self.frames.awaited {
+        if self.screen.frames.awaited {
             if framed.idle {
                 // Nothing to trace: the image shown already shows it.
-                self.frames.awaited = false;
+                self.screen.frames.awaited = false;
             } else if framed.traced.is_some() {
-                self.frames.input_job = Some(gfx.viewport.pending_image_job());
-                self.frames.awaited = false;
+                self.screen.frames.input_job = Some(gfx.viewport.pending_image_job());
+                self.screen.frames.awaited = false;
             }
         }
         let Some(status) = framed.traced else {
             return;
         };
-        self.frames.last_added = status.added;
+        self.screen.frames.last_added = status.added;
         // The budget reasons about the still image: a moving frame's time is scaled by the
         // pixels it left out.
         let ratio = (f64::from(still.0) * f64::from(still.1))
@@ -88,33 +89,33 @@ impl Editor {
     /// is run or displayed), and a frame once a job's image is ready to be shown. Never
     /// waits for the GPU.
     pub(super) fn pump_trace(&mut self) -> Result<()> {
-        self.frames.pump_at = None;
-        let gate = self.edits.gate.clone();
+        self.screen.frames.pump_at = None;
+        let gate = self.docs.edits.gate.clone();
         let Ok(_frame) = gate.try_lock() else {
             return Ok(());
         };
-        let Some(mut gfx) = self.gfx.take() else {
+        let Some(mut gfx) = self.screen.gfx.take() else {
             return Ok(());
         };
         let result = self.pump_with(&mut gfx);
-        self.gfx = Some(gfx);
+        self.screen.gfx = Some(gfx);
         result
     }
 
     fn pump_with(&mut self, gfx: &mut Gfx) -> Result<()> {
         let finished = gfx.viewport.shown_image()?.map(|s| s.image.job);
-        if finished.is_some() && finished != self.frames.shown_job {
+        if finished.is_some() && finished != self.screen.frames.shown_job {
             // A new image: a whole frame shows it (with the status line's new figures).
             gfx.host.request_redraw();
             return Ok(());
         }
-        if gfx.generation != self.generation {
+        if gfx.generation != self.docs.generation() {
             gfx.host.request_redraw();
             return Ok(());
         }
-        let (internal, target_spp) = self.frames.asked;
+        let (internal, target_spp) = self.screen.frames.asked;
         let area = self.viewing.area();
-        let doc = self.doc.clone();
+        let doc = self.docs.shared();
         let doc = doc.read().unwrap_or_else(|p| p.into_inner());
         if (doc.scene.epoch(), doc.scene.shifted()) != gfx.epoch {
             drop(doc);
@@ -138,7 +139,7 @@ impl Editor {
             .fit_internal(self.internal_size((area.2, area.3)));
         self.traced(gfx, &framed, (still, internal));
         if gfx.viewport.samples() < target_spp || gfx.viewport.in_flight()? > 0 {
-            self.frames.pump_at = Some(Instant::now() + PUMP);
+            self.screen.frames.pump_at = Some(Instant::now() + PUMP);
         }
         Ok(())
     }
@@ -154,14 +155,14 @@ impl Editor {
         if self.script.is_some() {
             internal
         } else {
-            self.frames.budget.apply(internal)
+            self.screen.frames.budget.apply(internal)
         }
     }
 
     /// Samples per frame and the traced resolution follow the GPU time ([`budget`]).
     pub(super) fn adapt_samples(&mut self, gpu: Option<f64>) {
         if let Some(t) = gpu {
-            self.frames.budget.update(t);
+            self.screen.frames.budget.update(t);
         }
     }
 }

@@ -19,19 +19,19 @@ pub(super) struct RectDrag {
 impl Editor {
     /// A press with a rectangle mode: the drag starts (over the scene or not).
     pub(super) fn rect_select_press(&mut self) {
-        let mods = self.pointer.mods;
-        self.pointer.rect_selecting = Some(RectDrag {
-            from: self.pointer.cursor,
+        let mods = self.controls.pointer.mods;
+        self.controls.pointer.rect_selecting = Some(RectDrag {
+            from: self.controls.pointer.cursor,
             how: Combine::of(mods.shift, mods.ctrl),
         });
     }
 
     /// The release: the rectangle's voxels (a click selects nothing when replacing).
     pub(super) fn rect_select_release(&mut self) {
-        let Some(d) = self.pointer.rect_selecting.take() else {
+        let Some(d) = self.controls.pointer.rect_selecting.take() else {
             return;
         };
-        let to = self.pointer.cursor;
+        let to = self.controls.pointer.cursor;
         if (to.0 - d.from.0).abs() < 2.0 && (to.1 - d.from.1).abs() < 2.0 {
             if d.how == Combine::Replace {
                 self.select(SelectOp::None);

@@ -131,7 +131,10 @@ impl Editor {
             return;
         }
         if brush.select_mode == super::tools::SelectMode::WandFace {
-            let how = crate::wand::Combine::of(self.pointer.mods.shift, self.pointer.mods.ctrl);
+            let how = crate::wand::Combine::of(
+                self.controls.pointer.mods.shift,
+                self.controls.pointer.mods.ctrl,
+            );
             let diagonal = brush.wand_diagonal;
             let hit = {
                 let doc = self.read();
@@ -157,7 +160,7 @@ impl Editor {
                 brush.select_mode == super::tools::SelectMode::WandColour,
                 brush.wand_diagonal,
             );
-            let mods = self.pointer.mods;
+            let mods = self.controls.pointer.mods;
             let how = crate::wand::Combine::of(mods.shift, mods.ctrl);
             let hit = {
                 let doc = self.read();
@@ -176,7 +179,7 @@ impl Editor {
             }
             return;
         }
-        let kind = DragKind::of(self.pointer.mods);
+        let kind = DragKind::of(self.controls.pointer.mods);
         let start = {
             let doc = self.read();
             let view = doc.scene.world.read();
@@ -185,7 +188,7 @@ impl Editor {
         };
         match start {
             Some(((v, layer), (hit, _))) => {
-                self.pointer.selecting = Some(SelectDrag {
+                self.controls.pointer.selecting = Some(SelectDrag {
                     layer,
                     inward: -hit.normal[layer.axis],
                     first: v,
@@ -201,13 +204,13 @@ impl Editor {
     /// While dragging a selection box: its corner follows the cursor on the first face's
     /// plane.
     pub(super) fn select_to_cursor(&mut self) {
-        let Some(d) = &self.pointer.selecting else {
+        let Some(d) = &self.controls.pointer.selecting else {
             return;
         };
         let (origin, dir) = self.cursor_ray();
         let dims = self.read().scene.world.dims().voxels();
         if let Some(v) = tools::on_layer(d.layer, origin, dir, dims)
-            && let Some(d) = &mut self.pointer.selecting
+            && let Some(d) = &mut self.controls.pointer.selecting
         {
             d.last = v;
         }
@@ -215,7 +218,7 @@ impl Editor {
 
     /// The box being dragged, if any.
     pub(super) fn dragged_box(&self) -> Option<(IVec3, IVec3, DragKind)> {
-        let d = self.pointer.selecting.as_ref()?;
+        let d = self.controls.pointer.selecting.as_ref()?;
         let depth = self.settings.brush.select_depth;
         let (lo, hi) = drag_box(d.first, d.last, d.layer, d.inward, depth);
         Some((lo, hi, d.kind))
@@ -224,7 +227,7 @@ impl Editor {
     /// Left button up: the dragged box changes the selection (one command).
     pub(super) fn select_release(&mut self) {
         if let Some((lo, hi, kind)) = self.dragged_box() {
-            self.pointer.selecting = None;
+            self.controls.pointer.selecting = None;
             self.select(kind.op((lo, hi)));
         }
     }
@@ -240,7 +243,7 @@ impl Editor {
             return;
         }
         let step = nudge_offset(n, self.viewing.camera.camera.forward());
-        let step = if self.pointer.mods.shift {
+        let step = if self.controls.pointer.mods.shift {
             step * 8
         } else {
             step
@@ -250,7 +253,7 @@ impl Editor {
 
     /// Where the paste being placed would go now in `doc` (its minimum corner and size).
     pub(super) fn paste_target(&self, doc: &Document) -> Option<(IVec3, IVec3)> {
-        if !self.pointer.pasting {
+        if !self.controls.pointer.pasting {
             return None;
         }
         let size = doc.scene.clipboard.as_ref()?.size;
@@ -262,10 +265,9 @@ impl Editor {
     /// A click while placing a paste: it goes down there.
     pub(super) fn paste_press(&mut self) {
         let target = self.paste_target(&self.read());
-        self.pointer.pasting = false;
+        self.controls.pointer.pasting = false;
         if let Some((at, _)) = target {
-            self.edits
-                .submit(&self.doc, Edit::Command(Command::Paste { at }));
+            self.docs.submit(Edit::Command(Command::Paste { at }));
         }
     }
 }

@@ -68,7 +68,7 @@ impl Editor {
         let Some((at, _)) = self.stamp_target(&self.read(), None) else {
             return;
         };
-        self.pointer.stamping = Some(StampDrag {
+        self.controls.pointer.stamping = Some(StampDrag {
             layer,
             at: vec![at],
         });
@@ -76,13 +76,13 @@ impl Editor {
 
     /// While dragging: another stamp once the cursor is a stamp's width from the last.
     pub(super) fn stamp_to_cursor(&mut self) {
-        let Some(layer) = self.pointer.stamping.as_ref().map(|d| d.layer) else {
+        let Some(layer) = self.controls.pointer.stamping.as_ref().map(|d| d.layer) else {
             return;
         };
         let Some((next, size)) = self.stamp_target(&self.read(), Some(layer)) else {
             return;
         };
-        if let Some(d) = &mut self.pointer.stamping
+        if let Some(d) = &mut self.controls.pointer.stamping
             && d.at.len() < MAX_STAMPS
             && d.at.last().is_none_or(|last| apart(*last, next, size))
         {
@@ -92,7 +92,7 @@ impl Editor {
 
     /// The release: every stamp of the drag, one step.
     pub(super) fn stamp_release(&mut self) {
-        if let Some(d) = self.pointer.stamping.take() {
+        if let Some(d) = self.controls.pointer.stamping.take() {
             self.execute(Command::Stamp {
                 at: d.at,
                 quarters: self.settings.brush.stamp_quarters,

@@ -48,10 +48,12 @@ impl Editor {
             ));
         }
         if tool == Tool::Measure {
-            parts.push(match self.pointer.ruler.ends(hovered.map(|(v, _)| v)) {
-                Some((a, b)) => super::measure::text(a, b),
-                None => "measure: click a voxel, then another".into(),
-            });
+            parts.push(
+                match self.controls.pointer.ruler.ends(hovered.map(|(v, _)| v)) {
+                    Some((a, b)) => super::measure::text(a, b),
+                    None => "measure: click a voxel, then another".into(),
+                },
+            );
         }
         parts.push(figures.to_string());
         parts.join(" · ")
