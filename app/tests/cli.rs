@@ -192,7 +192,7 @@ fn new_terrain_and_its_load_use_every_worker_and_no_voxel_work() {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let expect = format!(
         "on {cores} workers (adopted as one object on {cores} threads; \
-         0 bricks rewritten voxel by voxel, 0 composited)"
+         0 bricks rewritten voxel by voxel, 0 composited, 0 undo records)"
     );
     assert!(err.contains(&expect), "expected `{expect}` in: {err}");
     let info = ok(&["info", s(&a)]);
@@ -204,7 +204,7 @@ fn new_terrain_and_its_load_use_every_worker_and_no_voxel_work() {
     ok(&["convert", s(&ogt), s(&p)]);
     let info = ok(&["info", s(&p)]);
     assert!(
-        !field(&info, "loaded").contains(" 0 composited"),
+        !field(&info, "loaded").contains(" 0 composited,"),
         "objects are composited: {info}"
     );
 }

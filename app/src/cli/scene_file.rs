@@ -98,11 +98,13 @@ pub(crate) fn new(a: NewArgs, workers: usize) -> Result<()> {
     save(&scene, &a.output)?;
     eprintln!(
         "generated in {generated:.2} s on {} workers (adopted as one object on {} threads; \
-         {} bricks rewritten voxel by voxel, {} composited), wrote {} in {:.2} s total",
+         {} bricks rewritten voxel by voxel, {} composited, {} undo records), wrote {} in \
+         {:.2} s total",
         scene.world.workers(),
         work.adopted_on,
         work.voxel_bricks,
         work.composited,
+        work.undo_records,
         a.output.display(),
         started.elapsed().as_secs_f64()
     );
@@ -392,11 +394,12 @@ pub(crate) fn info(a: InfoArgs, workers: usize) -> Result<()> {
     let p = &scene.params;
     let mut text = format!("file         {}\n", file.display());
     text += &format!(
-        "loaded       in {loaded:.2} s on {} workers (adopted as one object on {} threads; {} bricks rewritten voxel by voxel, {} composited)\n",
+        "loaded       in {loaded:.2} s on {} workers (adopted as one object on {} threads; {} bricks rewritten voxel by voxel, {} composited, {} undo records)\n",
         scene.world.workers(),
         work.adopted_on,
         work.voxel_bricks,
-        work.composited
+        work.composited,
+        work.undo_records
     );
     text += &stats_text(&scene.world, started.elapsed().as_secs_f64());
     text += &objects_text(&scene.objects());

@@ -51,6 +51,11 @@ impl Undo {
             .chain(self.cleared.iter().map(|c| c.1))
     }
 
+    /// Whole records kept (`BrickUndo`s; the compact positions not counted).
+    pub(crate) fn records(&self) -> usize {
+        self.bricks.len()
+    }
+
     /// Nothing recorded.
     #[cfg(test)]
     pub(crate) fn is_empty(&self) -> bool {

@@ -89,6 +89,7 @@ impl Ticket<'_> {
         parts.sort_by_key(|(w, _)| *w);
         let changed_voxels = parts.iter().map(|(_, (_, c))| c).sum();
         let undo: Vec<crate::slab::Undo> = parts.into_iter().map(|(_, (u, _))| u).collect();
+        crate::census::undo_records(undo.iter().map(|u| u.records() as u64).sum());
         if let Some(e) = first_error {
             let inverse = inverse_of(undo);
             if !inverse.is_empty()
