@@ -90,6 +90,8 @@ pub(crate) enum WorkItem {
     Shape(Arc<(Shape, Mode)>),
     Voxels(Vec<VoxelEdit>),
     Restore(Vec<BrickUndo>),
+    /// This slab's run of a restore's list (the list in slab order, shared by the workers).
+    RestoreRun(Arc<Vec<BrickUndo>>, std::ops::Range<usize>),
     /// Generated columns (every column of the slab).
     Generate(Arc<dyn ColumnSource>),
     /// Panics (see `World::inject_worker_panic`; tests only).

@@ -335,6 +335,24 @@ impl World {
                 .map(|w| (w, WorkItem::Generate(g.0.clone())))
                 .collect(),
             EditOp::Restore(inv) => {
+                let slab = |u: &crate::edit::BrickUndo| self.slab_of_x[u.brick.x as usize];
+                if inv.bricks.is_sorted_by_key(slab) {
+                    // In slab order (a file's bricks, a generated grid's, most inverses): each
+                    // worker reads its run of one shared list, nothing is copied.
+                    let mut runs = Vec::new();
+                    let mut start = 0;
+                    while start < inv.bricks.len() {
+                        let w = slab(&inv.bricks[start]);
+                        let len = inv.bricks[start..].partition_point(|u| slab(u) == w);
+                        runs.push((w as usize, start..start + len));
+                        start += len;
+                    }
+                    let list = Arc::new(inv.bricks);
+                    return runs
+                        .into_iter()
+                        .map(|(w, r)| (w, WorkItem::RestoreRun(list.clone(), r)))
+                        .collect();
+                }
                 let mut per = vec![Vec::new(); self.slabs.len()];
                 for u in inv.bricks {
                     per[self.slab_of_x[u.brick.x as usize] as usize].push(u);

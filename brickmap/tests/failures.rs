@@ -227,10 +227,17 @@ fn an_unrecorded_bulk_write_is_the_same_edit_and_still_rolls_back() {
     // Over the brick budget part way (one 1024-brick chunk, 1500 bricks asked for across
     // both workers), recorded or not: the world as before, the pre-existing bricks and the
     // brick named twice included.
-    for unrecorded in [false, true] {
+    // Both ways a restore reaches the workers: copied apart, or (in slab order) as runs of
+    // one shared list.
+    for (unrecorded, in_slab_order) in [(false, false), (true, false), (false, true), (true, true)]
+    {
         let world = prepared(1024);
         let (hash, solid) = (world.read().content_hash(), world.read().solid_count());
-        let write = brickmap::terrain::set_bricks(partial_bricks(&world, 1500));
+        let mut bricks = partial_bricks(&world, 1500);
+        if in_slab_order {
+            bricks.sort_by_key(|b| b.0.x);
+        }
+        let write = brickmap::terrain::set_bricks(bricks);
         let err = if unrecorded {
             world.apply_unrecorded(write).unwrap_err()
         } else {

@@ -16,6 +16,7 @@ impl Slab {
             WorkItem::Shape(job) => self.run_shape(&job.0, job.1, &mut undo),
             WorkItem::Voxels(list) => self.run_voxels(&list, &mut undo),
             WorkItem::Restore(list) => self.run_restore(&list, &mut undo),
+            WorkItem::RestoreRun(list, run) => self.run_restore(&list[run], &mut undo),
             WorkItem::Generate(source) => self.run_generate(source.as_ref(), &mut undo),
             #[cfg(feature = "test-hooks")]
             WorkItem::Panic => panic!("injected worker panic"),
