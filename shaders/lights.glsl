@@ -55,28 +55,76 @@ float light_importance(uint i, vec3 p, ivec3 n) {
     return w * cl * cr / max(d2, r2);
 }
 
-// The slot chosen for p with normal n from u ∈ [0, 1) (rescaled at each level) and its
+// Benchmark only (trace.comp's EXPERIMENT bits 16..17): the descent takes LIGHT_LEVELS levels
+// of the binary tree a step, choosing among a node's 2^LIGHT_LEVELS descendants that many levels
+// down by their own importance (a 4- or 8-wide tree over the same nodes: fewer dependent steps,
+// the skipped levels' nodes unread). 1 is the binary descent of `Lights::sample_from`.
+#ifndef LIGHT_LEVELS
+#define LIGHT_LEVELS 1u
+#endif
+const uint LIGHT_WIDE = 8u; // the widest step's children (LIGHT_LEVELS ≤ 3)
+
+// The levels the step from depth d takes in a tree of `depth` levels.
+uint light_step(uint d, uint depth) { return min(min(LIGHT_LEVELS, 3u), depth - d); }
+
+// The slot chosen for p with normal n from u ∈ [0, 1) (rescaled at each step) and its
 // probability, or NO_LIGHT when no face can light p.
 uint sample_light(float u, vec3 p, ivec3 n, out float prob) {
     prob = 0.0;
     uint c = light_capacity();
     uint i = 1u;
     float pr = 1.0;
-    while (i < c) {
-        float l = light_importance(2u * i, p, n);
-        float r = light_importance(2u * i + 1u, p, n);
-        if (!(l + r > 0.0)) return 0xFFFFFFFFu;
-        float pl = l / (l + r);
-        if (u < pl) {
-            u /= pl;
-            pr *= pl;
-            i = 2u * i;
-        } else {
-            u = (u - pl) / (1.0 - pl);
-            pr *= 1.0 - pl;
-            i = 2u * i + 1u;
+    if (LIGHT_LEVELS == 1u) {
+        while (i < c) {
+            float l = light_importance(2u * i, p, n);
+            float r = light_importance(2u * i + 1u, p, n);
+            if (!(l + r > 0.0)) return 0xFFFFFFFFu;
+            float pl = l / (l + r);
+            if (u < pl) {
+                u /= pl;
+                pr *= pl;
+                i = 2u * i;
+            } else {
+                u = (u - pl) / (1.0 - pl);
+                pr *= 1.0 - pl;
+                i = 2u * i + 1u;
+            }
+            u = min(u, 0.99999994);
         }
-        u = min(u, 0.99999994);
+        prob = pr;
+        return i - c;
+    }
+    uint depth = uint(findMSB(c));
+    for (uint d = 0u; d < depth;) {
+        uint s = light_step(d, depth);
+        uint k = 1u << s;
+        uint first = i << s;
+        float imp[LIGHT_WIDE];
+        float sum = 0.0;
+        for (uint j = 0u; j < LIGHT_WIDE; j++) {
+            imp[j] = j < k ? light_importance(first + j, p, n) : 0.0;
+            sum += imp[j];
+        }
+        if (!(sum > 0.0)) return 0xFFFFFFFFu;
+        // The child whose share of [0, sum) holds u · sum: the last of positive importance
+        // whose share starts at or below it (the first positive one always does).
+        float target = u * sum;
+        float below = 0.0;
+        uint pick = 0u;
+        float below_pick = 0.0;
+        float w = 0.0;
+        for (uint j = 0u; j < LIGHT_WIDE; j++) {
+            if (imp[j] > 0.0 && below <= target) {
+                pick = j;
+                below_pick = below;
+                w = imp[j];
+            }
+            below += imp[j];
+        }
+        u = clamp((target - below_pick) / w, 0.0, 0.99999994);
+        pr *= w / sum;
+        i = first + pick;
+        d += s;
     }
     prob = pr;
     return i - c;
@@ -88,12 +136,32 @@ float light_probability(uint slot, vec3 p, ivec3 n) {
     uint c = light_capacity();
     uint leaf = c + slot;
     float pr = 1.0;
-    for (uint level = uint(findMSB(c)); level > 0u; level--) {
-        uint parent = leaf >> level;
-        float l = light_importance(2u * parent, p, n);
-        float r = light_importance(2u * parent + 1u, p, n);
-        if (!(l + r > 0.0)) return 0.0;
-        pr *= (((leaf >> (level - 1u)) & 1u) == 0u ? l : r) / (l + r);
+    if (LIGHT_LEVELS == 1u) {
+        for (uint level = uint(findMSB(c)); level > 0u; level--) {
+            uint parent = leaf >> level;
+            float l = light_importance(2u * parent, p, n);
+            float r = light_importance(2u * parent + 1u, p, n);
+            if (!(l + r > 0.0)) return 0.0;
+            pr *= (((leaf >> (level - 1u)) & 1u) == 0u ? l : r) / (l + r);
+        }
+        return pr;
+    }
+    uint depth = uint(findMSB(c));
+    for (uint d = 0u; d < depth;) {
+        uint s = light_step(d, depth);
+        uint k = 1u << s;
+        uint first = (leaf >> (depth - d)) << s;
+        uint on = (leaf >> (depth - d - s)) - first;
+        float sum = 0.0;
+        float w = 0.0;
+        for (uint j = 0u; j < LIGHT_WIDE; j++) {
+            float x = j < k ? light_importance(first + j, p, n) : 0.0;
+            sum += x;
+            w = j == on ? x : w;
+        }
+        if (!(sum > 0.0)) return 0.0;
+        pr *= w / sum;
+        d += s;
     }
     return pr;
 }

@@ -31,8 +31,10 @@ layout(constant_id = 7) const bool COUNT_RAYS = false;
 // makes shaders/shadow.comp skip its work, bit 5 pads each traversal step with 64 multiply-adds
 // (brickmap.glsl PAD_STEPS), bit 6 starts a subgroup's next samples together,
 // bits 7..10 turn traversal skips off (brickmap.glsl SKIPS_OFF), bit 11 chooses light faces by
-// weight alone (lights.glsl LIGHTS_BY_WEIGHT), bit 13 starts camera rays at the camera
-// (TILE_MARCH_OFF), bit 15 adds a load each traversal step waits for (PAD_LOAD).
+// weight alone (lights.glsl LIGHTS_BY_WEIGHT), bit 12 makes the sun-or-faces choice once for
+// the subgroup's lanes at a vertex (LIGHTS_COHERENT), bit 13 starts camera rays at the camera
+// (TILE_MARCH_OFF), bit 15 adds a load each traversal step waits for (PAD_LOAD), bits 16..17
+// descend the light tree 1 + their value levels a step (lights.glsl LIGHT_LEVELS).
 layout(constant_id = 8) const uint EXPERIMENT = 0u;
 // Shadow rays go to a queue that shaders/shadow.comp traces next, one per invocation, instead
 // of being traced here: in a warp only some lanes have a shadow ray at a vertex, and tracing
@@ -68,6 +70,8 @@ layout(constant_id = 15) const bool TRANSPARENT = false;
 #define PAD_STEPS ((EXPERIMENT & 32u) != 0u)
 #define PAD_LOAD ((EXPERIMENT & 32768u) != 0u)
 #define LIGHTS_BY_WEIGHT ((EXPERIMENT & 2048u) != 0u)
+#define LIGHTS_COHERENT ((EXPERIMENT & 4096u) != 0u)
+#define LIGHT_LEVELS (1u + ((EXPERIMENT >> 16) & 3u))
 // Camera rays start where their tile's frustum first meets an occupied coarse cell (off with
 // experiment bit 13, and with the coarse grid's skip off: bit 7).
 // (8320 = bits 13 and 7; one mask test: glslang miscompiles a && of two spec-constant tests.)
@@ -544,6 +548,18 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
             u = rand();
         }
         path_sun_share = share;
+        float u_light = (u - share) / (1.0 - share);
+        if (LIGHTS_COHERENT) {
+            // One uniform for the sun-or-faces choice of the subgroup's lanes here (each lane's
+            // is still uniform and independent of its path, so each lane's estimate stays
+            // unbiased), so that lanes that choose alike run one branch; the faces' descent
+            // takes the lane's own dimension whole.
+            if (sun_on && path_face_share > 0.0) {
+                u_light = u;
+                uint h = subgroupBroadcastFirst(hash(rng ^ hash(path_vertex * 0x9e3779b9u + 0x632be5abu)));
+                u = float(h >> 8) * (1.0 / 16777216.0);
+            }
+        }
         if ((EXPERIMENT & 8u) != 0u || delta) {
             path_face_share = 0.0;
         } else if (sun_on && u < share) {
@@ -569,7 +585,7 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
         } else if (LIGHTS && path_face_share > 0.0) {
             // A light face from the tree by importance, a point uniform on it.
             float prob;
-            uint slot = sample_light(min((u - share) / (1.0 - share), 0.99999994), pt, normal, prob);
+            uint slot = sample_light(min(u_light, 0.99999994), pt, normal, prob);
             if (slot != NO_LIGHT) {
                 ivec3 lv;
                 uint lf;

@@ -249,24 +249,31 @@ fn a_point_draws_faces_by_importance_with_the_probability_it_reports() {
         (glam::DVec3::new(64.0, 8.25, 16.5), IVec3::NEG_X),
         (glam::DVec3::new(100.5, 15.0, 0.5), IVec3::Z),
     ];
-    for (p, n) in points {
+    // The binary descent and the 4- and 8-wide steps over the same tree.
+    for ((p, n), levels) in points
+        .into_iter()
+        .flat_map(|q| (1..=3).map(move |l| (q, l)))
+    {
         let mut sum = 0.0;
         for (slot, f) in lights.iter() {
-            let prob = lights.probability_from(slot, p, n);
+            let prob = lights.probability_stepping(slot, p, n, levels);
             sum += prob;
             // A face whose centre is in front of it and of the receiver has a chance.
             let centre = f.voxel.as_dvec3() + 0.5 + f.normal().as_dvec3() * 0.5;
             let seen = (p - centre).dot(f.normal().as_dvec3()) > 0.0
                 && (centre - p).dot(n.as_dvec3()) > 0.0;
-            assert!(!seen || prob > 0.0, "{p} {n}: face {f:?} has no chance");
+            assert!(
+                !seen || prob > 0.0,
+                "{p} {n} {levels}: face {f:?} has no chance"
+            );
         }
-        assert!(sum > 0.5 && sum <= 1.0 + 1e-9, "{p} {n}: {sum}");
+        assert!(sum > 0.5 && sum <= 1.0 + 1e-9, "{p} {n} {levels}: {sum}");
         let draws = 200_000u32;
         let mut counts = std::collections::HashMap::new();
         for k in 0..draws {
             let u = (k as f64 + 0.5) / draws as f64;
-            if let Some((slot, prob)) = lights.sample_from(u, p, n) {
-                let expected = lights.probability_from(slot, p, n);
+            if let Some((slot, prob)) = lights.sample_stepping(u, p, n, levels) {
+                let expected = lights.probability_stepping(slot, p, n, levels);
                 assert!(
                     (prob - expected).abs() <= 1e-12 * expected,
                     "{prob} {expected}"
@@ -275,7 +282,7 @@ fn a_point_draws_faces_by_importance_with_the_probability_it_reports() {
             }
         }
         for (slot, _) in lights.iter() {
-            let expected = lights.probability_from(slot, p, n) * draws as f64;
+            let expected = lights.probability_stepping(slot, p, n, levels) * draws as f64;
             let got = *counts.get(&slot).unwrap_or(&0) as f64;
             // Stratified u: the counts are exact up to the rounding of each subtree's share.
             assert!(

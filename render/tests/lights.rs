@@ -82,6 +82,26 @@ mod gpu {
             let c1 = cpu(&w, &p, true, 64, 5);
             let c2 = cpu(&w, &p, true, 64, 6);
             check(&format!("GPU against CPU, {what}"), &l1, &l2, &c1, &c2);
+            // The benchmark's light-tree experiments (trace.comp EXPERIMENT bits 12, 16..17):
+            // the 4- and 8-wide descents and the subgroup's one sun-or-faces choice are
+            // other estimators of the same image.
+            let wide = match what {
+                "thousands of voxels" => vec![("4-wide", 1 << 16), ("8-wide", 2 << 16)],
+                "the sun and lamps" => vec![("coherent, 8-wide", 4096 | 2 << 16)],
+                _ => vec![],
+            };
+            for (label, experiment) in wide {
+                let x = |v: Variant| Variant { experiment, ..v };
+                let x1 = render(&ctx, &w, &p, x, 64, 9);
+                let x2 = render(&ctx, &w, &p, x, 64, 10);
+                check(
+                    &format!("GPU {label} against the CPU, {what}"),
+                    &x1,
+                    &x2,
+                    &c1,
+                    &c2,
+                );
+            }
             if what == "strengths 1 and 1000" {
                 // Shadow rays traced where they start (no shadow pass) render the same.
                 let i1 = common::gpu_render_with(&ctx, &w, &p, 24, 64, 7, on, false);

@@ -19,6 +19,10 @@
 use super::{FACE_NORMALS, LightFace, Lights};
 use glam::{DVec3, IVec3};
 
+/// Levels of the binary tree the descent takes a step (1: the binary descent; the wider
+/// steps are measured in BENCHMARKS.md "The renderer, round 7").
+const DESCENT_LEVELS: u32 = 1;
+
 /// Bounds words of an empty node (no face below it).
 pub(crate) const EMPTY_BOUNDS: [u32; 4] = [0, 0, 0, 0];
 
@@ -145,50 +149,80 @@ impl Lights {
     /// `u` ∈ [0, 1) (rescaled at each level), and its probability; None when no face can
     /// light p. The GPU descends the same way (shaders/lights.glsl `sample_light`).
     pub fn sample_from(&self, u: f64, p: DVec3, n: IVec3) -> Option<(u32, f64)> {
-        let c = self.capacity as usize;
-        if self.root_importance(p, n) <= 0.0 {
-            return None;
-        }
-        let (mut i, mut u, mut prob) = (1usize, u, 1.0);
-        while i < c {
-            let l = self.node_importance(2 * i, p, n);
-            let r = self.node_importance(2 * i + 1, p, n);
-            if l + r <= 0.0 {
-                return None;
-            }
-            let pl = l / (l + r);
-            if u < pl {
-                u /= pl;
-                prob *= pl;
-                i *= 2;
-            } else {
-                u = (u - pl) / (1.0 - pl);
-                prob *= 1.0 - pl;
-                i = 2 * i + 1;
-            }
-            u = u.min(1.0 - f64::EPSILON);
-        }
-        Some(((i - c) as u32, prob))
+        self.sample_stepping(u, p, n, DESCENT_LEVELS)
     }
 
     /// The probability that [`Lights::sample_from`] at `p` with normal `n` chooses `slot`.
     pub fn probability_from(&self, slot: u32, p: DVec3, n: IVec3) -> f64 {
+        self.probability_stepping(slot, p, n, DESCENT_LEVELS)
+    }
+
+    /// [`Lights::sample_from`] taking `levels` (1 ..= 3) levels of the binary tree a step: a
+    /// node's 2^levels descendants that many levels down are chosen among by their own
+    /// importance, as in a 2^levels-wide tree over the same nodes (the levels between are not
+    /// read). shaders/lights.glsl's `LIGHT_LEVELS` (a benchmark experiment there).
+    pub fn sample_stepping(&self, u: f64, p: DVec3, n: IVec3, levels: u32) -> Option<(u32, f64)> {
+        let c = self.capacity as usize;
+        if self.root_importance(p, n) <= 0.0 {
+            return None;
+        }
+        let depth = c.trailing_zeros();
+        let (mut i, mut u, mut prob, mut d) = (1usize, u, 1.0, 0);
+        while d < depth {
+            let s = levels.clamp(1, 3).min(depth - d);
+            let first = i << s;
+            let imp: Vec<f64> = (first..first + (1 << s))
+                .map(|j| self.node_importance(j, p, n))
+                .collect();
+            let sum: f64 = imp.iter().sum();
+            if sum <= 0.0 {
+                return None;
+            }
+            // The child whose share of [0, sum) holds u · sum: the last of positive importance
+            // whose share starts at or below it.
+            let target = u * sum;
+            let (mut below, mut pick, mut below_pick) = (0.0, 0, 0.0);
+            for (j, &x) in imp.iter().enumerate() {
+                if x > 0.0 && below <= target {
+                    pick = j;
+                    below_pick = below;
+                }
+                below += x;
+            }
+            u = ((target - below_pick) / imp[pick]).clamp(0.0, 1.0 - f64::EPSILON);
+            prob *= imp[pick] / sum;
+            i = first + pick;
+            d += s;
+        }
+        Some(((i - c) as u32, prob))
+    }
+
+    /// The probability that [`Lights::sample_stepping`] with `levels` chooses `slot`.
+    pub fn probability_stepping(&self, slot: u32, p: DVec3, n: IVec3, levels: u32) -> f64 {
         let c = self.capacity as usize;
         let leaf = c + slot as usize;
         if self.root_importance(p, n) <= 0.0 {
             return 0.0;
         }
-        let mut prob = 1.0;
         let depth = c.trailing_zeros();
-        for level in (0..depth).rev() {
-            let parent = leaf >> (level + 1);
-            let l = self.node_importance(2 * parent, p, n);
-            let r = self.node_importance(2 * parent + 1, p, n);
-            if l + r <= 0.0 {
+        let (mut prob, mut d) = (1.0, 0);
+        while d < depth {
+            let s = levels.clamp(1, 3).min(depth - d);
+            let first = (leaf >> (depth - d)) << s;
+            let on = leaf >> (depth - d - s);
+            let (mut sum, mut w) = (0.0, 0.0);
+            for j in first..first + (1 << s) {
+                let x = self.node_importance(j, p, n);
+                sum += x;
+                if j == on {
+                    w = x;
+                }
+            }
+            if sum <= 0.0 {
                 return 0.0;
             }
-            let child = leaf >> level;
-            prob *= if child & 1 == 0 { l } else { r } / (l + r);
+            prob *= w / sum;
+            d += s;
         }
         prob
     }
