@@ -55,12 +55,12 @@ float light_importance(uint i, vec3 p, ivec3 n) {
     return w * cl * cr / max(d2, r2);
 }
 
-// Benchmark only (trace.comp's EXPERIMENT bits 16..17): the descent takes LIGHT_LEVELS levels
-// of the binary tree a step, choosing among a node's 2^LIGHT_LEVELS descendants that many levels
-// down by their own importance (a 4- or 8-wide tree over the same nodes: fewer dependent steps,
-// the skipped levels' nodes unread). 1 is the binary descent of `Lights::sample_from`.
+// The descent takes LIGHT_LEVELS levels of the binary tree a step, choosing among a node's
+// 2^LIGHT_LEVELS descendants that many levels down by their own importance: an 8-wide tree over
+// the same nodes (tree.rs `DESCENT_LEVELS`, 3), the levels between unread. trace.comp's
+// EXPERIMENT bits 16..17 choose 2 or 1 (the binary descent) for the benchmark.
 #ifndef LIGHT_LEVELS
-#define LIGHT_LEVELS 1u
+#define LIGHT_LEVELS 3u
 #endif
 const uint LIGHT_WIDE = 8u; // the widest step's children (LIGHT_LEVELS ≤ 3)
 

@@ -33,8 +33,10 @@ layout(constant_id = 7) const bool COUNT_RAYS = false;
 // bits 7..10 turn traversal skips off (brickmap.glsl SKIPS_OFF), bit 11 chooses light faces by
 // weight alone (lights.glsl LIGHTS_BY_WEIGHT), bit 12 makes the sun-or-faces choice once for
 // the subgroup's lanes at a vertex (LIGHTS_COHERENT), bit 13 starts camera rays at the camera
-// (TILE_MARCH_OFF), bit 15 adds a load each traversal step waits for (PAD_LOAD), bits 16..17
-// descend the light tree 1 + their value levels a step (lights.glsl LIGHT_LEVELS).
+// (TILE_MARCH_OFF), bit 14 lowers the sun's and the faces' least share to 0.02 (sun_share),
+// bit 15 adds a load each traversal step waits for (PAD_LOAD), bits 16..17
+// descend the light tree 2 (value 1) or 1 (value 2: the binary descent) levels a step
+// instead of 3 (lights.glsl LIGHT_LEVELS).
 layout(constant_id = 8) const uint EXPERIMENT = 0u;
 // Shadow rays go to a queue that shaders/shadow.comp traces next, one per invocation, instead
 // of being traced here: in a warp only some lanes have a shadow ray at a vertex, and tracing
@@ -71,7 +73,7 @@ layout(constant_id = 15) const bool TRANSPARENT = false;
 #define PAD_LOAD ((EXPERIMENT & 32768u) != 0u)
 #define LIGHTS_BY_WEIGHT ((EXPERIMENT & 2048u) != 0u)
 #define LIGHTS_COHERENT ((EXPERIMENT & 4096u) != 0u)
-#define LIGHT_LEVELS (1u + ((EXPERIMENT >> 16) & 3u))
+#define LIGHT_LEVELS max(3u - ((EXPERIMENT >> 16) & 3u), 1u)
 // Camera rays start where their tile's frustum first meets an occupied coarse cell (off with
 // experiment bit 13, and with the coarse grid's skip off: bit 7).
 // (8320 = bits 13 and 7; one mask test: glslang miscompiles a && of two spec-constant tests.)
@@ -340,7 +342,10 @@ float sun_share(float sun, float faces) {
     if (!(faces > 0.0)) return 1.0;
     if (!(sun > 0.0)) return 0.0;
     if (LIGHTS_BY_WEIGHT) return 0.5;
-    return 0.1 + 0.8 * sun / (sun + faces);
+    // Experiment bit 14: a least share of 0.02 instead (fewer face samples where the sun's
+    // estimate dominates).
+    float least = (EXPERIMENT & 16384u) != 0u ? 0.02 : 0.1;
+    return least + (1.0 - 2.0 * least) * sun / (sun + faces);
 }
 
 // The depth (along the camera's forward axis, in units of its unnormalized film directions)

@@ -82,12 +82,15 @@ mod gpu {
             let c1 = cpu(&w, &p, true, 64, 5);
             let c2 = cpu(&w, &p, true, 64, 6);
             check(&format!("GPU against CPU, {what}"), &l1, &l2, &c1, &c2);
-            // The benchmark's light-tree experiments (trace.comp EXPERIMENT bits 12, 16..17):
-            // the 4- and 8-wide descents and the subgroup's one sun-or-faces choice are
-            // other estimators of the same image.
+            // The benchmark's light-tree experiments (trace.comp EXPERIMENT bits 12, 14, 16..17):
+            // the 4-wide and binary descents, the subgroup's one sun-or-faces choice and the
+            // least share of 0.02 are other estimators of the same image.
             let wide = match what {
-                "thousands of voxels" => vec![("4-wide", 1 << 16), ("8-wide", 2 << 16)],
-                "the sun and lamps" => vec![("coherent, 8-wide", 4096 | 2 << 16)],
+                "thousands of voxels" => vec![("4-wide", 1 << 16), ("binary", 2 << 16)],
+                "the sun and lamps" => vec![
+                    ("coherent, binary", 4096 | 2 << 16),
+                    ("least share 0.02", 16384),
+                ],
                 _ => vec![],
             };
             for (label, experiment) in wide {

@@ -19,9 +19,10 @@
 use super::{FACE_NORMALS, LightFace, Lights};
 use glam::{DVec3, IVec3};
 
-/// Levels of the binary tree the descent takes a step (1: the binary descent; the wider
-/// steps are measured in BENCHMARKS.md "The renderer, round 7").
-const DESCENT_LEVELS: u32 = 1;
+/// Levels of the binary tree the descent takes a step: 3, an 8-wide tree over the same nodes
+/// (BENCHMARKS.md "The renderer, round 7": at equal samples 53 / 11 / 30 % less error than
+/// the binary descent in the lamp room / the thesis scene with lamps / the city at night).
+pub const DESCENT_LEVELS: u32 = 3;
 
 /// Bounds words of an empty node (no face below it).
 pub(crate) const EMPTY_BOUNDS: [u32; 4] = [0, 0, 0, 0];
@@ -146,8 +147,9 @@ impl Lights {
     }
 
     /// A slot chosen for point `p` with normal `n` by descending the tree by importance with
-    /// `u` ∈ [0, 1) (rescaled at each level), and its probability; None when no face can
-    /// light p. The GPU descends the same way (shaders/lights.glsl `sample_light`).
+    /// `u` ∈ [0, 1) (rescaled at each step), [`DESCENT_LEVELS`] levels a step, and its
+    /// probability; None when no face can light p. The GPU descends the same way
+    /// (shaders/lights.glsl `sample_light`).
     pub fn sample_from(&self, u: f64, p: DVec3, n: IVec3) -> Option<(u32, f64)> {
         self.sample_stepping(u, p, n, DESCENT_LEVELS)
     }
@@ -160,7 +162,7 @@ impl Lights {
     /// [`Lights::sample_from`] taking `levels` (1 ..= 3) levels of the binary tree a step: a
     /// node's 2^levels descendants that many levels down are chosen among by their own
     /// importance, as in a 2^levels-wide tree over the same nodes (the levels between are not
-    /// read). shaders/lights.glsl's `LIGHT_LEVELS` (a benchmark experiment there).
+    /// read). shaders/lights.glsl's `LIGHT_LEVELS`.
     pub fn sample_stepping(&self, u: f64, p: DVec3, n: IVec3, levels: u32) -> Option<(u32, f64)> {
         let c = self.capacity as usize;
         if self.root_importance(p, n) <= 0.0 {
