@@ -433,7 +433,7 @@ fn bench_error_measures_every_choice_against_a_checked_reference() {
         "--size",
         "32x18",
         "--reference-spp",
-        "128",
+        "256",
         "--max-spp",
         "8",
         "--views",
