@@ -1,7 +1,8 @@
 // The light faces of emissive voxels (brickmap/src/lights/: layout, weights, the light tree's
 // bounds and importance, the face → slot table), binding 10. A face is chosen by descending
 // the tree from the root by each child's importance from the shading point, exactly as
-// `Lights::sample_from` does on the CPU (in f64 there). Keep in sync with both.
+// `Lights::sample_from` does on the CPU (in f64 there), times the light visibility cache's
+// factors (below; the GPU's alone). Keep in sync with both.
 layout(std430, set = 0, binding = 10) readonly buffer LightFaces { uint light_words[]; };
 
 const uint LIGHT_WEIGHTS = 4u;  // 256 f32 material weights after the 4-word header
@@ -13,6 +14,78 @@ float light_node(uint i) { return uintBitsToFloat(light_words[LIGHT_NODES + i]);
 float light_total() { return light_node(1u); }
 float light_weight(int material) { return uintBitsToFloat(light_words[LIGHT_WEIGHTS + uint(material)]); }
 uint light_faces_at() { return LIGHT_NODES + 10u * light_capacity(); }
+
+// The light visibility cache (render/src/vulkan/trace.rs `LightCache`), binding 11: for each
+// of CACHE_ENTRIES cells of space (8³-voxel blocks, hashed), how often shadow rays from there
+// towards the lights under each tree node of the cached level reached their light, and the
+// factors learned from those counts (shaders/light_cache.comp, before each trace dispatch). The
+// descent multiplies the importance of the nodes at its first two step levels (3 and 6, or the
+// tree's depth) by their factors, and the sun-or-faces share weighs both estimates by theirs:
+// a deterministic, positive function of the point for a whole dispatch, so sampling and the MIS
+// probability of a light face hit by a BSDF ray agree and every estimate stays unbiased.
+// Entry words: [0, 64) tries and [64, 128) unblocked rays per node of the cached level, 128..129
+// the sun's, [160, 224) those nodes' factors, [224, 232) the coarse level's, 232 the faces'
+// (all nodes), 233 the sun's, 255 the capacity the counts were gathered under.
+layout(std430, set = 0, binding = 11) buffer LightCache { uint light_cache[]; };
+const uint CACHE_ENTRIES = 8192u;
+const uint CACHE_WORDS = 256u;
+const uint NO_ENTRY = 0xFFFFFFFFu;
+#ifndef LIGHT_CACHE_ON
+#define LIGHT_CACHE_ON false
+#endif
+
+uint light_mix(uint x);
+
+// The cached level (counts and factors) and the coarse level (factors) of a tree of `depth`.
+uint cache_level(uint depth) { return min(6u, depth); }
+uint cache_coarse_level(uint depth) { return min(3u, depth); }
+
+// The cache entry of a vertex whose shadow rays start in voxel `front` (the air voxel before
+// its face), or NO_ENTRY with the cache off.
+uint cache_entry(ivec3 front) {
+    if (!LIGHT_CACHE_ON) return NO_ENTRY;
+    uvec3 b = uvec3(front >> 3);
+    return light_mix(b.x ^ light_mix(b.y ^ light_mix(b.z + 0x9e3779b9u))) & (CACHE_ENTRIES - 1u);
+}
+
+// The factor of tree node `node`'s importance at `entry` (1 at uncached levels).
+float cache_factor(uint entry, uint node) {
+    if (!LIGHT_CACHE_ON || entry == NO_ENTRY) return 1.0;
+    uint depth = uint(findMSB(light_capacity()));
+    uint level = uint(findMSB(node));
+    uint base = entry * CACHE_WORDS;
+    if (level == cache_level(depth) && level > 0u) return uintBitsToFloat(light_cache[base + 160u + node - (1u << level)]);
+    if (level == cache_coarse_level(depth) && level > 0u) return uintBitsToFloat(light_cache[base + 224u + node - (1u << level)]);
+    return 1.0;
+}
+
+// The factors of the faces' and the sun's estimates in the sun-or-faces share.
+float cache_faces_factor(uint entry) {
+    return LIGHT_CACHE_ON && entry != NO_ENTRY ? uintBitsToFloat(light_cache[entry * CACHE_WORDS + 232u]) : 1.0;
+}
+float cache_sun_factor(uint entry) {
+    return LIGHT_CACHE_ON && entry != NO_ENTRY ? uintBitsToFloat(light_cache[entry * CACHE_WORDS + 233u]) : 1.0;
+}
+
+// Counts a shadow ray from `entry` towards light slot `slot` (NO_LIGHT: the sun).
+void cache_record(uint entry, uint slot, bool unblocked) {
+    if (!LIGHT_CACHE_ON || entry == NO_ENTRY) return;
+    uint base = entry * CACHE_WORDS;
+    uint tries;
+    uint hits;
+    if (slot == 0xFFFFFFFFu) {
+        tries = base + 128u;
+        hits = base + 129u;
+    } else {
+        uint c = light_capacity();
+        uint depth = uint(findMSB(c));
+        uint level = cache_level(depth);
+        tries = base + ((c + slot) >> (depth - level)) - (1u << level);
+        hits = tries + 64u;
+    }
+    atomicAdd(light_cache[tries], 1u);
+    if (unblocked) atomicAdd(light_cache[hits], 1u);
+}
 
 // Benchmark only (trace.comp's EXPERIMENT bit 11): faces chosen by weight alone, the tree's
 // bounds ignored (and the sun and the faces half each), as before the light tree.
@@ -69,15 +142,15 @@ uint light_step(uint d, uint depth) { return min(min(LIGHT_LEVELS, 3u), depth - 
 
 // The slot chosen for p with normal n from u ∈ [0, 1) (rescaled at each step) and its
 // probability, or NO_LIGHT when no face can light p.
-uint sample_light(float u, vec3 p, ivec3 n, out float prob) {
+uint sample_light(float u, vec3 p, ivec3 n, uint entry, out float prob) {
     prob = 0.0;
     uint c = light_capacity();
     uint i = 1u;
     float pr = 1.0;
     if (LIGHT_LEVELS == 1u) {
         while (i < c) {
-            float l = light_importance(2u * i, p, n);
-            float r = light_importance(2u * i + 1u, p, n);
+            float l = light_importance(2u * i, p, n) * cache_factor(entry, 2u * i);
+            float r = light_importance(2u * i + 1u, p, n) * cache_factor(entry, 2u * i + 1u);
             if (!(l + r > 0.0)) return 0xFFFFFFFFu;
             float pl = l / (l + r);
             if (u < pl) {
@@ -102,7 +175,7 @@ uint sample_light(float u, vec3 p, ivec3 n, out float prob) {
         float imp[LIGHT_WIDE];
         float sum = 0.0;
         for (uint j = 0u; j < LIGHT_WIDE; j++) {
-            imp[j] = j < k ? light_importance(first + j, p, n) : 0.0;
+            imp[j] = j < k ? light_importance(first + j, p, n) * cache_factor(entry, first + j) : 0.0;
             sum += imp[j];
         }
         if (!(sum > 0.0)) return 0xFFFFFFFFu;
@@ -132,15 +205,15 @@ uint sample_light(float u, vec3 p, ivec3 n, out float prob) {
 
 // The probability that sample_light at p with normal n chooses `slot` (the caller knows the
 // root's importance is positive).
-float light_probability(uint slot, vec3 p, ivec3 n) {
+float light_probability(uint slot, vec3 p, ivec3 n, uint entry) {
     uint c = light_capacity();
     uint leaf = c + slot;
     float pr = 1.0;
     if (LIGHT_LEVELS == 1u) {
         for (uint level = uint(findMSB(c)); level > 0u; level--) {
             uint parent = leaf >> level;
-            float l = light_importance(2u * parent, p, n);
-            float r = light_importance(2u * parent + 1u, p, n);
+            float l = light_importance(2u * parent, p, n) * cache_factor(entry, 2u * parent);
+            float r = light_importance(2u * parent + 1u, p, n) * cache_factor(entry, 2u * parent + 1u);
             if (!(l + r > 0.0)) return 0.0;
             pr *= (((leaf >> (level - 1u)) & 1u) == 0u ? l : r) / (l + r);
         }
@@ -155,7 +228,7 @@ float light_probability(uint slot, vec3 p, ivec3 n) {
         float sum = 0.0;
         float w = 0.0;
         for (uint j = 0u; j < LIGHT_WIDE; j++) {
-            float x = j < k ? light_importance(first + j, p, n) : 0.0;
+            float x = j < k ? light_importance(first + j, p, n) * cache_factor(entry, first + j) : 0.0;
             sum += x;
             w = j == on ? x : w;
         }

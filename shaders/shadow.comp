@@ -1,5 +1,6 @@
 // Traces the shadow rays trace.comp queued (shaders/shadow_queue.glsl), one per invocation,
-// and adds the light of each unblocked one to its pixel's accumulation.
+// and adds the light of each unblocked one to its pixel's accumulation (and, for a ray from a
+// light-sampling vertex, counts its outcome in the light visibility cache).
 // Keep in sync with render/src/vulkan/trace.rs.
 #version 450
 #extension GL_EXT_shader_atomic_float : require
@@ -18,6 +19,8 @@ layout(constant_id = 2) const bool LIGHTS = false;
 #define SKIPS_OFF ((EXPERIMENT >> 7) & 15u)
 #define PAD_STEPS ((EXPERIMENT & 32u) != 0u)
 #define PAD_LOAD ((EXPERIMENT & 32768u) != 0u)
+// trace.comp's: used only where LIGHTS holds.
+#define LIGHT_CACHE_ON ((EXPERIMENT & 262144u) == 0u)
 #include "brickmap.glsl"
 
 // The trace pass's bindings: only the grid size (Params.grid) is read here.
@@ -36,7 +39,7 @@ void main() {
     ShadowRay r = shadow_rays[i];
     uint key = floatBitsToUint(r.dir_key.w);
     uint pixel = key & ((1u << PIXEL_BITS) - 1u);
-    uint off = key >> PIXEL_BITS;
+    uint off = (key >> PIXEL_BITS) & 31u;
     ivec3 cell = ivec3(floor(r.origin_t.xyz)) + ivec3(off % 3u, (off / 3u) % 3u, off / 9u) - 1;
     g_steps = 0u;
     g_capped = 0u;
@@ -53,6 +56,8 @@ void main() {
         light_face(light_slot, target, face, material);
         blocked = voxel != target;
     }
+    // The ray counts in the light visibility cache at the entry of its first cell.
+    if (LIGHTS && (key >> 31) != 0u) cache_record(cache_entry(cell), light_slot, !blocked);
     if (COUNT_RAYS) {
         atomicAdd(counters[5], g_steps);
         atomicMax(counters[7], g_steps);

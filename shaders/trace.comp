@@ -36,7 +36,8 @@ layout(constant_id = 7) const bool COUNT_RAYS = false;
 // (TILE_MARCH_OFF), bit 14 lowers the sun's and the faces' least share to 0.02 (sun_share),
 // bit 15 adds a load each traversal step waits for (PAD_LOAD), bits 16..17
 // descend the light tree 2 (value 1) or 1 (value 2: the binary descent) levels a step
-// instead of 3 (lights.glsl LIGHT_LEVELS).
+// instead of 3 (lights.glsl LIGHT_LEVELS), bit 18 turns the light visibility cache off
+// (lights.glsl LIGHT_CACHE_ON).
 layout(constant_id = 8) const uint EXPERIMENT = 0u;
 // Shadow rays go to a queue that shaders/shadow.comp traces next, one per invocation, instead
 // of being traced here: in a warp only some lanes have a shadow ray at a vertex, and tracing
@@ -74,6 +75,8 @@ layout(constant_id = 15) const bool TRANSPARENT = false;
 #define LIGHTS_BY_WEIGHT ((EXPERIMENT & 2048u) != 0u)
 #define LIGHTS_COHERENT ((EXPERIMENT & 4096u) != 0u)
 #define LIGHT_LEVELS max(3u - ((EXPERIMENT >> 16) & 3u), 1u)
+// Used only where LIGHTS holds (an && of two spec-constant tests is miscompiled, below).
+#define LIGHT_CACHE_ON ((EXPERIMENT & 262144u) == 0u)
 // Camera rays start where their tile's frustum first meets an occupied coarse cell (off with
 // experiment bit 13, and with the coarse grid's skip off: bit 7).
 // (8320 = bits 13 and 7; one mask test: glslang miscompiles a && of two spec-constant tests.)
@@ -305,6 +308,10 @@ vec3 shadow_d;
 float shadow_t;
 vec3 shadow_l;
 uint shadow_slot;
+// The light visibility cache entry the pending shadow ray counts in (NO_ENTRY: none), and the
+// entry of the vertex being scattered (lights.glsl cache_entry).
+uint shadow_entry;
+uint vertex_entry;
 
 void add_shadow(vec3 d, float t, vec3 l, uint light_slot) {
     shadow_pending = true;
@@ -312,6 +319,7 @@ void add_shadow(vec3 d, float t, vec3 l, uint light_slot) {
     shadow_t = t;
     shadow_l = l;
     shadow_slot = light_slot;
+    shadow_entry = vertex_entry;
 }
 
 // cos(max(0, θ − β)) for cos θ = c and sin β = sin_b (render/src/cpu/direct.rs `widened`).
@@ -437,6 +445,8 @@ void begin_path(uvec2 px, uint s) {
     path_face_share = 0.0;
     path_n = ivec3(0);
     shadow_pending = false;
+    shadow_entry = NO_ENTRY;
+    vertex_entry = NO_ENTRY;
 }
 
 // What the path's ray found (a voxel at t_voxel, or nothing): adds what it sees, prepares
@@ -498,8 +508,9 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
         float w = 1.0;
         if (LIGHTS && path_face_share > 0.0 && path_pdf >= 0.0) {
             uint slot = light_slot_of(voxel, face_of(normal));
+            // The vertex that sampled: its shadow rays started in path_start too.
             float pdf_light = slot == NO_LIGHT ? 0.0
-                : path_face_share * light_probability(slot, o, path_n) * t_voxel * t_voxel / -dot(d, n);
+                : path_face_share * light_probability(slot, o, path_n, cache_entry(path_start)) * t_voxel * t_voxel / -dot(d, n);
             w = power_heuristic(path_pdf, pdf_light);
         }
         pixel_sum += path_beta * s.albedo * s.param * w;
@@ -544,9 +555,13 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
         float share = sun_on ? 1.0 : 0.0;
         float u = 0.0;
         path_face_share = 0.0;
+        vertex_entry = NO_ENTRY;
         if (LIGHTS && !delta && path_medium == AIR && light_total() > 0.0) {
+            vertex_entry = cache_entry(front);
             float faces = light_importance(1u, pt, normal);
-            share = sun_on ? sun_share(sun_on ? sun_estimate(pt, normal) : 0.0, faces) : 0.0;
+            // The estimates weighed by how often each reached its light from here (the cache).
+            share = sun_on ? sun_share(sun_estimate(pt, normal) * cache_sun_factor(vertex_entry),
+                                       faces * cache_faces_factor(vertex_entry)) : 0.0;
             path_face_share = faces > 0.0 ? 1.0 - share : 0.0;
             path_n = normal;
             dims(base + 2u);
@@ -590,7 +605,7 @@ bool scatter(bool hit, ivec3 voxel, ivec3 normal, float t_voxel) {
         } else if (LIGHTS && path_face_share > 0.0) {
             // A light face from the tree by importance, a point uniform on it.
             float prob;
-            uint slot = sample_light(min(u_light, 0.99999994), pt, normal, prob);
+            uint slot = sample_light(min(u_light, 0.99999994), pt, normal, vertex_entry, prob);
             if (slot != NO_LIGHT) {
                 ivec3 lv;
                 uint lf;
@@ -695,6 +710,7 @@ void main() {
                     light_face(shadow_slot, target, face, material);
                     hit = voxel != target;
                 }
+                if (LIGHTS) cache_record(shadow_entry, shadow_slot, !hit);
                 if (!hit) pixel_sum += shadow_l;
                 shadow_pending = false;
             } else {
@@ -715,7 +731,7 @@ void main() {
                     }
                     base = subgroupBroadcastFirst(base);
                     uint slot = base + subgroupBallotExclusiveBitCount(ballot);
-                    if (want && push_shadow_ray(slot, path_o, path_start, shadow_d, shadow_t, shadow_l, shadow_slot, index)) {
+                    if (want && push_shadow_ray(slot, path_o, path_start, shadow_d, shadow_t, shadow_l, shadow_slot, index, LIGHTS && shadow_entry != NO_ENTRY)) {
                         shadow_pending = false;
                         if (COUNT_RAYS) g_rays[2]++;
                     }

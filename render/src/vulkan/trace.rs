@@ -27,7 +27,8 @@
 //! (a light face's ray may end in its light's voxel, found from the slot). A vertex may hold
 //! two pending shadow rays (the sun's and a light face's) only in `lights` variants; without
 //! them the code is the sun-only code (measured: thesis complexities unchanged).
-//! `set_deferred_shadows`/`set_queue_limit` for benchmarks and tests. A dispatch is planned
+//! `set_deferred_shadows`/`set_queue_limit` for benchmarks and tests. Light-sampling variants
+//! run the light visibility cache's pass before the trace (`light_cache.rs`; binding 11). A dispatch is planned
 //! once (`plan`: pipelines, queue, bindings) and recorded by `record_plan`, either in a waited
 //! submission (`dispatch_repeated`) or into a frame's command buffer with cached sets
 //! (`record`). The queue holds at most `queue_fit` rays (the device's limits); a larger queue
@@ -47,8 +48,11 @@ use glam::DVec3;
 use gpu_allocator::MemoryLocation;
 use std::collections::HashMap;
 
+mod light_cache;
 mod params;
 mod variant;
+use light_cache::LightCache;
+pub use light_cache::{EXPERIMENT_NO_LIGHT_CACHE, LIGHT_CACHE_ENTRIES};
 pub use params::{Dim, TraceParams, Window};
 pub use variant::Variant;
 
@@ -59,9 +63,9 @@ const SHADOW_SPIRV: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/shadow.com
 const SLICED_SPIRV: &[u8] =
     include_bytes!(concat!(env!("OUT_DIR"), "/trace.comp.SAMPLE_SLICES.spv"));
 
-/// Storage bindings of both passes: the world (0..4), parameters, accumulation, counters,
-/// shadow rays, queue header, light faces (10).
-const BINDINGS: u32 = 11;
+/// Storage bindings of the three passes: the world (0..4), parameters, accumulation, counters,
+/// shadow rays, queue header, light faces (10), the light visibility cache (11).
+const BINDINGS: u32 = 12;
 /// Bytes per queued shadow ray (`ShadowRay` in shaders/shadow_queue.glsl).
 const SHADOW_RAY_BYTES: u64 = 48;
 /// Queue capacity bounds, in rays: enough for one shadow ray per sample of a dispatch,
@@ -188,6 +192,8 @@ struct Plan {
     groups: Dispatch,
     zero: Option<Binding>,
     header: Option<Binding>,
+    /// The light visibility cache's pass first, and whether it drops the counts.
+    cache: Option<bool>,
 }
 
 /// The path-tracing pipelines, one per variant in use.
@@ -204,6 +210,8 @@ pub struct PathTracer {
     /// Whether the device can split samples (float atomic adds).
     can_slice: bool,
     counters: HostBuffer,
+    /// The light visibility cache, made with the first light-sampling dispatch.
+    cache: Option<LightCache>,
 }
 
 impl PathTracer {
@@ -225,6 +233,7 @@ impl PathTracer {
                 COUNTERS_BYTES,
                 MemoryLocation::GpuToCpu,
             )?,
+            cache: None,
         })
     }
 
@@ -446,20 +455,31 @@ impl PathTracer {
     ) -> Result<Vec<f64>, GpuError> {
         let plan = self.plan(ctx, world, variant, p, slices, uniforms, accum)?;
         let (trace, shadow) = self.passes_of(&plan);
-        let trace_set = trace.allocate_set(ctx, &plan.bound)?;
-        let shadow_set = match shadow.map(|s| s.allocate_set(ctx, &plan.bound)).transpose() {
-            Ok(set) => set,
-            Err(e) => {
-                trace.free_set(ctx, trace_set);
-                return Err(e);
+        let cache = self.cache_pass(&plan);
+        let mut sets = Vec::new();
+        for pass in std::iter::once(trace).chain(shadow).chain(cache) {
+            match pass.allocate_set(ctx, &plan.bound) {
+                Ok(set) => sets.push((pass, set)),
+                Err(e) => {
+                    for (pass, set) in sets {
+                        pass.free_set(ctx, set);
+                    }
+                    return Err(e);
+                }
             }
-        };
+        }
+        let set_of = |k: usize| sets.get(k).map(|s| s.1);
+        let shadow_set = shadow.and(set_of(1));
+        let cache_set = cache.and(set_of(1 + shadow.is_some() as usize));
+        let first = std::cell::Cell::new(true);
         let result = run_batch(ctx, count, time, |cmd| {
-            self.record_plan(ctx, cmd, &plan, trace_set, shadow_set)
+            // Only the batch's first dispatch may drop the cache's counts.
+            let cache = plan.cache.map(|reset| reset && first.replace(false));
+            let cache = cache.zip(cache_set);
+            self.record_plan(ctx, cmd, &plan, cache, sets[0].1, shadow_set)
         });
-        trace.free_set(ctx, trace_set);
-        if let (Some(s), Some(set)) = (shadow, shadow_set) {
-            s.free_set(ctx, set);
+        for (pass, set) in sets {
+            pass.free_set(ctx, set);
         }
         result
     }
@@ -487,15 +507,22 @@ impl PathTracer {
                 unreachable!("a plan dispatches groups")
             };
             plan.groups = Dispatch::Rows(x, band.rows(y), z);
-            // The sliced shader's zeroing of a new accumulation: once, before the first band.
+            // The sliced shader's zeroing of a new accumulation, and the cache's factors: once,
+            // before the first band (the pass's bands sample as its one dispatch would).
             if band.index > 0 {
                 plan.zero = None;
+                plan.cache = None;
             }
         }
         let (trace, shadow) = self.passes_of(&plan);
         let trace_set = sets.get(ctx, trace, &plan.bound)?;
         let shadow_set = shadow.map(|s| sets.get(ctx, s, &plan.bound)).transpose()?;
-        self.record_plan(ctx, cmd, &plan, trace_set, shadow_set);
+        let cache_set = self
+            .cache_pass(&plan)
+            .map(|c| sets.get(ctx, c, &plan.bound))
+            .transpose()?;
+        let cache = plan.cache.zip(cache_set);
+        self.record_plan(ctx, cmd, &plan, cache, trace_set, shadow_set);
         Ok(())
     }
 
@@ -532,6 +559,10 @@ impl PathTracer {
             };
             self.ensure_queue(ctx, samples * per_sample, max)?;
         }
+        let cached = variant.lights && variant.experiment & EXPERIMENT_NO_LIGHT_CACHE == 0;
+        if cached && self.cache.is_none() {
+            self.cache = Some(LightCache::new(ctx, BINDINGS)?);
+        }
         uniforms.write(bytemuck::bytes_of(p));
         let mut bound = world.bindings();
         bound.extend([uniforms.binding(), accum, self.counters.binding()]);
@@ -542,6 +573,18 @@ impl PathTracer {
             None => bound.extend([self.counters.binding(), self.counters.binding()]),
         }
         bound.push(world.light_binding());
+        // Unused without the cache: any valid buffer.
+        bound.push(match &self.cache {
+            Some(cache) => cache.binding(),
+            None => self.counters.binding(),
+        });
+        // The counts outlive an accumulation (a camera move keeps what the cells learnt) but
+        // not a change of the world's voxels or lights: then they start again from none, so
+        // the same world and dispatches give the same images.
+        let cache = match &mut self.cache {
+            Some(c) if cached => Some(c.reset_for(world)),
+            _ => None,
+        };
         Ok(Plan {
             pass: (variant, queued, sliced),
             shadow: queued.then_some((variant.count_rays, variant.experiment, variant.lights)),
@@ -550,7 +593,18 @@ impl PathTracer {
             // The sliced shader only adds: a new accumulation starts from zero.
             zero: (sliced && p.seed[3] == 0).then_some(accum),
             header: queue.map(|q| q.header.binding()),
+            cache,
         })
+    }
+
+    fn cache_pass(&self, plan: &Plan) -> Option<&ComputePass> {
+        plan.cache.and(self.cache.as_ref()).map(LightCache::pass)
+    }
+
+    /// The light visibility cache's buffer (tests read it back), once a light-sampling
+    /// dispatch has made it.
+    pub fn light_cache(&self) -> Option<Binding> {
+        self.cache.as_ref().map(LightCache::binding)
     }
 
     fn passes_of(&self, plan: &Plan) -> (&ComputePass, Option<&ComputePass>) {
@@ -560,12 +614,14 @@ impl PathTracer {
         )
     }
 
-    /// Records a planned dispatch: zeroing and queue reset, the trace pass, the shadow pass.
+    /// Records a planned dispatch: zeroing and queue reset, the light visibility cache's pass
+    /// (`cache`: whether it drops the counts, and its set), the trace pass, the shadow pass.
     fn record_plan(
         &self,
         ctx: &GpuContext,
         cmd: vk::CommandBuffer,
         plan: &Plan,
+        cache: Option<(bool, vk::DescriptorSet)>,
         trace_set: vk::DescriptorSet,
         shadow_set: Option<vk::DescriptorSet>,
     ) {
@@ -588,6 +644,9 @@ impl PathTracer {
             if plan.zero.is_some() || plan.header.is_some() {
                 barrier(ctx, cmd, Scope::TRANSFER_WRITE, Scope::SHADER_RW);
             }
+        }
+        if let (Some((reset, set)), Some(c)) = (cache, &self.cache) {
+            c.record(ctx, cmd, set, reset);
         }
         trace.record(ctx, cmd, trace_set, &[], plan.groups);
         if let (Some(h), Some(shadow), Some(set)) = (plan.header, shadow, shadow_set) {
@@ -632,5 +691,8 @@ impl PathTracer {
             q.header.destroy(ctx);
         }
         self.counters.destroy(ctx);
+        if let Some(cache) = self.cache {
+            cache.destroy(ctx);
+        }
     }
 }

@@ -87,7 +87,14 @@ pub struct GpuWorld {
     queue: VecDeque<Upload>,
     dims: [u32; 3],
     words_per_column: u32,
+    /// This world among those made in the process, and how many times its bytes on the GPU
+    /// changed ([`GpuWorld::state`]).
+    id: u64,
+    changes: u64,
 }
+
+/// Ids of the GPU worlds made so far.
+static WORLDS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 fn align(x: u64, a: u64) -> u64 {
     x.div_ceil(a) * a
@@ -251,6 +258,8 @@ impl GpuWorld {
             queue: VecDeque::new(),
             dims: dims.bricks().to_array(),
             words_per_column: dims.coarse_words_per_column() as u32,
+            id: WORLDS.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            changes: 0,
         };
         let whole = sizes.map(|s| std::iter::once(0..s).collect());
         let staged = world
@@ -297,6 +306,7 @@ impl GpuWorld {
     fn flush(&mut self, ctx: &GpuContext) -> Result<UploadReport, GpuError> {
         let buffers: [vk::Buffer; N] = std::array::from_fn(|i| self.buffers[i].raw);
         let flushed = self.ring.flush(ctx, &mut self.queue, |r| (buffers[r], 0))?;
+        self.changes += u64::from(flushed.bytes > 0);
         Ok(UploadReport {
             uploaded_bytes: flushed.bytes,
             copy_regions: flushed.regions,
@@ -320,6 +330,7 @@ impl GpuWorld {
         if sizes.iter().zip(&self.buffers).any(|(s, b)| *s > b.size) {
             self.grow(ctx, sizes)?;
             report.grew = true;
+            self.changes += 1;
         }
         let mut bytes = Vec::new();
         let mut runs: [Vec<Range<usize>>; N] = Default::default();
@@ -432,6 +443,12 @@ impl GpuWorld {
             .map(HostBuffer::binding)
             .collect()
     }
+    /// Which world this is and how many times its GPU bytes changed: equal states hold the
+    /// same voxels and lights (the tracer's light visibility cache is kept while it is).
+    pub fn state(&self) -> (u64, u64) {
+        (self.id, self.changes)
+    }
+
     /// The light faces' region ([`brickmap::lights`]; binding 10 of the tracer).
     pub fn light_binding(&self) -> Binding {
         self.buffers[GpuBuffer::Lights as usize].binding()
