@@ -214,6 +214,100 @@ mod gpu {
     }
 
     #[test]
+    fn the_light_cache_counts_each_shadow_ray_keeps_its_counts_and_drops_them_when_the_world_changes()
+     {
+        use render::vulkan::trace::{LIGHT_CACHE_ENTRIES, PathTracer};
+        use render::vulkan::world::GpuWorld;
+        let Some(ctx) = common::gpu_context(DeviceChoice::Best) else {
+            return;
+        };
+        let (w, p) = sealed_lamps();
+        // A 1-spp render (one dispatch) on `tracer`, and the cache's tries and unblocked rays
+        // summed over its entries, per word of an entry (0..64 the nodes, 128 the sun's).
+        let counts = |tracer: &mut PathTracer, world: &GpuWorld, seed: u64| {
+            let view = w.read();
+            let job = RenderJob {
+                width: 24,
+                height: 24,
+                spp: 1,
+                seed,
+            };
+            let how = render::viewport::RenderHow::variant(Variant::for_scene(&view, &p));
+            tracer.render(&ctx, world, &view, &p, &job, how).unwrap();
+            let bytes =
+                render::vulkan::buffer::read_device(&ctx, tracer.light_cache().unwrap()).unwrap();
+            let words: Vec<u32> = bytes
+                .chunks_exact(4)
+                .map(|b| u32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
+                .collect();
+            assert_eq!(words.len(), LIGHT_CACHE_ENTRIES as usize * 256);
+            let mut tries = vec![0u64; 64];
+            let mut unblocked = vec![0u64; 64];
+            for entry in words.chunks_exact(256) {
+                for k in 0..64 {
+                    tries[k] += u64::from(entry[k]);
+                    unblocked[k] += u64::from(entry[64 + k]);
+                }
+            }
+            (tries, unblocked)
+        };
+        let total = |v: &[u64]| v.iter().sum::<u64>();
+        let fresh = |queued: bool| {
+            let world = GpuWorld::upload(&ctx, &w.read()).unwrap();
+            let mut tracer = PathTracer::new(&ctx).unwrap();
+            tracer.set_deferred_shadows(&ctx, queued);
+            (tracer, world)
+        };
+        // Queued shadow rays and rays traced in place count alike.
+        let (mut queued, mut world) = fresh(true);
+        let (mut in_place, other) = fresh(false);
+        let (tries, unblocked) = counts(&mut queued, &world, 1);
+        let (tries_here, unblocked_here) = counts(&mut in_place, &other, 1);
+        assert_eq!(tries, tries_here, "the same rays, from either pass");
+        let (a, b) = (total(&unblocked) as f64, total(&unblocked_here) as f64);
+        assert!((a - b).abs() <= 1e-3 * a, "{a} against {b} unblocked");
+        // Most lamps are sealed: many rays towards them, few of them unblocked.
+        assert!(total(&tries) > 1000 && total(&unblocked) > 0, "{tries:?}");
+        assert!(
+            total(&unblocked) < total(&tries) / 2,
+            "{unblocked:?} of {tries:?}"
+        );
+        // A second render on the same world adds to the counts (a camera move keeps them).
+        let (more, _) = counts(&mut queued, &world, 2);
+        assert!(
+            total(&more) > total(&tries) * 3 / 2,
+            "{more:?} after {tries:?}"
+        );
+        // An edit (a voxel set and cleared: the same world, changed) drops them: the next
+        // render counts as a new tracer's first.
+        for mode in [Mode::Add(0), Mode::Remove] {
+            let at = IVec3::new(2, 1, 2);
+            w.apply(EditOp::Shape {
+                shape: Shape::Box { min: at, max: at },
+                mode,
+            })
+            .unwrap();
+            world.sync(&ctx, &w).unwrap();
+        }
+        let (after, _) = counts(&mut queued, &world, 3);
+        let (first, _) = counts(&mut in_place, &other, 3);
+        let (mut new, unused) = fresh(true);
+        let (again, _) = counts(&mut new, &world, 3);
+        unused.destroy(&ctx);
+        assert_eq!(after, again, "an edit starts the counts afresh");
+        assert!(
+            total(&first) > total(&after),
+            "the untouched tracer kept counting"
+        );
+        for t in [queued, in_place, new] {
+            t.destroy(&ctx);
+        }
+        world.destroy(&ctx);
+        other.destroy(&ctx);
+        assert_eq!(ctx.validation_errors(), 0);
+    }
+
+    #[test]
     fn no_nan_when_the_last_light_face_is_erased() {
         let Some(ctx) = common::gpu_context(DeviceChoice::Best) else {
             return;
