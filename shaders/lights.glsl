@@ -16,7 +16,8 @@ float light_weight(int material) { return uintBitsToFloat(light_words[LIGHT_WEIG
 uint light_faces_at() { return LIGHT_NODES + 10u * light_capacity(); }
 
 // The light visibility cache (render/src/vulkan/trace.rs `LightCache`), binding 11: for each
-// of CACHE_ENTRIES cells of space (8³-voxel blocks, hashed), how often shadow rays from there
+// of its entries (cache_entries(): 8192 where the device's limits allow, a power of two) for
+// cells of space (8³-voxel blocks, hashed), how often shadow rays from there
 // towards the lights under each tree node of the cached level reached their light, and the
 // factors learned from those counts (shaders/light_cache.comp, before each trace dispatch). The
 // descent multiplies the importance of the nodes at its first two step levels (3 and 6, or the
@@ -27,7 +28,6 @@ uint light_faces_at() { return LIGHT_NODES + 10u * light_capacity(); }
 // the sun's, [160, 224) those nodes' factors, [224, 232) the coarse level's, 232 the faces'
 // (all nodes), 233 the sun's, 255 the capacity the counts were gathered under.
 layout(std430, set = 0, binding = 11) buffer LightCache { uint light_cache[]; };
-const uint CACHE_ENTRIES = 8192u;
 const uint CACHE_WORDS = 256u;
 const uint NO_ENTRY = 0xFFFFFFFFu;
 #ifndef LIGHT_CACHE_ON
@@ -35,6 +35,8 @@ const uint NO_ENTRY = 0xFFFFFFFFu;
 #endif
 
 uint light_mix(uint x);
+
+uint cache_entries() { return uint(light_cache.length()) / CACHE_WORDS; }
 
 // The cached level (counts and factors) and the coarse level (factors) of a tree of `depth`.
 uint cache_level(uint depth) { return min(6u, depth); }
@@ -45,7 +47,7 @@ uint cache_coarse_level(uint depth) { return min(3u, depth); }
 uint cache_entry(ivec3 front) {
     if (!LIGHT_CACHE_ON) return NO_ENTRY;
     uvec3 b = uvec3(front >> 3);
-    return light_mix(b.x ^ light_mix(b.y ^ light_mix(b.z + 0x9e3779b9u))) & (CACHE_ENTRIES - 1u);
+    return light_mix(b.x ^ light_mix(b.y ^ light_mix(b.z + 0x9e3779b9u))) & (cache_entries() - 1u);
 }
 
 // The factor of tree node `node`'s importance at `entry` (1 at uncached levels).

@@ -240,7 +240,11 @@ mod gpu {
                 .chunks_exact(4)
                 .map(|b| u32::from_ne_bytes([b[0], b[1], b[2], b[3]]))
                 .collect();
-            assert_eq!(words.len(), LIGHT_CACHE_ENTRIES as usize * 256);
+            assert_eq!(
+                words.len(),
+                LIGHT_CACHE_ENTRIES as usize * 256,
+                "all entries fit"
+            );
             let mut tries = vec![0u64; 64];
             let mut unblocked = vec![0u64; 64];
             for entry in words.chunks_exact(256) {

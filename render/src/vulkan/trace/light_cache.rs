@@ -1,6 +1,7 @@
 //! The light visibility cache of the light-sampling variants (shaders/lights.glsl
 //! `LightCache`, shaders/light_cache.comp; docs/DESIGN.md "The GPU's light visibility cache"):
-//! per 8³-voxel cell (hashed into [`LIGHT_CACHE_ENTRIES`]), how often shadow rays from there
+//! per 8³-voxel cell (hashed into at most [`LIGHT_CACHE_ENTRIES`] entries: fewer where the
+//! device's limits do not fit them), how often shadow rays from there
 //! reached the lights under each node of the light tree's cached level, and the factors the
 //! descent weighs those nodes by. The trace and shadow passes add to the counts; this pass,
 //! recorded before each trace dispatch, turns them into factors. The counts are kept while the
@@ -16,9 +17,9 @@ use gpu_allocator::MemoryLocation;
 
 const SPIRV: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/light_cache.comp.spv"));
 
-/// Entries of the cache (lights.glsl `CACHE_ENTRIES`), 256 words each (`CACHE_WORDS`).
+/// The most entries of the cache, 256 words each (lights.glsl `CACHE_WORDS`).
 pub const LIGHT_CACHE_ENTRIES: u32 = 8192;
-const BYTES: u64 = LIGHT_CACHE_ENTRIES as u64 * 256 * 4;
+const ENTRY_BYTES: u64 = 256 * 4;
 /// trace.comp's experiment bit that turns the cache off (lights.glsl `LIGHT_CACHE_ON`).
 pub const EXPERIMENT_NO_LIGHT_CACHE: u32 = 1 << 18;
 
@@ -27,16 +28,27 @@ pub(super) struct LightCache {
     buffer: HostBuffer,
     pass: ComputePass,
     world: Option<(u64, u64)>,
+    entries: u32,
 }
 
 impl LightCache {
     /// A cache with no counts yet (its first pass zeroes the buffer); `bindings` is the
     /// tracer's binding count, which the pass shares.
     pub(super) fn new(ctx: &GpuContext, bindings: u32) -> Result<Self, GpuError> {
+        // The most that fits the storage range, the allocation size and the pass's groups, as a
+        // power of two (the shader masks its hash with it).
+        let fit = ctx
+            .limits
+            .elements(ENTRY_BYTES)
+            .min(u64::from(LIGHT_CACHE_ENTRIES))
+            .min(u64::from(ctx.limits.groups[0]))
+            .max(1);
+        let entries = 1u32 << fit.ilog2();
+        let bytes = u64::from(entries) * ENTRY_BYTES;
         let buffer = HostBuffer::new(
             ctx,
             "light visibility cache",
-            BYTES,
+            bytes,
             MemoryLocation::GpuOnly,
         )?;
         match ComputePass::new(ctx, SPIRV, bindings, 4) {
@@ -44,6 +56,7 @@ impl LightCache {
                 buffer,
                 pass,
                 world: None,
+                entries,
             }),
             Err(e) => {
                 buffer.destroy(ctx);
@@ -79,13 +92,8 @@ impl LightCache {
         // SAFETY: recording.
         unsafe { barrier(ctx, cmd, Scope::SHADER_WRITE, Scope::SHADER_RW) };
         let push = u32::from(reset).to_ne_bytes();
-        self.pass.record(
-            ctx,
-            cmd,
-            set,
-            &push,
-            Dispatch::Groups(LIGHT_CACHE_ENTRIES, 1, 1),
-        );
+        self.pass
+            .record(ctx, cmd, set, &push, Dispatch::Groups(self.entries, 1, 1));
         // SAFETY: recording.
         unsafe { barrier(ctx, cmd, Scope::SHADER_WRITE, Scope::SHADER_RW) };
     }
