@@ -20,7 +20,7 @@ layout(constant_id = 2) const bool LIGHTS = false;
 #define PAD_STEPS ((EXPERIMENT & 32u) != 0u)
 #define PAD_LOAD ((EXPERIMENT & 32768u) != 0u)
 // trace.comp's: used only where LIGHTS holds.
-#define LIGHT_CACHE_ON ((EXPERIMENT & 262144u) == 0u)
+#define LIGHT_CACHE_ON ((EXPERIMENT & 262144u) != 0u)
 #include "brickmap.glsl"
 
 // The trace pass's bindings: only the grid size (Params.grid) is read here.

@@ -36,8 +36,8 @@ layout(constant_id = 7) const bool COUNT_RAYS = false;
 // (TILE_MARCH_OFF), bit 14 lowers the sun's and the faces' least share to 0.02 (sun_share),
 // bit 15 adds a load each traversal step waits for (PAD_LOAD), bits 16..17
 // descend the light tree 2 (value 1) or 1 (value 2: the binary descent) levels a step
-// instead of 3 (lights.glsl LIGHT_LEVELS), bit 18 turns the light visibility cache off
-// (lights.glsl LIGHT_CACHE_ON).
+// instead of 3 (lights.glsl LIGHT_LEVELS), bit 18 turns the light visibility cache on
+// (lights.glsl LIGHT_CACHE_ON; render/src/vulkan/trace/light_cache.rs says why not by default).
 layout(constant_id = 8) const uint EXPERIMENT = 0u;
 // Shadow rays go to a queue that shaders/shadow.comp traces next, one per invocation, instead
 // of being traced here: in a warp only some lanes have a shadow ray at a vertex, and tracing
@@ -76,7 +76,7 @@ layout(constant_id = 15) const bool TRANSPARENT = false;
 #define LIGHTS_COHERENT ((EXPERIMENT & 4096u) != 0u)
 #define LIGHT_LEVELS max(3u - ((EXPERIMENT >> 16) & 3u), 1u)
 // Used only where LIGHTS holds (an && of two spec-constant tests is miscompiled, below).
-#define LIGHT_CACHE_ON ((EXPERIMENT & 262144u) == 0u)
+#define LIGHT_CACHE_ON ((EXPERIMENT & 262144u) != 0u)
 // Camera rays start where their tile's frustum first meets an occupied coarse cell (off with
 // experiment bit 13, and with the coarse grid's skip off: bit 7).
 // (8320 = bits 13 and 7; one mask test: glslang miscompiles a && of two spec-constant tests.)

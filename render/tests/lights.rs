@@ -167,11 +167,11 @@ mod gpu {
             return;
         };
         let (w, p) = sealed_lamps();
-        let cached = |v: Variant| v;
-        let uncached = |v: Variant| Variant {
-            experiment: render::vulkan::trace::EXPERIMENT_NO_LIGHT_CACHE,
+        let cached = |v: Variant| Variant {
+            experiment: render::vulkan::trace::EXPERIMENT_LIGHT_CACHE,
             ..v
         };
+        let uncached = |v: Variant| v;
         let on: Vec<Image> = (0..2)
             .map(|s| render(&ctx, &w, &p, cached, 256, 20 + s))
             .collect();
@@ -232,7 +232,11 @@ mod gpu {
                 spp: 1,
                 seed,
             };
-            let how = render::viewport::RenderHow::variant(Variant::for_scene(&view, &p));
+            let variant = Variant {
+                experiment: render::vulkan::trace::EXPERIMENT_LIGHT_CACHE,
+                ..Variant::for_scene(&view, &p)
+            };
+            let how = render::viewport::RenderHow::variant(variant);
             tracer.render(&ctx, world, &view, &p, &job, how).unwrap();
             let bytes =
                 render::vulkan::buffer::read_device(&ctx, tracer.light_cache().unwrap()).unwrap();

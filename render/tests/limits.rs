@@ -2,9 +2,8 @@
 //! `maxMemoryAllocationSize` capped far below the real ones (as `VOXBRICK_MAX_STORAGE_RANGE` /
 //! `VOXBRICK_MAX_ALLOCATION` do), the world goes to the GPU in one buffer per region, the
 //! shadow-ray queue holds what fits and the rest is traced in place, the light visibility cache
-//! takes the entries that fit, and the image is the uncapped renderer's (same seed, within
-//! float rounding, the cache off: its entries hash cells apart differently), with no
-//! validation message. What
+//! (an experiment) takes the entries that fit, and the image is the uncapped renderer's (same
+//! seed, within float rounding), with no validation message. What
 //! cannot fit is refused with [`GpuError::Limit`], never bound past a limit, and the
 //! interactive viewport traces a smaller internal image instead.
 
@@ -13,7 +12,7 @@ mod common;
 use brickmap::GpuBuffer;
 use render::Image;
 use render::viewport::{FrameRequest, IMAGE_BYTES_PER_PIXEL, RenderHow, Viewport};
-use render::vulkan::trace::{EXPERIMENT_NO_LIGHT_CACHE, PathTracer, Variant, queue_fit};
+use render::vulkan::trace::{EXPERIMENT_LIGHT_CACHE, PathTracer, Variant, queue_fit};
 use render::vulkan::{ContextOptions, DeviceChoice, GpuContext, GpuError};
 use std::sync::Arc;
 
@@ -88,17 +87,17 @@ fn capped_limits_render_the_uncapped_image_without_validation_messages() {
             "{what}: the capped queue ({}) must be smaller than a dispatch's rays ({wanted})",
             queue_fit(&ctx.limits)
         );
-        let uncached = |v: Variant| Variant {
-            experiment: EXPERIMENT_NO_LIGHT_CACHE,
-            ..v
-        };
         for seed in [3, 4] {
-            let a = common::gpu_render_with(&full, world, params, SIZE, 8, seed, uncached, true);
-            let b = common::gpu_render_with(&ctx, world, params, SIZE, 8, seed, uncached, true);
+            let a = common::gpu_render_with(&full, world, params, SIZE, 8, seed, |v| v, true);
+            let b = common::gpu_render_with(&ctx, world, params, SIZE, 8, seed, |v| v, true);
             assert_same_within_rounding(&a, &b, &format!("{what}, seed {seed}"));
         }
-        // With the cache, in the entries that fit.
-        let cached = common::gpu_render_with(&ctx, world, params, SIZE, 8, 5, |v| v, true);
+        // The light visibility cache (an experiment), in the entries that fit.
+        let cache = |v: Variant| Variant {
+            experiment: EXPERIMENT_LIGHT_CACHE,
+            ..v
+        };
+        let cached = common::gpu_render_with(&ctx, world, params, SIZE, 8, 5, cache, true);
         common::assert_finite_and_nonnegative(&cached, what);
         assert_eq!(ctx.validation_errors(), 0, "{what}: capped");
     }

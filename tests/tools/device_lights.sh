@@ -4,10 +4,10 @@
 #   cp tests/tools/device_lights.sh .device/ && bash .device/device_lights.sh
 # `bench-gpu --lights` (light tree against BSDF only in the lamp room, thesis + lamps + sun and
 # the city at night; GPU time by timestamp queries, relMSE against a 1024-spp reference) for:
-#   0       8-wide descent with the light visibility cache (the renderer)
-#   393216  binary descent, no cache (the estimator before stop 57)
-#   262144  8-wide descent, no cache
-#   4096    0 with one sun-or-faces choice per subgroup (LIGHTS_COHERENT)
+#   0       8-wide descent (the renderer)
+#   262144  8-wide descent with the light visibility cache (experiment bit 18)
+#   131072  binary descent (the estimator before stop 57)
+#   266240  the cache with one sun-or-faces choice per subgroup (bits 18 and 12)
 # Each run writes its own file; one archive comes back even if a run times out.
 set -u
 cd "$(dirname "$0")/.."
@@ -24,6 +24,6 @@ run() {
     echo "rc $? $((SECONDS - t0)) s" | tee -a "$OUT/r/$name.txt"
     grep -E "median|steady|edit:" "$OUT/r/$name.txt" | tail -9
 }
-for x in 0 393216 262144 4096; do
+for x in 0 262144 131072 266240; do
     run "lights-$x" bench-gpu --lights --reference-spp 1024 --experiment "$x"
 done

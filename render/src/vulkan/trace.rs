@@ -27,8 +27,9 @@
 //! (a light face's ray may end in its light's voxel, found from the slot). A vertex may hold
 //! two pending shadow rays (the sun's and a light face's) only in `lights` variants; without
 //! them the code is the sun-only code (measured: thesis complexities unchanged).
-//! `set_deferred_shadows`/`set_queue_limit` for benchmarks and tests. Light-sampling variants
-//! run the light visibility cache's pass before the trace (`light_cache.rs`; binding 11). A dispatch is planned
+//! `set_deferred_shadows`/`set_queue_limit` for benchmarks and tests. With experiment bit 18,
+//! light-sampling variants run the light visibility cache's pass before the trace
+//! (`light_cache.rs`; binding 11). A dispatch is planned
 //! once (`plan`: pipelines, queue, bindings) and recorded by `record_plan`, either in a waited
 //! submission (`dispatch_repeated`) or into a frame's command buffer with cached sets
 //! (`record`). The queue holds at most `queue_fit` rays (the device's limits); a larger queue
@@ -52,7 +53,7 @@ mod light_cache;
 mod params;
 mod variant;
 use light_cache::LightCache;
-pub use light_cache::{EXPERIMENT_NO_LIGHT_CACHE, LIGHT_CACHE_ENTRIES};
+pub use light_cache::{EXPERIMENT_LIGHT_CACHE, LIGHT_CACHE_ENTRIES};
 pub use params::{Dim, TraceParams, Window};
 pub use variant::Variant;
 
@@ -559,7 +560,7 @@ impl PathTracer {
             };
             self.ensure_queue(ctx, samples * per_sample, max)?;
         }
-        let cached = variant.lights && variant.experiment & EXPERIMENT_NO_LIGHT_CACHE == 0;
+        let cached = variant.lights && variant.experiment & EXPERIMENT_LIGHT_CACHE != 0;
         if cached && self.cache.is_none() {
             self.cache = Some(LightCache::new(ctx, BINDINGS)?);
         }

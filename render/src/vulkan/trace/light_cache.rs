@@ -1,5 +1,6 @@
 //! The light visibility cache of the light-sampling variants (shaders/lights.glsl
 //! `LightCache`, shaders/light_cache.comp; docs/DESIGN.md "The GPU's light visibility cache"):
+//! an experiment (trace.comp's experiment bit 18, [`EXPERIMENT_LIGHT_CACHE`]), off by default:
 //! per 8³-voxel cell (hashed into at most [`LIGHT_CACHE_ENTRIES`] entries: fewer where the
 //! device's limits do not fit them), how often shadow rays from there
 //! reached the lights under each node of the light tree's cached level, and the factors the
@@ -20,8 +21,11 @@ const SPIRV: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/light_cache.comp.
 /// The most entries of the cache, 256 words each (lights.glsl `CACHE_WORDS`).
 pub const LIGHT_CACHE_ENTRIES: u32 = 8192;
 const ENTRY_BYTES: u64 = 256 * 4;
-/// trace.comp's experiment bit that turns the cache off (lights.glsl `LIGHT_CACHE_ON`).
-pub const EXPERIMENT_NO_LIGHT_CACHE: u32 = 1 << 18;
+/// trace.comp's experiment bit that turns the cache on (lights.glsl `LIGHT_CACHE_ON`): an
+/// experiment, off in every real render — it learns between dispatches, so an image would
+/// depend on where dispatches end and on the renders before (tiles, bands of another shape,
+/// the one-shot and the interactive accumulation would differ).
+pub const EXPERIMENT_LIGHT_CACHE: u32 = 1 << 18;
 
 /// The cache's buffer and pass, and the world state its counts were gathered in.
 pub(super) struct LightCache {
