@@ -15,7 +15,8 @@ float light_total() { return light_node(1u); }
 float light_weight(int material) { return uintBitsToFloat(light_words[LIGHT_WEIGHTS + uint(material)]); }
 uint light_faces_at() { return LIGHT_NODES + 10u * light_capacity(); }
 
-// The light visibility cache (render/src/vulkan/trace.rs `LightCache`), binding 11: for each
+// The light visibility cache (an experiment: trace.comp's EXPERIMENT bit 18;
+// render/src/vulkan/trace/light_cache.rs), binding 11: for each
 // of its entries (cache_entries(): 8192 where the device's limits allow, a power of two) for
 // cells of space (8³-voxel blocks, hashed), how often shadow rays from there
 // towards the lights under each tree node of the cached level reached their light, and the
@@ -24,11 +25,18 @@ uint light_faces_at() { return LIGHT_NODES + 10u * light_capacity(); }
 // tree's depth) by their factors, and the sun-or-faces share weighs both estimates by theirs:
 // a deterministic, positive function of the point for a whole dispatch, so sampling and the MIS
 // probability of a light face hit by a BSDF ray agree and every estimate stays unbiased.
-// Entry words: [0, 64) tries and [64, 128) unblocked rays per node of the cached level, 128..129
-// the sun's, [160, 224) those nodes' factors, [224, 232) the coarse level's, 232 the faces'
-// (all nodes), 233 the sun's, 255 the capacity the counts were gathered under.
+// Entry words, from the constants below: tries and unblocked rays per node of the cached level,
+// the sun's two, those nodes' factors, the coarse level's, the faces' (all nodes), the sun's,
+// and last the capacity the counts were gathered under.
 layout(std430, set = 0, binding = 11) buffer LightCache { uint light_cache[]; };
 const uint CACHE_WORDS = 256u;
+const uint CACHE_NODES = 64u;        // nodes of the cached level at most (level 6)
+const uint CACHE_HITS = 64u;         // [CACHE_HITS, +64): unblocked rays ([0, 64): tries)
+const uint CACHE_SUN = 128u;         // the sun's tries, then its unblocked rays
+const uint CACHE_FACTORS = 160u;     // [CACHE_FACTORS, +64): the cached level's factors
+const uint CACHE_COARSE = 224u;      // [CACHE_COARSE, +8): the coarse level's factors
+const uint CACHE_FACES = 232u;       // the faces' factor, then the sun's
+const uint CACHE_CAPACITY = 255u;
 const uint NO_ENTRY = 0xFFFFFFFFu;
 #ifndef LIGHT_CACHE_ON
 #define LIGHT_CACHE_ON false
@@ -56,17 +64,17 @@ float cache_factor(uint entry, uint node) {
     uint depth = uint(findMSB(light_capacity()));
     uint level = uint(findMSB(node));
     uint base = entry * CACHE_WORDS;
-    if (level == cache_level(depth) && level > 0u) return uintBitsToFloat(light_cache[base + 160u + node - (1u << level)]);
-    if (level == cache_coarse_level(depth) && level > 0u) return uintBitsToFloat(light_cache[base + 224u + node - (1u << level)]);
+    if (level == cache_level(depth) && level > 0u) return uintBitsToFloat(light_cache[base + CACHE_FACTORS + node - (1u << level)]);
+    if (level == cache_coarse_level(depth) && level > 0u) return uintBitsToFloat(light_cache[base + CACHE_COARSE + node - (1u << level)]);
     return 1.0;
 }
 
 // The factors of the faces' and the sun's estimates in the sun-or-faces share.
 float cache_faces_factor(uint entry) {
-    return LIGHT_CACHE_ON && entry != NO_ENTRY ? uintBitsToFloat(light_cache[entry * CACHE_WORDS + 232u]) : 1.0;
+    return LIGHT_CACHE_ON && entry != NO_ENTRY ? uintBitsToFloat(light_cache[entry * CACHE_WORDS + CACHE_FACES]) : 1.0;
 }
 float cache_sun_factor(uint entry) {
-    return LIGHT_CACHE_ON && entry != NO_ENTRY ? uintBitsToFloat(light_cache[entry * CACHE_WORDS + 233u]) : 1.0;
+    return LIGHT_CACHE_ON && entry != NO_ENTRY ? uintBitsToFloat(light_cache[entry * CACHE_WORDS + CACHE_FACES + 1u]) : 1.0;
 }
 
 // Counts a shadow ray from `entry` towards light slot `slot` (NO_LIGHT: the sun).
@@ -76,14 +84,14 @@ void cache_record(uint entry, uint slot, bool unblocked) {
     uint tries;
     uint hits;
     if (slot == 0xFFFFFFFFu) {
-        tries = base + 128u;
-        hits = base + 129u;
+        tries = base + CACHE_SUN;
+        hits = tries + 1u;
     } else {
         uint c = light_capacity();
         uint depth = uint(findMSB(c));
         uint level = cache_level(depth);
         tries = base + ((c + slot) >> (depth - level)) - (1u << level);
-        hits = tries + 64u;
+        hits = tries + CACHE_HITS;
     }
     atomicAdd(light_cache[tries], 1u);
     if (unblocked) atomicAdd(light_cache[hits], 1u);

@@ -18,8 +18,8 @@ const uint PIXEL_BITS = 26u;
 
 // Stores a shadow ray at `slot`: its first cell as an offset in {-1, 0, 1}³ from the cell
 // holding its origin, with the pixel and (bit 31) whether its outcome counts in the light
-// visibility cache (at the entry of that first cell), in one word. False when it does not fit (queue full,
-// pixel index too large, or the offset out of range): the caller traces it itself.
+// visibility cache (at the entry of that first cell), in one word. False when it does not fit
+// (queue full, pixel index too large, or the offset out of range): the caller traces it itself.
 bool push_shadow_ray(uint slot, vec3 o, ivec3 cell, vec3 d, float t, vec3 light, uint light_slot, uint pixel, bool cached) {
     ivec3 off = cell - ivec3(floor(o)) + 1;
     if (slot >= uint(shadow_rays.length()) || pixel >= (1u << PIXEL_BITS)

@@ -443,6 +443,7 @@ impl GpuWorld {
             .map(HostBuffer::binding)
             .collect()
     }
+
     /// Which world this is and how many times its GPU bytes changed: equal states hold the
     /// same voxels and lights (the tracer's light visibility cache is kept while it is).
     pub fn state(&self) -> (u64, u64) {
